@@ -1,0 +1,231 @@
+"""Match configuration: frozen dataclasses with defaults, passed explicitly.
+
+Every physical constant carries its unit next to it. The whole configuration
+travels as JSON (``MatchConfig.to_json``/``from_json``), so every process of a
+match, local or on a robot's own computer, plays from the very same numbers.
+
+Field numbers (design.md section 7): a 12 m x 8 m playing area, 1 m run-off
+enclosed by a fence, goals 2 m wide and 1 m high. The MSL rule book's areas
+(22 m x 14 m field) are scaled down and rounded; the chosen values are listed in
+docs/field.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+import msgspec
+
+TEAMS = ("a", "b")
+KINDS = ("engine", "referee", "basestation", "robot", "recorder")
+
+
+@dataclass(frozen=True)
+class FieldParams:
+    length: float = 12.0  # [m] goal line to goal line
+    width: float = 8.0  # [m] touch line to touch line
+    runoff: float = 1.0  # [m] border between the lines and the fence
+    goal_width: float = 2.0  # [m] inner distance between the posts
+    goal_height: float = 1.0  # [m] crossbar height
+    goal_depth: float = 0.5  # [m] net depth behind the goal line
+    center_circle_radius: float = 1.0  # [m] MSL 2 m, scaled
+    penalty_area_depth: float = 1.5  # [m] MSL 2.25 m, scaled
+    penalty_area_width: float = 5.0  # [m] MSL 6.5 m, scaled
+    goal_area_depth: float = 0.5  # [m] MSL 0.75 m, scaled
+    goal_area_width: float = 3.0  # [m] MSL 3.9 m, scaled
+    penalty_mark_distance: float = 2.0  # [m] from the goal line; MSL 3 m, scaled
+    corner_arc_radius: float = 0.5  # [m]
+    line_width: float = 0.125  # [m]
+
+
+@dataclass(frozen=True)
+class RobotParams:
+    """The IRIS robot (paper 2): 45 x 45 cm, 37 kg, four omni wheels."""
+
+    model: str = "omni4"  # omni4 (IRIS, paper 2 eq. 3-4) | omni3 (Robotino, paper 1 eq. 1-2)
+    size: float = 0.45  # [m] square footprint side
+    height: float = 0.70  # [m]
+    mass: float = 37.0  # [kg]
+    max_speed: float = 5.0  # [m/s]
+    max_accel: float = 2.0  # [m/s^2]
+    max_omega: float = 6.0  # [rad/s]
+    max_alpha: float = 12.0  # [rad/s^2] angular acceleration limit
+    wheel_radius: float = 0.05  # [m]
+    wheel_base: float = 0.20  # [m] l: wheel to robot centre
+    max_wheel_speed: float = 110.0  # [rad/s] saturation (5.5 m/s at the rim)
+    kick_max_speed: float = 8.0  # [m/s] flat kick
+    dribble_max_omega: float = 3.0  # [rad/s] turn rate above which the dribbler loses the ball
+    cmd_timeout: float = 0.2  # [s] realtime mode: wheels stop after this long without a command
+
+
+@dataclass(frozen=True)
+class BallParams:
+    """Size-5 football."""
+
+    radius: float = 0.11  # [m]
+    mass: float = 0.43  # [kg]
+    rolling_decel: float = 0.4  # [m/s^2] rolling friction on carpet
+    restitution: float = 0.6  # [-] against fence, posts and robots
+
+
+@dataclass(frozen=True)
+class SensorParams:
+    """The paper's 360-degree LIDAR-like sensor: noisy, range-limited detections."""
+
+    pose_sigma: float = 0.02  # [m] self-localisation noise (1 sigma)
+    heading_sigma: float = 0.01  # [rad]
+    ball_range: float = 6.0  # [m] beyond this the ball is not detected
+    robot_range: float = 5.0  # [m]
+    det_sigma: float = 0.03  # [m] detection noise at 0 m
+    det_sigma_per_m: float = 0.01  # [m/m] detection noise growth with range
+
+
+@dataclass(frozen=True)
+class TimingParams:
+    dt: float = 0.02  # [s] control tick (50 Hz)
+    substeps: int = 5  # physics steps per tick (250 Hz)
+    comm_period: int = 5  # [ticks] robot <-> base station Wi-Fi period (10 Hz)
+    referee_period: int = 5  # [ticks] engine events -> referee -> everyone (10 Hz)
+    world_period: int = 1  # [ticks] ground-truth `world` for viewers and the recorder
+    startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
+    wait_timeout: float = 5.0  # [s] wall: lockstep wait before a silent peer counts as dead
+
+
+@dataclass(frozen=True)
+class MatchConfig:
+    seed: int = 0
+    home: str = "basic-static"  # strategy of team a
+    away: str = "basic-static"  # strategy of team b
+    robots: int = 3  # per team, goalkeeper (robot 0) included
+    half_time: float = 300.0  # [s] simulated
+    link: str = "ideal"  # link preset name (runtime/links.py)
+    link_overrides: dict[str, dict[str, float]] = field(default_factory=dict)
+    realtime: bool = False
+    external: tuple[str, ...] = ()  # processes started by hand, e.g. "robot/a/1"
+    record: str = ""  # MCAP path, "" for none
+    field: FieldParams = FieldParams()
+    robot: RobotParams = RobotParams()
+    ball: BallParams = BallParams()
+    sensor: SensorParams = SensorParams()
+    timing: TimingParams = TimingParams()
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def half_ticks(self) -> int:
+        return int(round(self.half_time / self.timing.dt))
+
+    @property
+    def total_ticks(self) -> int:
+        """Ticks 0..total_ticks are played; the last one is END_GAME."""
+        return 2 * self.half_ticks
+
+    def strategy_of(self, team: str) -> str:
+        return self.home if team == "a" else self.away
+
+    def processes(self) -> list[ProcessId]:
+        """Every process of the match, in the canonical order used for digests."""
+        out = [ProcessId("engine"), ProcessId("referee")]
+        for team in TEAMS:
+            out.append(ProcessId("basestation", team))
+        for team in TEAMS:
+            for n in range(self.robots):
+                out.append(ProcessId("robot", team, n))
+        if self.record:
+            out.append(ProcessId("recorder"))
+        return out
+
+    # ------------------------------------------------------------- (de)serial
+    def to_dict(self) -> dict[str, Any]:
+        return msgspec.to_builtins(self)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2, sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> MatchConfig:
+        """Validate and build; raises ConfigError with a readable reason."""
+        try:
+            cfg = msgspec.convert(data, cls, strict=False)
+        except msgspec.ValidationError as exc:
+            raise ConfigError(f"invalid match configuration: {exc}") from None
+        cfg.validate()
+        return cfg
+
+    @classmethod
+    def from_json(cls, text: str) -> MatchConfig:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"match configuration is not JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise ConfigError("match configuration must be a JSON object")
+        return cls.from_dict(data)
+
+    def replace(self, **changes: Any) -> MatchConfig:
+        cfg = dataclasses.replace(self, **changes)
+        cfg.validate()
+        return cfg
+
+    def validate(self) -> None:
+        if not 1 <= self.robots <= 6:
+            raise ConfigError(f"--robots must be between 1 and 6, got {self.robots}")
+        if not self.half_time > 0:
+            raise ConfigError(f"--half-time must be positive, got {self.half_time}")
+        if self.half_ticks < 1:
+            raise ConfigError(f"--half-time {self.half_time} is shorter than one tick")
+        t = self.timing
+        if t.dt <= 0 or t.substeps < 1 or t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
+            raise ConfigError("timing: dt must be > 0 and every period >= 1 tick")
+        if not 0 <= self.seed < 2**63:
+            raise ConfigError(f"--seed must be in [0, 2^63), got {self.seed}")
+        for ext in self.external:
+            pid = ProcessId.parse(ext)
+            if pid not in self.processes():
+                raise ConfigError(f"--external {ext}: no such process in this match")
+
+
+class ConfigError(ValueError):
+    """A configuration or command-line value that cannot be used."""
+
+
+@dataclass(frozen=True, order=True)
+class ProcessId:
+    """Who a process is: kind, and for team processes the team and robot number."""
+
+    kind: str
+    team: str = ""
+    robot: int = -1
+
+    def __str__(self) -> str:
+        if self.kind == "robot":
+            return f"robot/{self.team}/{self.robot}"
+        if self.kind == "basestation":
+            return f"basestation/{self.team}"
+        return self.kind
+
+    @property
+    def short(self) -> str:
+        """`a/1` for robots (the --external form), else the full name."""
+        return f"{self.team}/{self.robot}" if self.kind == "robot" else str(self)
+
+    @classmethod
+    def parse(cls, text: str) -> ProcessId:
+        """Accepts `robot/a/1`, `a/1`, `basestation/a`, `engine`, `referee`, `recorder`."""
+        parts = text.strip().strip("/").split("/")
+        try:
+            if len(parts) == 2 and parts[0] in TEAMS:
+                return cls("robot", parts[0], int(parts[1]))
+            if parts[0] == "robot" and len(parts) == 3 and parts[1] in TEAMS:
+                return cls("robot", parts[1], int(parts[2]))
+            if parts[0] == "basestation" and len(parts) == 2 and parts[1] in TEAMS:
+                return cls("basestation", parts[1])
+            if len(parts) == 1 and parts[0] in ("engine", "referee", "recorder"):
+                return cls(parts[0])
+        except ValueError:
+            pass
+        raise ConfigError(
+            f"bad process name {text!r}: use a/1 or robot/a/1, basestation/a, engine, referee or recorder"
+        )

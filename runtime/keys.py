@@ -1,0 +1,106 @@
+"""Key expressions: every data pair is one zenoh key under `arena/<match>/`.
+
+`KEYS` is the single table the wire contract (schemas/README.md), the
+recorder and the process wiring are derived from.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from arena.schemas import messages as m
+
+ROOT = "arena"
+_MATCH_ID = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
+
+
+def check_match_id(match: str) -> str:
+    if not _MATCH_ID.match(match):
+        raise ValueError(f"bad match id {match!r}: use 1-64 characters of A-Z a-z 0-9 _ . -")
+    return match
+
+
+@dataclass(frozen=True)
+class KeySpec:
+    name: str  # short name used in code and docs
+    pattern: str  # relative to arena/<match>/, with <team> and <n> placeholders
+    message: type[m.Base]
+    data_pair: str  # the paper's name (Fig. 1 and 2)
+    sender: str
+    receivers: str
+    rate: str
+    link_class: str  # which link model applies on the receiving side
+
+    def rel(self, team: str = "", n: int | None = None) -> str:
+        key = self.pattern.replace("<team>", team)
+        if n is not None:
+            key = key.replace("<n>", str(n))
+        return key
+
+
+KEYS: tuple[KeySpec, ...] = (
+    KeySpec("field", "field", m.FieldSpec, "S_G / G_S", "engine", "all", "once, at tick 0", "wired"),
+    KeySpec("sense", "robot/<team>/<n>/sense", m.Sense, "G_R_n", "engine", "robot n", "every tick (50 Hz)", "sensor"),
+    KeySpec("cmd", "robot/<team>/<n>/cmd", m.Cmd, "R_n_G", "robot n", "engine", "every tick (50 Hz)", "sensor"),
+    KeySpec(
+        "report", "team/<team>/report/<n>", m.Report, "R_n_B", "robot n", "base station", "every comm period (10 Hz)", "wifi"
+    ),
+    KeySpec(
+        "order", "team/<team>/order/<n>", m.Order, "B_R_n", "base station", "robot n", "every comm period (10 Hz)", "wifi"
+    ),
+    KeySpec(
+        "referee",
+        "referee",
+        m.Referee,
+        "Re_G, Re_B",
+        "referee",
+        "engine, base stations",
+        "every referee period (10 Hz)",
+        "wired",
+    ),
+    KeySpec(
+        "events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", "every referee period (10 Hz)", "wired"
+    ),
+    KeySpec("world", "world", m.World, "G_V", "engine", "recorder, viewers", "every world period (50 Hz)", "ideal"),
+)
+
+KEY_BY_NAME = {k.name: k for k in KEYS}
+
+# Infrastructure keys (not data pairs of the paper).
+ALIVE = "alive"  # liveliness tokens: arena/<m>/alive/<process id>
+SUMMARY = "summary"  # arena/<m>/summary/<process id>: one Summary per process at the end
+CONFIG = "config"  # queryable: the match configuration as JSON
+
+
+class Keys:
+    """Absolute key builders for one match."""
+
+    def __init__(self, match: str):
+        self.match = check_match_id(match)
+        self.prefix = f"{ROOT}/{match}/"
+
+    def key(self, name: str, team: str = "", n: int | None = None) -> str:
+        return self.prefix + KEY_BY_NAME[name].rel(team, n)
+
+    def rel(self, key: str) -> str:
+        """Key without the match prefix (digests must not depend on the match id)."""
+        return key[len(self.prefix) :] if key.startswith(self.prefix) else key
+
+    def alive(self, process: str) -> str:
+        return f"{self.prefix}{ALIVE}/{process}"
+
+    def alive_all(self) -> str:
+        return f"{self.prefix}{ALIVE}/**"
+
+    def summary(self, process: str) -> str:
+        return f"{self.prefix}{SUMMARY}/{process}"
+
+    def summary_all(self) -> str:
+        return f"{self.prefix}{SUMMARY}/**"
+
+    def config(self) -> str:
+        return f"{self.prefix}{CONFIG}"
+
+    def everything(self) -> str:
+        return f"{self.prefix}**"

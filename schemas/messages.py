@@ -1,0 +1,261 @@
+"""The wire messages: one typed msgpack map per data pair of the IRIS diagram.
+
+Each message is a msgspec Struct encoded as a msgpack *map* with the field
+names as keys, so any stock msgpack library can read and write it. Every
+message carries `tick`: the control tick (default 20 ms) at which it was sent.
+Units are SI. Frames:
+
+* field frame: origin at the centre spot, x along the length towards the goal
+  that team a attacks in the first half, y to the left of x, z up; theta is
+  measured from +x, counter-clockwise, in (-pi, pi].
+* body frame: x forward (the dribbler side), y to the robot's left.
+
+Schema evolution (msgspec's rules, kept here too): a new field gets a default;
+a field's type never changes; a field is never renamed.
+
+The `Annotated` descriptions are the source of schemas/README.md; run
+`arena schemas --write` after changing anything here.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import msgspec
+from msgspec import Meta, Struct
+
+# ---------------------------------------------------------------- field types
+Tick = Annotated[int, Meta(ge=0, description="control tick at which the message was sent")]
+Meters = Annotated[float, Meta(description="[m]")]
+MetersPerSecond = Annotated[float, Meta(description="[m/s]")]
+Radians = Annotated[float, Meta(description="[rad]")]
+RadPerSecond = Annotated[float, Meta(description="[rad/s]")]
+Team = Literal["a", "b"]
+TeamOrNone = Literal["a", "b", ""]
+
+
+class Base(Struct, kw_only=True, forbid_unknown_fields=False):
+    """Common base: maps with named fields; unknown fields are ignored (evolution)."""
+
+
+class Pose(Base):
+    x: Annotated[float, Meta(description="[m] field frame")]
+    y: Annotated[float, Meta(description="[m] field frame")]
+    theta: Annotated[float, Meta(description="[rad] heading from +x, CCW")]
+
+
+class BallSeen(Base):
+    visible: Annotated[bool, Meta(description="false: no detection, x/y are meaningless")] = False
+    x: Annotated[float, Meta(description="[m] field frame")] = 0.0
+    y: Annotated[float, Meta(description="[m] field frame")] = 0.0
+
+
+class RobotSeen(Base):
+    team: Annotated[Team, Meta(description="team colour seen on the robot")]
+    x: Annotated[float, Meta(description="[m] field frame")]
+    y: Annotated[float, Meta(description="[m] field frame")]
+
+
+# ------------------------------------------------------------------- S_G / G_S
+class FieldSpec(Base):
+    """S_G: the field's geometry, sent once by the engine at tick 0."""
+
+    tick: Tick
+    length: Annotated[float, Meta(description="[m] goal line to goal line")]
+    width: Annotated[float, Meta(description="[m] touch line to touch line")]
+    runoff: Annotated[float, Meta(description="[m] lines to fence")]
+    goal_width: Annotated[float, Meta(description="[m] between the posts")]
+    goal_height: Annotated[float, Meta(description="[m] crossbar height")]
+    goal_depth: Annotated[float, Meta(description="[m] net depth")]
+    center_circle_radius: Meters
+    penalty_area_depth: Meters
+    penalty_area_width: Meters
+    goal_area_depth: Meters
+    goal_area_width: Meters
+    penalty_mark_distance: Annotated[float, Meta(description="[m] from the goal line")]
+    robots_per_team: Annotated[int, Meta(description="robots per team, goalkeeper (0) included")]
+    dt: Annotated[float, Meta(description="[s] control tick length")]
+    total_ticks: Annotated[int, Meta(description="last tick of the match")]
+
+
+# ---------------------------------------------------------------------- G_R_n
+class Sense(Base):
+    """G_R_n: what robot n's sensors report at this tick. Never ground truth."""
+
+    tick: Tick
+    pose: Annotated[Pose, Meta(description="noisy self-localisation, field frame")]
+    vx: Annotated[float, Meta(description="[m/s] odometry, body frame")] = 0.0
+    vy: Annotated[float, Meta(description="[m/s] odometry, body frame")] = 0.0
+    omega: Annotated[float, Meta(description="[rad/s] odometry")] = 0.0
+    ball: Annotated[BallSeen, Meta(description="noisy, range-limited ball detection")] = msgspec.field(default_factory=BallSeen)
+    robots: Annotated[list[RobotSeen], Meta(description="noisy, range-limited robot detections")] = []
+    has_ball: Annotated[bool, Meta(description="the dribbler holds the ball")] = False
+
+
+# ---------------------------------------------------------------------- R_n_G
+class Cmd(Base):
+    """R_n_G: robot n's actuator command. Applied by the engine from tick+1 on."""
+
+    tick: Tick
+    mode: Annotated[Literal["body", "wheels"], Meta(description="which of the two velocity forms is meant")] = "body"
+    vx: Annotated[float, Meta(description="[m/s] body frame, mode=body")] = 0.0
+    vy: Annotated[float, Meta(description="[m/s] body frame, mode=body")] = 0.0
+    omega: Annotated[float, Meta(description="[rad/s] mode=body")] = 0.0
+    wheels: Annotated[list[float], Meta(description="[rad/s] wheel speeds, mode=wheels")] = []
+    dribbler: Annotated[bool, Meta(description="dribbler on")] = False
+    kick_speed: Annotated[float, Meta(ge=0.0, description="[m/s] 0 = no kick; capped by the robot's kicker")] = 0.0
+    kick_lob: Annotated[bool, Meta(description="lob kick (ballistic z) instead of a flat kick")] = False
+
+
+# ---------------------------------------------------------------------- R_n_B
+class Report(Base):
+    """R_n_B (eq. 5): robot n tells its base station what it knows."""
+
+    tick: Tick
+    robot: Annotated[int, Meta(ge=0, description="robot number n")]
+    pose: Annotated[Pose, Meta(description="the robot's own pose estimate")]
+    ball: BallSeen = msgspec.field(default_factory=BallSeen)
+    robots: Annotated[list[RobotSeen], Meta(description="robots it detects (P_A, P_B)")] = []
+    has_ball: bool = False
+    role: Annotated[str, Meta(description="the role the robot is playing")] = ""
+
+
+# ---------------------------------------------------------------------- B_R_n
+class TeamPose(Base):
+    robot: Annotated[int, Meta(description="robot number, -1 if unknown (opponents)")]
+    x: Meters
+    y: Meters
+    theta: Radians = 0.0
+    age: Annotated[int, Meta(description="[ticks] since last seen")] = 0
+
+
+class Order(Base):
+    """B_R_n (eq. 5): base station to robot n: P_A, P_B, P_ball, C, S and roles."""
+
+    tick: Tick
+    robot: Annotated[int, Meta(ge=0, description="robot number n")]
+    command: Annotated[str, Meta(description="C: current referee command (MSL RefBox name)")] = "STOP"
+    command_team: Annotated[TeamOrNone, Meta(description="team the command is for, '' = both")] = ""
+    spot_x: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
+    spot_y: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
+    attack_dir: Annotated[int, Meta(description="+1: this team attacks the +x goal now, -1: the -x goal")] = 1
+    strategy: Annotated[int, Meta(ge=1, le=3, description="S: 1 level, 2 offensive (losing), 3 defensive (winning)")] = 1
+    role: Annotated[str, Meta(description="role for this robot: goalkeeper, defender, attacker")] = ""
+    role_state: Annotated[int, Meta(description="Fig. 6 state 1-4, 0 for the goalkeeper")] = 0
+    own: Annotated[list[TeamPose], Meta(description="P_A: fused poses of own robots")] = []
+    opponents: Annotated[list[TeamPose], Meta(description="P_B: fused opponent positions")] = []
+    ball_valid: bool = False
+    ball_x: Annotated[float, Meta(description="[m] P_ball, field frame")] = 0.0
+    ball_y: Annotated[float, Meta(description="[m] P_ball, field frame")] = 0.0
+    ball_z: Annotated[float, Meta(description="[m] P_ball")] = 0.0
+    ball_age: Annotated[int, Meta(description="[ticks] since the ball was last seen")] = 0
+
+
+# ----------------------------------------------------------- Re_G / Re -> B
+class RefCommand(Base):
+    name: Annotated[str, Meta(description="MSL RefBox command name")]
+    team: Annotated[TeamOrNone, Meta(description="target team, '' = both")] = ""
+    x: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
+    y: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
+    tick: Annotated[int, Meta(description="tick at which the referee issued it")] = 0
+
+
+class Referee(Base):
+    """Re_G and referee to base stations: the referee box's state and new commands."""
+
+    tick: Tick
+    stage: Annotated[str, Meta(description="PRE_GAME, FIRST_HALF, HALF_TIME, SECOND_HALF, END_GAME")]
+    command: Annotated[str, Meta(description="the command in force (MSL RefBox name)")]
+    command_team: TeamOrNone = ""
+    spot_x: Meters = 0.0
+    spot_y: Meters = 0.0
+    score_a: Annotated[int, Meta(ge=0)] = 0
+    score_b: Annotated[int, Meta(ge=0)] = 0
+    attack_dir_a: Annotated[int, Meta(description="+1: team a attacks the +x goal now")] = 1
+    commands: Annotated[list[RefCommand], Meta(description="commands issued since the previous message, in order")] = []
+
+
+# ----------------------------------------------------------------------- G_Re
+class BallEvent(Base):
+    kind: Annotated[
+        str,
+        Meta(description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, ROBOT_DEAD"),
+    ]
+    tick: Annotated[int, Meta(description="tick at which it happened")]
+    team: Annotated[TeamOrNone, Meta(description="GOAL: scoring team; TOUCH: toucher's team")] = ""
+    robot: Annotated[int, Meta(description="robot involved, -1 if none")] = -1
+    x: Annotated[float, Meta(description="[m] ball position, field frame")] = 0.0
+    y: Annotated[float, Meta(description="[m] ball position, field frame")] = 0.0
+    last_team: Annotated[TeamOrNone, Meta(description="team of the last robot to touch the ball")] = ""
+    last_robot: Annotated[int, Meta(description="last robot to touch the ball, -1 if none")] = -1
+
+
+class EngineEvents(Base):
+    """G_Re: ball-status events since the previous message (may be empty)."""
+
+    tick: Tick
+    events: list[BallEvent] = []
+
+
+# ------------------------------------------------------------------------ G_V
+class RobotState(Base):
+    team: Team
+    robot: int
+    x: Meters
+    y: Meters
+    theta: Radians
+    vx: Annotated[float, Meta(description="[m/s] field frame")] = 0.0
+    vy: Annotated[float, Meta(description="[m/s] field frame")] = 0.0
+    omega: RadPerSecond = 0.0
+    has_ball: bool = False
+
+
+class World(Base):
+    """G_V: ground truth for viewers and the recorder. Robots never read it."""
+
+    tick: Tick
+    t: Annotated[float, Meta(description="[s] simulated time")]
+    ball_x: Meters
+    ball_y: Meters
+    ball_z: Meters = 0.0
+    ball_vx: MetersPerSecond = 0.0
+    ball_vy: MetersPerSecond = 0.0
+    ball_vz: MetersPerSecond = 0.0
+    robots: list[RobotState] = []
+    last_team: TeamOrNone = ""
+    last_robot: int = -1
+
+
+# --------------------------------------------------------- infrastructure
+class Summary(Base):
+    """End of match: one per process, for the launcher's JSON summary."""
+
+    tick: Tick
+    process: Annotated[str, Meta(description="e.g. robot/a/1")]
+    pid: Annotated[int, Meta(description="OS process id")]
+    digest: Annotated[str, Meta(description="hex BLAKE2b of every (key, payload) it sent, in order")]
+    sent: Annotated[int, Meta(description="frames sent")]
+    rejected: Annotated[int, Meta(description="malformed or out-of-sequence inputs")]
+    rejected_reasons: dict[str, int] = {}
+    links: Annotated[
+        dict[str, dict[str, float]],
+        Meta(description="per inbound link class: frames, dropped, delay_ms_sum"),
+    ] = {}
+    delays_ms: Annotated[dict[str, list[float]], Meta(description="per link class: drawn delays [ms]")] = {}
+    dead: Annotated[list[str], Meta(description="peers that went silent and were treated as dead")] = []
+    tick_us: Annotated[list[float], Meta(description="[us] median and p95 wall time per tick of own work")] = []
+    extra: Annotated[dict[str, object], Meta(description="kind-specific results (score, events, distances)")] = {}
+
+
+MESSAGE_TYPES: tuple[type[Base], ...] = (FieldSpec, Sense, Cmd, Report, Order, Referee, EngineEvents, World, Summary)
+
+_ENCODER = msgspec.msgpack.Encoder()
+
+
+def encode(msg: Base) -> bytes:
+    return _ENCODER.encode(msg)
+
+
+def decoder(msg_type: type[Base]) -> msgspec.msgpack.Decoder:
+    """A validating decoder for one message type (raises msgspec.DecodeError / ValidationError)."""
+    return msgspec.msgpack.Decoder(msg_type)
