@@ -71,6 +71,8 @@ KEY_BY_NAME = {k.name: k for k in KEYS}
 ALIVE = "alive"  # liveliness tokens: arena/<m>/alive/<process id>
 SUMMARY = "summary"  # arena/<m>/summary/<process id>: one Summary per process at the end
 CONFIG = "config"  # queryable: the match configuration as JSON
+ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
+COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
 
 
 class Keys:
@@ -98,6 +100,12 @@ class Keys:
 
     def summary_all(self) -> str:
         return f"{self.prefix}{SUMMARY}/**"
+
+    def ack(self, process: str) -> str:
+        return f"{self.prefix}{ACK}/{process}"
+
+    def collector(self) -> str:
+        return f"{self.prefix}{COLLECTOR}"
 
     def config(self) -> str:
         return f"{self.prefix}{CONFIG}"

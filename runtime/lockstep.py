@@ -1,0 +1,308 @@
+"""Deterministic lockstep time (design.md section 3).
+
+Conservative synchronisation with lookahead:
+
+* Every link has a **schedule** (period and phase, in ticks): its sender emits
+  exactly one frame at every scheduled tick, empty or not, so the receiver
+  always knows which frame it is waiting for.
+* Every link has a **lag** >= 0: a frame sent at tick s is never delivered
+  before tick s + lag. To act at tick k, a receiver needs every frame sent at
+  or before k - lag, and no other. With lag 1 on every link but the engine's
+  `sense` (lag 0), all processes can work on neighbouring ticks in parallel.
+* Link emulation happens on the receiving side, frame by frame in send order,
+  with the link's own seeded RNG: a dropped frame still arrives and is then
+  discarded (nobody waits for it); a delayed frame is held until its delivery
+  tick ``s + max(lag, ceil(delay / dt))``: delays are rounded **up** to the
+  receiver's next tick.
+
+A run is thus a pure function of (configuration, seed), whatever the OS
+scheduler does. Frames arrive in order per sender (zenoh, RELIABLE); a frame
+whose tick is not the next scheduled one, or that does not decode as the key's
+message type, is rejected with a logged reason and counted.
+
+Bounded waits: a receiver that has waited `wait_timeout` seconds of wall time
+for a frame, or whose sender's liveliness token vanished, treats the sender as
+dead, records it, and stops waiting for that link. (Wall time is used only to
+detect failures, never for simulation behaviour.)
+
+In real-time mode nothing blocks but a process's clock link; other links are
+polled, and a frame is delivered ceil(delay / dt) ticks after the tick at which
+it was polled.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import heapq
+import logging
+import math
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Generic, TypeVar
+
+import msgspec
+
+from arena.runtime.links import LinkEmulator
+from arena.runtime.transport import WAKE, Channel, Transport
+from arena.schemas.messages import Base
+
+M = TypeVar("M", bound=Base)
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Ticks phase, phase + period, phase + 2 period, ..."""
+
+    period: int = 1
+    phase: int = 0
+
+    def due(self, k: int) -> bool:
+        return k >= self.phase and (k - self.phase) % self.period == 0
+
+    def last_at_or_before(self, k: int) -> int:
+        """The last scheduled tick <= k, or -1 if there is none."""
+        if k < self.phase:
+            return -1
+        return k - (k - self.phase) % self.period
+
+    def first_after(self, s: int) -> int:
+        if s < self.phase:
+            return self.phase
+        return s + self.period - (s - self.phase) % self.period
+
+    def ticks(self, last: int) -> range:
+        return range(self.phase, last + 1, self.period)
+
+
+EVERY_TICK = Schedule(1, 0)
+
+
+class Rejections:
+    """Counts malformed or out-of-sequence inputs, logs the first ones of each kind."""
+
+    LOG_FIRST = 5
+
+    def __init__(self, log: logging.Logger):
+        self.log = log
+        self.by_reason: Counter[str] = Counter()
+
+    @property
+    def total(self) -> int:
+        return sum(self.by_reason.values())
+
+    def reject(self, key: str, reason: str, detail: str = "") -> None:
+        self.by_reason[reason] += 1
+        n = self.by_reason[reason]
+        if n <= self.LOG_FIRST or n % 1000 == 0:
+            self.log.warning("rejected input on %s: %s%s (%d so far)", key, reason, f": {detail}" if detail else "", n)
+
+
+class Watchdog:
+    """Bounds every blocking wait: wakes the waiting channel after `timeout` seconds.
+
+    The main thread announces what it waits for (`arm`), the watchdog thread
+    checks ten times a second and, past the deadline, delivers a local WAKE to
+    that key's subscription. Cheap: no work on the hot path but two stores.
+    """
+
+    def __init__(self, transport: Transport, timeout: float):
+        self.transport = transport
+        self.timeout = timeout
+        self._key: str | None = None
+        self._since = 0.0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="watchdog", daemon=True)
+        self._thread.start()
+
+    def arm(self, key: str) -> None:
+        self._since = time.monotonic()
+        self._key = key
+
+    def disarm(self) -> None:
+        self._key = None
+
+    def expired(self) -> bool:
+        return self._key is not None and time.monotonic() - self._since >= self.timeout
+
+    def _run(self) -> None:
+        while not self._stop.wait(0.1):
+            key = self._key
+            if key is not None and time.monotonic() - self._since >= self.timeout:
+                self.transport.wake(key)
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=1.0)
+
+
+class Outbound(Generic[M]):
+    """One outbound key: encodes, adds the frame to the process digest, publishes."""
+
+    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent")
+
+    def __init__(self, key: str, rel: str, put: Callable[[bytes], None], digest: hashlib.blake2b):
+        self.key = key
+        self.rel = rel.encode()
+        self._put = put
+        self._digest = digest
+        self._encode = msgspec.msgpack.Encoder().encode
+        self.sent = 0
+
+    def send(self, msg: M) -> None:
+        payload = self._encode(msg)
+        d = self._digest
+        d.update(self.rel)
+        d.update(len(payload).to_bytes(4, "little"))
+        d.update(payload)
+        self.sent += 1
+        self._put(payload)
+
+
+class Inbound(Generic[M]):
+    """One inbound link, in lockstep: schedule, lag, link emulation, validation."""
+
+    def __init__(
+        self,
+        *,
+        key: str,
+        msg_type: type[M],
+        channel: Channel,
+        schedule: Schedule,
+        lag: int,
+        link_class: str,
+        sender: str,
+        emulator: LinkEmulator,
+        dt: float,
+        rejections: Rejections,
+        watchdog: Watchdog,
+        is_dead: Callable[[str], bool],
+        on_dead: Callable[[str, str], None],
+        check: Callable[[M], str | None] | None = None,
+    ):
+        self.key = key
+        self.msg_type = msg_type
+        self._decode = msgspec.msgpack.Decoder(msg_type).decode
+        self._channel = channel
+        self.schedule = schedule
+        self.lag = lag
+        self.link_class = link_class
+        self.sender = sender
+        self.emulator = emulator
+        self._dt_ms = dt * 1000.0
+        self._rej = rejections
+        self._watchdog = watchdog
+        self._is_dead = is_dead
+        self._on_dead = on_dead
+        self._check = check
+        self.strict = True  # lockstep; False in real-time mode
+        self.last_seen = -1  # tick of the last accepted frame
+        self.dead = False
+        self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
+        self.latest: M | None = None  # the last delivered message
+
+    # ------------------------------------------------------------------ intake
+    def _accept(self, raw: bytes, now_tick: int | None) -> bool:
+        """Decode, check sequence, emulate the link. Returns True if it was a frame."""
+        if raw == WAKE:
+            return False
+        try:
+            msg = self._decode(raw)
+        except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+            self._rej.reject(self.key, "malformed", str(exc)[:120])
+            return False
+        tick = msg.tick
+        if self.strict:  # lockstep: exactly the next scheduled tick
+            expected = self.schedule.first_after(self.last_seen)
+            if tick != expected:
+                self._rej.reject(self.key, "out-of-sequence", f"tick {tick}, expected {expected}")
+                return False
+        elif tick <= self.last_seen:
+            self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {self.last_seen}")
+            return False
+        if self._check is not None:
+            problem = self._check(msg)
+            if problem:
+                self._rej.reject(self.key, "invalid", problem)
+                return False
+        self.last_seen = tick
+        delay = self.emulator.decide()
+        if delay is None:
+            return True
+        base = tick if now_tick is None else now_tick
+        hold = max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
+        heapq.heappush(self._pending, (base + hold, tick, msg))
+        return True
+
+    def sync(self, k: int) -> None:
+        """Block until every frame sent at or before k - lag is in (lockstep)."""
+        target = self.schedule.last_at_or_before(k - self.lag)
+        if self.last_seen >= target or self.dead:
+            return
+        ch = self._channel
+        wd = self._watchdog
+        while self.last_seen < target:
+            raw = ch.try_recv()
+            expired = False
+            if raw is None:
+                wd.arm(self.key)
+                raw = ch.recv()
+                expired = wd.expired()
+                wd.disarm()
+            if raw == WAKE:
+                # A wake-up means a dead peer or a timeout; a stale one is ignored.
+                if self._is_dead(self.sender):
+                    self._give_up("its liveliness token vanished")
+                    return
+                if expired:
+                    self._give_up(f"silent for {wd.timeout:g} s waiting for tick {target}")
+                    return
+                continue
+            self._accept(raw, None)
+
+    def poll(self, now_tick: int) -> None:
+        """Real-time mode: take whatever has arrived, never block."""
+        while True:
+            raw = self._channel.try_recv()
+            if raw is None:
+                return
+            self._accept(raw, now_tick)
+
+    def recv_clock(self) -> int | None:
+        """Real-time mode, clock link: block for the next frame; returns its tick."""
+        ch = self._channel
+        wd = self._watchdog
+        while True:
+            wd.arm(self.key)
+            raw = ch.recv()
+            expired = wd.expired()
+            wd.disarm()
+            if raw == WAKE:
+                if expired or self._is_dead(self.sender):
+                    self._give_up("silent in real-time mode")
+                    return None
+                continue
+            before = self.last_seen
+            if self._accept(raw, None) and self.last_seen > before:
+                return self.last_seen
+
+    def _give_up(self, why: str) -> None:
+        self.dead = True
+        self._on_dead(self.sender, f"{self.key}: {why}")
+
+    # ---------------------------------------------------------------- delivery
+    def take(self, k: int) -> list[M]:
+        """Frames delivered by tick k, in delivery order; also updates `latest`."""
+        out: list[M] = []
+        pending = self._pending
+        while pending and pending[0][0] <= k:
+            out.append(heapq.heappop(pending)[2])
+        if out:
+            self.latest = out[-1]
+        return out
+
+    def latest_by(self, k: int) -> M | None:
+        self.take(k)
+        return self.latest

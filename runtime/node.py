@@ -1,0 +1,230 @@
+"""What every process of a match shares: identity, wiring, barrier, summary.
+
+A process kind subclasses `Node`, declares its links in `__init__` with
+`out(...)` and `inp(...)`, and implements `loop()`. `run()` then does the rest:
+
+1. declares the liveliness token `arena/<m>/alive/<process>` *after* every
+   subscription, so a peer that sees the token can already reach it;
+2. waits (bounded) until every process of the match has its token;
+3. runs `loop()`;
+4. publishes its `Summary` (digest, counters, link statistics).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+import resource
+import statistics
+import threading
+import time
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+from arena.runtime import seeds
+from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.keys import KEY_BY_NAME, Keys
+from arena.runtime.links import IDEAL, LinkEmulator, resolve
+from arena.runtime.lockstep import Inbound, Outbound, Rejections, Schedule, Watchdog
+from arena.runtime.transport import Transport
+from arena.schemas import messages as msgs
+
+M = TypeVar("M", bound=msgs.Base)
+
+
+class StartupError(RuntimeError):
+    """The match could not start: a process never came up."""
+
+
+class Node:
+    def __init__(self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys):
+        self.pid = pid
+        self.name = str(pid)
+        self.cfg = cfg
+        self.transport = transport
+        self.keys = keys
+        self.log = logging.getLogger(f"arena.{self.name}")
+        self.links = resolve(cfg.link, cfg.link_overrides)
+        self.digest = hashlib.blake2b(digest_size=16)
+        self.rejections = Rejections(self.log)
+        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout)
+        self.outbound: list[Outbound[Any]] = []
+        self.inbound: list[Inbound[Any]] = []
+        self.gone: set[str] = set()  # peers whose liveliness token vanished
+        self.dead: dict[str, str] = {}  # peers we stopped waiting for, with the reason
+        self._alive: set[str] = set()
+        self._alive_cond = threading.Condition()
+        self._work_s: list[float] = []  # wall seconds of own work per tick (perf statistics only)
+        self.last_tick = 0
+        self._wall_s = 0.0
+        self._collector = False
+
+    # ----------------------------------------------------------------- wiring
+    def out(self, name: str, team: str = "", n: int | None = None) -> Outbound[Any]:
+        key = self.keys.key(name, team, n)
+        ob: Outbound[Any] = Outbound(key, self.keys.rel(key), self.transport.publisher(key), self.digest)
+        self.outbound.append(ob)
+        return ob
+
+    def inp(
+        self,
+        name: str,
+        team: str = "",
+        n: int | None = None,
+        *,
+        schedule: Schedule,
+        lag: int,
+        sender: str,
+        check: Callable[[M], str | None] | None = None,
+    ) -> Inbound[Any]:
+        spec = KEY_BY_NAME[name]
+        key = self.keys.key(name, team, n)
+        model = self.links.get(spec.link_class, IDEAL)
+        emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
+        ib: Inbound[Any] = Inbound(
+            key=key,
+            msg_type=spec.message,
+            channel=self.transport.subscribe(key),
+            schedule=schedule,
+            lag=lag,
+            link_class=spec.link_class,
+            sender=sender,
+            emulator=emulator,
+            dt=self.cfg.timing.dt,
+            rejections=self.rejections,
+            watchdog=self.watchdog,
+            is_dead=self._is_gone,
+            on_dead=self._record_dead,
+            check=check,
+        )
+        ib.strict = not self.cfg.realtime
+        self.inbound.append(ib)
+        return ib
+
+    def rng(self, *path: object):
+        """This process's own RNG for `path` (one per component)."""
+        return seeds.rng(self.cfg.seed, self.name, *path)
+
+    # -------------------------------------------------------------- liveliness
+    def _is_gone(self, peer: str) -> bool:
+        return peer in self.gone
+
+    def _record_dead(self, peer: str, why: str) -> None:
+        if peer not in self.dead:
+            self.dead[peer] = why
+            self.log.error("treating %s as dead: %s", peer, why)
+
+    def _on_collector(self, key: str, alive: bool) -> None:  # noqa: ARG002
+        self._collector = alive
+
+    def _on_alive(self, key: str, alive: bool) -> None:
+        peer = key.split("/alive/", 1)[-1]
+        with self._alive_cond:
+            if alive:
+                self._alive.add(peer)
+                self.gone.discard(peer)
+            else:
+                self._alive.discard(peer)
+                self.gone.add(peer)
+            self._alive_cond.notify_all()
+        if not alive:
+            for ib in self.inbound:
+                if ib.sender == peer:
+                    self.transport.wake(ib.key)
+
+    def expected_peers(self) -> list[str]:
+        return [str(p) for p in self.cfg.processes()]
+
+    def barrier(self) -> None:
+        self.transport.watch_alive(self.keys.collector(), self._on_collector)
+        self.transport.watch_alive(self.keys.alive_all(), self._on_alive)
+        self.transport.declare_alive(self.keys.alive(self.name))
+        expected = set(self.expected_peers())
+        deadline = time.monotonic() + self.cfg.timing.startup_timeout
+        with self._alive_cond:
+            while not expected <= self._alive:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    missing = ", ".join(sorted(expected - self._alive))
+                    raise StartupError(
+                        f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
+                    )
+                self._alive_cond.wait(min(left, 0.5))
+
+    # -------------------------------------------------------------------- run
+    def loop(self) -> None:
+        raise NotImplementedError
+
+    def summary_extra(self) -> dict[str, object]:
+        return {}
+
+    def run(self) -> msgs.Summary:
+        try:
+            self.barrier()
+            t0 = time.perf_counter()
+            self.loop()
+            self._wall_s = time.perf_counter() - t0
+        finally:
+            self.watchdog.stop()
+        summary = self.summary()
+        self.deliver_summary(msgs.encode(summary))
+        return summary
+
+    def deliver_summary(self, payload: bytes, timeout: float = 5.0) -> None:
+        """Publish the summary until a collector acknowledges it (bounded).
+
+        A process that closes its session right after a put can lose that
+        put; when a collector (`arena match`, `arena up`) is present, it
+        acknowledges every summary on `ack/<process>`. With no collector
+        (a process started on its own) nobody waits.
+        """
+        ack = self.transport.subscribe(self.keys.ack(self.name))
+        put = self.transport.publisher(self.keys.summary(self.name))
+        deadline = time.monotonic() + timeout
+        while True:
+            put(payload)
+            if not self._collector:
+                return
+            wait_until = min(deadline, time.monotonic() + 0.25)
+            while time.monotonic() < wait_until:
+                if ack.try_recv() is not None:
+                    return
+                time.sleep(0.005)
+            if time.monotonic() >= deadline:
+                self.log.warning("no collector acknowledged the summary within %g s", timeout)
+                return
+
+    def timed(self, start: float) -> None:
+        """Record the wall time of one tick's own work (for the timing statistics)."""
+        self._work_s.append(time.perf_counter() - start)
+
+    def summary(self) -> msgs.Summary:
+        links: dict[str, dict[str, float]] = {}
+        delays: dict[str, list[float]] = {}
+        for ib in self.inbound:
+            e = ib.emulator
+            agg = links.setdefault(ib.link_class, {"frames": 0.0, "dropped": 0.0})
+            agg["frames"] += e.frames
+            agg["dropped"] += e.dropped
+            delays.setdefault(ib.link_class, []).extend(round(d, 3) for d in e.delays_ms)
+        tick_us: list[float] = []
+        if self._work_s:
+            w = sorted(self._work_s)
+            tick_us = [statistics.median(w) * 1e6, w[int(0.95 * (len(w) - 1))] * 1e6]
+        return msgs.Summary(
+            tick=self.last_tick,
+            process=self.name,
+            pid=os.getpid(),
+            digest=self.digest.hexdigest(),
+            sent=sum(o.sent for o in self.outbound),
+            rejected=self.rejections.total,
+            rejected_reasons=dict(self.rejections.by_reason),
+            links=links,
+            delays_ms=delays,
+            dead=sorted(self.dead),
+            tick_us=tick_us,
+            wall_s=self._wall_s,
+            cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
+            extra=self.summary_extra(),
+        )

@@ -1,0 +1,214 @@
+"""The transport behind a small interface: zenoh for real, memory for unit tests.
+
+Processes see only `Transport`: publishers, pull-style subscriptions (the
+main thread blocks in `recv`, the fastest receive style measured on 2 cores,
+see notes-zenoh-mcap.md), a local wake-up, liveliness, and one queryable for
+the match configuration. `MemoryTransport` implements the same interface in
+one Python process, so process logic can be driven with scripted inputs and no
+zenoh at all; it is never what a feature claims to run on.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+from collections import defaultdict
+from collections.abc import Callable
+from typing import Protocol
+
+import zenoh
+
+# 0xc1 is the one byte msgpack never uses, so a wake-up can never be a message.
+WAKE = b"\xc1arena-wake"
+
+
+class Channel(Protocol):
+    def recv(self) -> bytes: ...
+    def try_recv(self) -> bytes | None: ...
+
+
+class Transport(Protocol):
+    def publisher(self, key: str) -> Callable[[bytes], None]: ...
+    def subscribe(self, key: str) -> Channel: ...
+    def wake(self, key: str) -> None:
+        """Deliver WAKE to this process's own subscribers of `key` only."""
+    def declare_alive(self, key: str) -> None: ...
+    def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
+    def serve(self, key: str, payload: bytes) -> None: ...
+    def query(self, key: str, timeout: float) -> bytes | None: ...
+    def close(self) -> None: ...
+
+
+# ---------------------------------------------------------------------- zenoh
+class _ZenohChannel:
+    __slots__ = ("_sub",)
+
+    def __init__(self, sub: zenoh.Subscriber):
+        self._sub = sub
+
+    def recv(self) -> bytes:
+        return self._sub.recv().payload.to_bytes()
+
+    def try_recv(self) -> bytes | None:
+        s = self._sub.try_recv()
+        return None if s is None else s.payload.to_bytes()
+
+
+class ZenohTransport:
+    """Lockstep traffic is RELIABLE with congestion control BLOCK: nothing is dropped by zenoh."""
+
+    FIFO = 1 << 14  # frames buffered per subscription
+
+    def __init__(self, session: zenoh.Session):
+        self.session = session
+        self._keep: list[object] = []  # declared entities live as long as the transport
+
+    def publisher(self, key: str) -> Callable[[bytes], None]:
+        pub = self.session.declare_publisher(
+            key,
+            encoding=zenoh.Encoding("application/msgpack"),
+            congestion_control=zenoh.CongestionControl.BLOCK,
+            reliability=zenoh.Reliability.RELIABLE,
+            priority=zenoh.Priority.REAL_TIME,
+            express=True,
+        )
+        self._keep.append(pub)
+        return pub.put
+
+    def subscribe(self, key: str) -> Channel:
+        sub = self.session.declare_subscriber(key, zenoh.handlers.FifoChannel(self.FIFO))
+        self._keep.append(sub)
+        return _ZenohChannel(sub)
+
+    def wake(self, key: str) -> None:
+        self.session.put(key, WAKE, allowed_destination=zenoh.Locality.SESSION_LOCAL)
+
+    def declare_alive(self, key: str) -> None:
+        self._keep.append(self.session.liveliness().declare_token(key))
+
+    def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None:
+        def cb(sample: zenoh.Sample) -> None:
+            on_change(str(sample.key_expr), sample.kind == zenoh.SampleKind.PUT)
+
+        self._keep.append(self.session.liveliness().declare_subscriber(key_expr, cb, history=True))
+
+    def serve(self, key: str, payload: bytes) -> None:
+        def cb(query: zenoh.Query) -> None:
+            query.reply(key, payload)
+
+        self._keep.append(self.session.declare_queryable(key, cb))
+
+    def query(self, key: str, timeout: float) -> bytes | None:
+        for reply in self.session.get(key, timeout=timeout):
+            if reply.ok is not None:
+                return reply.ok.payload.to_bytes()
+        return None
+
+    def close(self) -> None:
+        for entity in reversed(self._keep):
+            undeclare = getattr(entity, "undeclare", None)
+            if undeclare is not None:
+                undeclare()
+        self._keep.clear()
+
+
+# --------------------------------------------------------------------- memory
+class _MemoryChannel:
+    __slots__ = ("_q",)
+
+    def __init__(self) -> None:
+        self._q: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+
+    def recv(self) -> bytes:
+        return self._q.get()
+
+    def try_recv(self) -> bytes | None:
+        try:
+            return self._q.get_nowait()
+        except queue.Empty:
+            return None
+
+
+class MemoryBus:
+    """The shared 'network' of MemoryTransports: exact keys and trailing `/**`."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._subs: dict[str, list[tuple[object, _MemoryChannel]]] = defaultdict(list)
+        self._alive: dict[str, object] = {}
+        self._watchers: list[tuple[str, Callable[[str, bool], None]]] = []
+        self._served: dict[str, bytes] = {}
+
+    @staticmethod
+    def matches(expr: str, key: str) -> bool:
+        if expr.endswith("/**"):
+            return key.startswith(expr[:-2]) or key == expr[:-3]
+        return expr == key
+
+    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+        with self._lock:
+            targets = [(owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs]
+        for owner, ch in targets:
+            if only is None or owner is only:
+                ch._q.put(payload)
+
+    def subscribe(self, owner: object, key: str) -> _MemoryChannel:
+        ch = _MemoryChannel()
+        with self._lock:
+            self._subs[key].append((owner, ch))
+        return ch
+
+    def set_alive(self, key: str, owner: object, alive: bool) -> None:
+        with self._lock:
+            if alive:
+                self._alive[key] = owner
+            else:
+                self._alive.pop(key, None)
+            watchers = [cb for expr, cb in self._watchers if self.matches(expr, key)]
+        for cb in watchers:
+            cb(key, alive)
+
+    def watch(self, expr: str, cb: Callable[[str, bool], None]) -> None:
+        with self._lock:
+            self._watchers.append((expr, cb))
+            present = [k for k in self._alive if self.matches(expr, k)]
+        for k in present:
+            cb(k, True)
+
+
+class MemoryTransport:
+    def __init__(self, bus: MemoryBus):
+        self.bus = bus
+        self._tokens: list[str] = []
+
+    def publisher(self, key: str) -> Callable[[bytes], None]:
+        bus = self.bus
+
+        def put(payload: bytes) -> None:
+            bus.deliver(key, payload)
+
+        return put
+
+    def subscribe(self, key: str) -> Channel:
+        return self.bus.subscribe(self, key)
+
+    def wake(self, key: str) -> None:
+        self.bus.deliver(key, WAKE, only=self)
+
+    def declare_alive(self, key: str) -> None:
+        self._tokens.append(key)
+        self.bus.set_alive(key, self, True)
+
+    def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None:
+        self.bus.watch(key_expr, on_change)
+
+    def serve(self, key: str, payload: bytes) -> None:
+        self.bus._served[key] = payload
+
+    def query(self, key: str, timeout: float) -> bytes | None:
+        return self.bus._served.get(key)
+
+    def close(self) -> None:
+        for key in self._tokens:
+            self.bus.set_alive(key, self, False)
+        self._tokens.clear()
