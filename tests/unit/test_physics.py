@@ -1,0 +1,521 @@
+"""Unit tests of the engine's pymunk world (processes/physics.py), real pymunk."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import pytest
+
+from arena.processes.physics import Physics, wrap_angle
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import BallEvent, Cmd
+
+CFG = MatchConfig()
+F, R, B = CFG.field, CFG.robot, CFG.ball
+DT = CFG.timing.dt
+FACE = R.size / 2 + B.radius  # [m] robot centre to a touching ball's centre
+
+
+def make(robots: int = 1, **kwargs: float) -> Physics:
+    """A world with every robot parked side by side in the -y run-off, ball at the centre."""
+    ph = Physics(CFG.replace(robots=robots), **kwargs)
+    for i, (team, n) in enumerate(ph.robot_ids):
+        ph.place_robot(team, n, -5.5 + i, -F.width / 2 - 0.5, 0.0)
+    ph.place_ball(0.0, 0.0)
+    return ph
+
+
+def cmd(**kwargs: object) -> Cmd:
+    return Cmd(tick=0, **kwargs)
+
+
+def run(ph: Physics, ticks: int) -> list[BallEvent]:
+    events: list[BallEvent] = []
+    for _ in range(ticks):
+        events.extend(ph.step())
+    return events
+
+
+def ball_in_front(ph: Physics, team: str, n: int, gap: float = 0.01) -> None:
+    x, y, th = ph.robot_pose(team, n)
+    ph.place_ball(x + (FACE + gap) * math.cos(th), y + (FACE + gap) * math.sin(th))
+
+
+def kinds(events: list[BallEvent]) -> list[str]:
+    return [e.kind for e in events]
+
+
+# ----------------------------------------------------------------- robots
+def test_robot_acceleration_and_speed_are_limited():
+    ph = make()
+    ph.place_ball(5.0, 3.0)
+    ph.place_robot("a", 0, -6.0, -3.5, 0.0)
+    ph.set_command("a", 0, cmd(vx=8.0, vy=6.0))  # 10 m/s asked, capped at 5
+    prev = (0.0, 0.0)
+    for tick in range(1, 136):
+        ph.step()
+        vx, vy, w = ph.robot_velocity("a", 0)
+        v = math.hypot(vx, vy)
+        assert v <= R.max_speed + 1e-9, f"tick {tick}: speed {v}"
+        accel = math.hypot(vx - prev[0], vy - prev[1]) / DT
+        assert accel <= R.max_accel + 1e-6, f"tick {tick}: accel {accel}"
+        prev = (vx, vy)
+    assert math.hypot(*prev) == pytest.approx(R.max_speed, abs=0.01)
+    assert math.atan2(prev[1], prev[0]) == pytest.approx(math.atan2(6.0, 8.0), abs=1e-6)
+
+
+def test_robot_turn_rate_and_angular_acceleration_are_limited():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ph.set_command("a", 0, cmd(omega=-20.0))
+    prev = 0.0
+    for tick in range(1, 50):
+        ph.step()
+        w = ph.robot_velocity("a", 0)[2]
+        assert abs(w) <= R.max_omega + 1e-9, f"tick {tick}: omega {w}"
+        assert abs(w - prev) <= R.max_alpha * DT + 1e-9, f"tick {tick}: alpha {(w - prev) / DT}"
+        prev = w
+    assert prev == pytest.approx(-R.max_omega)
+    assert ph.robot_pose("a", 0)[:2] == pytest.approx((-3.0, 0.0), abs=1e-9)
+
+
+def test_body_frame_command_follows_heading():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, math.pi / 2)
+    ph.set_command("a", 0, cmd(vx=0.0, vy=-1.0))  # body right = field +x when facing +y
+    run(ph, 50)
+    vx, vy, _ = ph.robot_velocity("a", 0)
+    assert vx == pytest.approx(1.0, abs=1e-6)
+    assert vy == pytest.approx(0.0, abs=1e-6)
+
+
+def test_wheels_mode_is_a_zero_command_for_now():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ph.set_command("a", 0, cmd(mode="wheels", wheels=[50.0, 50.0, 50.0, 50.0]))
+    run(ph, 20)
+    assert ph.robot_pose("a", 0) == (-3.0, 0.0, 0.0)
+
+
+def test_distance_sums_travel_but_not_placements():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ph.set_command("a", 0, cmd(vx=1.0))
+    run(ph, 100)
+    x, _, _ = ph.robot_pose("a", 0)
+    assert ph.distance[("a", 0)] == pytest.approx(x + 3.0, rel=1e-6)
+    ph.place_robot("a", 0, 3.0, 3.0, 0.0)
+    ph.set_command("a", 0, cmd())
+    run(ph, 10)
+    assert ph.distance[("a", 0)] == pytest.approx(x + 3.0, rel=1e-3)
+    assert ph.distance[("b", 0)] == 0.0
+
+
+# ------------------------------------------------------------------- ball
+def test_rolling_ball_decelerates_at_rolling_decel_and_stops_cleanly():
+    ph = make()
+    ph.place_ball(-6.0, 2.0, 3.0, 0.0)
+    speeds = []
+    for _ in range(400):
+        ph.step()
+        _, _, _, vx, vy, _ = ph.ball_state()
+        speeds.append(math.hypot(vx, vy))
+    for a, b in zip(speeds[:300], speeds[1:300]):
+        assert (a - b) / DT == pytest.approx(B.rolling_decel, rel=1e-6)
+    stop = next(i for i, v in enumerate(speeds) if v == 0.0)
+    assert (stop + 1) * DT == pytest.approx(3.0 / B.rolling_decel, abs=2 * DT)
+    x, y, *_ = ph.ball_state()
+    assert x + 6.0 == pytest.approx(3.0**2 / (2 * B.rolling_decel), abs=0.02)
+    run(ph, 50)
+    assert ph.ball_state()[:2] == (x, y), "a stopped ball must not creep"
+
+
+def test_ball_bounces_off_the_fence_with_restitution():
+    ph = make()
+    fence = F.width / 2 + F.runoff
+    ph.place_ball(2.0, fence - 0.5, 0.0, 4.0)
+    vys = []
+    for _ in range(30):
+        ph.step()
+        vys.append(ph.ball_state()[4])
+        assert ph.ball_state()[1] <= fence - B.radius + 0.01
+    before = max(vys)
+    after = -min(vys)
+    assert after == pytest.approx(B.restitution * before, rel=0.05)
+
+
+def test_long_random_run_keeps_ball_inside_fence_and_robots_apart():
+    rnd = random.Random(7)
+    ph = Physics(CFG.replace(robots=3))
+    ph.kickoff_positions("a")
+    xf, yf = F.length / 2 + F.runoff, F.width / 2 + F.runoff
+    ids = ph.robot_ids
+    for tick in range(1, 3001):
+        if tick % 10 == 1:
+            bx, by, *_ = ph.ball_state()
+            for team, n in ids:
+                x, y, th = ph.robot_pose(team, n)
+                if rnd.random() < 0.5:  # chase the ball, in the body frame
+                    a = math.atan2(by - y, bx - x) - th
+                    c = cmd(vx=4.0 * math.cos(a), vy=4.0 * math.sin(a), omega=3.0 * wrap_angle(a), dribbler=True)
+                else:
+                    c = cmd(vx=rnd.uniform(-6, 6), vy=rnd.uniform(-6, 6), omega=rnd.uniform(-7, 7),
+                            dribbler=rnd.random() < 0.3)
+                if rnd.random() < 0.2:
+                    c.kick_speed = rnd.uniform(1.0, 10.0)
+                    c.kick_lob = rnd.random() < 0.3
+                ph.set_command(team, n, c)
+        events = ph.step()
+        if any(e.kind == "GOAL" for e in events) or tick % 500 == 0:
+            ph.kickoff_positions("b")
+        bx, by, bz, *_ = ph.ball_state()
+        # discrete collision: a fast ball may dig one substep's travel (< r/2) into the fence
+        assert abs(bx) <= xf - B.radius / 2 and abs(by) <= yf - B.radius / 2, f"tick {tick}: ball {bx, by}"
+        assert bz >= 0.0
+        poses = [ph.robot_pose(t, n) for t, n in ids]
+        for i, (x, y, _) in enumerate(poses):
+            assert abs(x) <= xf - R.size / 2 + 0.01 and abs(y) <= yf - R.size / 2 + 0.01, f"tick {tick}: robot {ids[i]}"
+            for x2, y2, _ in poses[i + 1:]:
+                assert math.hypot(x - x2, y - y2) >= R.size - 0.02, f"tick {tick}: robots overlap"
+
+
+# ----------------------------------------------------------------- kicker
+@pytest.mark.parametrize(("asked", "expected"), [(6.0, 6.0), (20.0, R.kick_max_speed)])
+def test_flat_kick_speed_and_direction(asked, expected):
+    ph = make()
+    ph.place_robot("a", 0, -2.0, 1.0, 0.3)
+    ball_in_front(ph, "a", 0, gap=0.05)
+    ph.set_command("a", 0, cmd(kick_speed=asked))
+    events = ph.step()
+    _, _, z, vx, vy, _ = ph.ball_state()
+    assert math.hypot(vx, vy) == pytest.approx(expected - B.rolling_decel * DT, abs=1e-6)
+    assert math.atan2(vy, vx) == pytest.approx(0.3, abs=1e-9)
+    assert z == 0.0
+    assert ph.last_toucher() == ("a", 0)
+    assert [(e.kind, e.team, e.robot) for e in events] == [("TOUCH", "a", 0)]
+
+
+def test_kick_needs_the_ball_in_reach_and_fires_once_per_command():
+    ph = make()
+    ph.place_robot("a", 0, -2.0, 1.0, 0.0)
+    ph.place_ball(-2.0 + FACE + 0.3, 1.0)  # too far
+    ph.set_command("a", 0, cmd(kick_speed=5.0))
+    ph.step()
+    assert ph.ball_state()[3] == 0.0
+    ph.place_ball(-2.0 + FACE + 0.05, 1.0)  # in reach now: the armed kick fires
+    ph.step()
+    assert ph.ball_state()[3] > 4.9
+    ph.place_ball(-2.0 + FACE + 0.05, 1.0)  # same command: no second kick
+    ph.step()
+    assert ph.ball_state()[3] == 0.0
+
+
+def _lob_towards_robot(lob: bool) -> tuple[Physics, float]:
+    ph = make()
+    ph.place_robot("a", 0, -4.0, 0.0, 0.0)
+    ph.place_robot("b", 0, -2.5, 0.0, math.pi)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=8.0, kick_lob=lob))
+    ph.step()
+    ph.set_command("a", 0, cmd())
+    top = 0.0
+    for _ in range(150):
+        ph.step()
+        top = max(top, ph.ball_state()[2])
+    return ph, top
+
+
+def test_lob_flies_over_a_robot_and_lands():
+    ph, top = _lob_towards_robot(lob=True)
+    v = 8.0 * math.sin(math.radians(45))
+    assert top == pytest.approx(v * v / (2 * 9.81), rel=0.02)
+    x, _, z, _, _, vz = ph.ball_state()
+    assert x > 0.0, "the ball flew past the robot"
+    assert (z, vz) == (0.0, 0.0), "the ball landed"
+    assert ph.last_toucher() == ("a", 0)
+    assert ph.robot_pose("b", 0)[0] == pytest.approx(-2.5, abs=1e-9)
+
+
+def test_flat_kick_hits_the_robot_in_its_path():
+    ph, top = _lob_towards_robot(lob=False)
+    assert top == 0.0
+    assert ph.ball_state()[0] < -2.5
+
+
+def test_touch_events_follow_the_ball_from_robot_to_robot():
+    ph = make()
+    ph.place_robot("a", 0, -4.0, 0.0, 0.0)
+    ph.place_robot("b", 0, -2.5, 0.0, math.pi)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=3.0))
+    events = run(ph, 100)  # a0 kicks, b0 sends it back, a0 gets it again
+    assert [(e.kind, e.team, e.robot) for e in events] == [("TOUCH", "a", 0), ("TOUCH", "b", 0), ("TOUCH", "a", 0)]
+    assert ph.last_toucher() == ("a", 0)
+
+
+# ---------------------------------------------------------------- dribbler
+def test_dribbler_carries_the_ball():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0, gap=0.06)
+    ph.set_command("a", 0, cmd(vx=1.5, omega=1.0, dribbler=True))
+    events = ph.step()
+    assert ph.holder() == ("a", 0)
+    assert kinds(events) == ["TOUCH"]
+    for tick in range(100):
+        ph.step()
+        x, y, th = ph.robot_pose("a", 0)
+        bx, by, *_ = ph.ball_state()
+        assert ph.holder() == ("a", 0), f"tick {tick}"
+        assert math.hypot(bx - x, by - y) == pytest.approx(FACE + 0.005, abs=0.01)
+        assert wrap_angle(math.atan2(by - y, bx - x) - th) == pytest.approx(0.0, abs=0.02)
+    assert ph.world(ph.tick).robots[0].has_ball
+
+
+def test_turning_too_fast_loses_the_ball():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(omega=R.max_omega, dribbler=True))
+    lost = None
+    for tick in range(50):
+        ph.step()
+        if ph.holder() is None:
+            lost = tick
+            break
+    assert lost is not None
+    assert abs(ph.robot_velocity("a", 0)[2]) > R.dribble_max_omega
+    assert abs(ph.robot_velocity("a", 0)[2]) < R.dribble_max_omega + 2 * R.max_alpha * DT
+
+
+def test_switching_the_dribbler_off_releases_the_ball():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(dribbler=True))
+    ph.step()
+    assert ph.holder() == ("a", 0)
+    ph.set_command("a", 0, cmd(dribbler=False))
+    ph.step()
+    assert ph.holder() is None
+
+
+def test_challenger_with_dribbler_releases_the_ball():
+    ph = make()
+    ph.place_robot("a", 0, 0.0, 0.0, 0.0)
+    ph.place_robot("b", 0, 1.2, 0.0, math.pi)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(dribbler=True))
+    ph.set_command("b", 0, cmd(vx=0.5, dribbler=True))
+    ph.step()
+    assert ph.holder() == ("a", 0)
+    released = False
+    for _ in range(100):
+        ph.step()
+        if ph.holder() != ("a", 0):
+            released = True
+            break
+    assert released
+
+
+def test_another_robot_touching_the_held_ball_knocks_it_loose():
+    ph = make()
+    ph.place_robot("a", 0, 0.0, 0.0, 0.0)
+    ph.place_robot("b", 0, 1.5, 0.0, math.pi)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(dribbler=True))
+    ph.set_command("b", 0, cmd(vx=1.0))  # no dribbler: only its body challenges
+    ph.step()
+    assert ph.holder() == ("a", 0)
+    events = run(ph, 100)
+    assert ("TOUCH", "b", 0) in [(e.kind, e.team, e.robot) for e in events]
+    assert ph.holder() is None
+
+
+def test_kick_from_the_dribbler():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(dribbler=True))
+    ph.step()
+    ph.set_command("a", 0, cmd(dribbler=True, kick_speed=7.0))
+    ph.step()
+    assert ph.holder() is None
+    assert ph.ball_state()[3] == pytest.approx(7.0 - B.rolling_decel * DT, abs=1e-6)
+
+
+# ----------------------------------------------------------------- events
+@pytest.mark.parametrize(("attack_dir_a", "scorer"), [(1, "a"), (-1, "b")])
+def test_ball_into_plus_x_goal_scores_once(attack_dir_a, scorer):
+    ph = make()
+    ph.attack_dir_a = attack_dir_a
+    ph.place_ball(4.0, 0.3, 4.0, 0.0)
+    events = run(ph, 150)
+    goals = [e for e in events if e.kind == "GOAL"]
+    assert len(goals) == 1 and goals[0].team == scorer
+    assert kinds(events) == ["GOAL"]
+    x, y, _, vx, vy, _ = ph.ball_state()
+    assert F.length / 2 + B.radius < x < F.length / 2 + F.goal_depth and abs(y) < F.goal_width / 2
+    assert (vx, vy) == (0.0, 0.0)
+    run(ph, 600)  # no second GOAL, no NO_PROGRESS while the ball waits in the net
+    assert kinds(run(ph, 10)) == []
+
+
+def test_ball_into_minus_x_goal_scores_for_the_other_side():
+    ph = make()
+    ph.place_ball(-4.0, -0.5, -5.0, 0.0)
+    goals = [e for e in run(ph, 100) if e.kind == "GOAL"]
+    assert [g.team for g in goals] == ["b"]
+
+
+def test_ball_over_the_goal_line_beside_the_goal():
+    ph = make()
+    ph.place_ball(4.0, 2.5, 4.0, 0.0)
+    events = run(ph, 100)
+    assert kinds(events) == ["GOAL_LINE"]
+    assert events[0].x > F.length / 2 + B.radius
+
+
+def test_high_lob_over_the_crossbar_is_no_goal_and_low_lob_is():
+    ph = make()
+    ph.place_robot("a", 0, 3.5, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=8.0, kick_lob=True))
+    events = ph.step()
+    ph.place_robot("a", 0, 0.0, -4.5, 0.0)  # out of the way of the ball coming back off the fence
+    events += run(ph, 200)
+    assert kinds(events) == ["TOUCH", "GOAL_LINE"]
+
+    ph = make()
+    ph.place_robot("a", 0, 4.5, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=4.0, kick_lob=True))
+    events = run(ph, 200)
+    assert [e.team for e in events if e.kind == "GOAL"] == ["a"]
+
+
+def test_touch_line_event_names_the_last_toucher():
+    ph = make()
+    ph.place_robot("a", 0, 0.0, 2.5, math.pi / 2)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=4.0))
+    events = run(ph, 100)
+    assert kinds(events) == ["TOUCH", "TOUCH_LINE"]
+    out = events[1]
+    assert (out.last_team, out.last_robot) == ("a", 0)
+    assert out.y > F.width / 2 + B.radius
+    assert events[0].tick == 1 and out.tick > 1
+
+
+def test_line_event_rearms_only_after_the_ball_is_back_inside():
+    ph = make()
+    ph.place_ball(0.0, 3.5, 0.0, 2.0)
+    assert kinds(run(ph, 150)) == ["TOUCH_LINE"]  # out, fence bounce, still out
+    ph.place_ball(0.0, 3.5, 0.0, 2.0)
+    assert kinds(run(ph, 50)) == ["TOUCH_LINE"]
+
+
+def test_touch_events_on_change_of_toucher_only():
+    ph = make()
+    ph.place_robot("a", 0, -1.0, 0.0, 0.0)
+    ph.place_ball(0.0, 0.0)
+    ph.set_command("a", 0, cmd(vx=1.0))
+    events = run(ph, 100)  # pushes the ball on and on
+    touches = [(e.team, e.robot, e.tick) for e in events if e.kind == "TOUCH"]
+    assert len(touches) == 1 and touches[0][:2] == ("a", 0)
+    assert events[0].tick == touches[0][2]
+
+
+def test_no_progress_after_idle_time_once_then_rearmed_by_placement():
+    ph = make(no_progress_s=2.0)
+    ph.place_ball(1.0, 1.0)
+    events = run(ph, 300)
+    assert [(e.kind, e.tick) for e in events] == [("NO_PROGRESS", 100)]
+    ph.place_ball(1.0, 1.0)
+    events = run(ph, 100)
+    assert [(e.kind, e.tick) for e in events] == [("NO_PROGRESS", 400)]
+    assert Physics(CFG).no_progress_s == 10.0
+
+
+def test_no_progress_rearms_when_the_ball_moves_again():
+    ph = make(no_progress_s=1.0)
+    ph.place_robot("a", 0, -1.0, 0.0, 0.0)
+    events = run(ph, 60)
+    assert kinds(events) == ["NO_PROGRESS"]
+    ph.set_command("a", 0, cmd(vx=1.0))
+    run(ph, 50)
+    ph.set_command("a", 0, cmd(vx=-1.0))
+    events = run(ph, 400)
+    assert kinds(events) == ["NO_PROGRESS"]
+
+
+# --------------------------------------------------------------- placement
+@pytest.mark.parametrize("robots", [1, 2, 3, 4, 5, 6])
+@pytest.mark.parametrize("attack_dir_a", [1, -1])
+@pytest.mark.parametrize("kicking", ["a", "b"])
+def test_kickoff_positions(robots, attack_dir_a, kicking):
+    ph = Physics(CFG.replace(robots=robots))
+    ph.attack_dir_a = attack_dir_a
+    ph.kickoff_positions(kicking)
+    assert ph.ball_state() == (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    poses = {}
+    for team, n in ph.robot_ids:
+        attack = attack_dir_a if team == "a" else -attack_dir_a
+        x, y, th = ph.robot_pose(team, n)
+        poses[(team, n)] = (x, y)
+        assert x * attack < 0, f"{team}/{n} not in its own half"
+        assert abs(x) <= F.length / 2 - R.size / 2 + 1e-9 and abs(y) <= F.width / 2 - R.size / 2
+        assert math.cos(th) == pytest.approx(attack)
+        if n == 0:
+            assert (abs(x), y) == (pytest.approx(F.length / 2 - R.size / 2), 0.0)
+        elif n == 1 and team == kicking:
+            assert (x, y) == (pytest.approx(-0.5 * attack), 0.0)
+        else:
+            assert math.hypot(x, y) >= F.center_circle_radius + R.size / 2
+    pts = list(poses.values())
+    for i, (x, y) in enumerate(pts):
+        for x2, y2 in pts[i + 1:]:
+            assert math.hypot(x - x2, y - y2) > R.size * 1.5
+
+
+# ------------------------------------------------------------ determinism
+def test_two_instances_with_the_same_commands_agree_at_every_tick():
+    cfg = CFG.replace(robots=3)
+    worlds = [Physics(cfg), Physics(cfg)]
+    for ph in worlds:
+        ph.kickoff_positions("a")
+    rnd = random.Random(3)
+    ids = worlds[0].robot_ids
+    for tick in range(1, 801):
+        if tick % 5 == 1:
+            cmds = {
+                r: cmd(vx=rnd.uniform(-5, 5), vy=rnd.uniform(-5, 5), omega=rnd.uniform(-6, 6),
+                       dribbler=rnd.random() < 0.5, kick_speed=rnd.choice([0.0, 0.0, 0.0, 6.0]),
+                       kick_lob=rnd.random() < 0.5)
+                for r in ids
+            }
+            for ph in worlds:
+                for (team, n), c in cmds.items():
+                    ph.set_command(team, n, c)
+        ev = [ph.step() for ph in worlds]
+        assert ev[0] == ev[1], f"events differ at tick {tick}"
+        assert worlds[0].world(tick) == worlds[1].world(tick), f"world differs at tick {tick}"
+    assert worlds[0].distance == worlds[1].distance
+
+
+def test_world_message_is_ground_truth():
+    ph = make()
+    ph.place_robot("b", 0, 1.0, 2.0, 3.0)
+    w = ph.world(7)
+    assert (w.tick, w.t) == (7, pytest.approx(7 * DT))
+    b0 = next(r for r in w.robots if (r.team, r.robot) == ("b", 0))
+    assert (b0.x, b0.y, b0.theta) == (1.0, 2.0, 3.0)
+    assert (w.ball_x, w.ball_y, w.last_team, w.last_robot) == (0.0, 0.0, "", -1)
+
+
+def test_wrap_angle():
+    assert wrap_angle(math.pi) == math.pi
+    assert wrap_angle(-math.pi) == math.pi
+    assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
+    assert wrap_angle(-7.0) == pytest.approx(-7.0 + math.tau)
