@@ -244,6 +244,8 @@ class Summary(Base):
     delays_ms: Annotated[dict[str, list[float]], Meta(description="per link class: drawn delays [ms]")] = {}
     dead: Annotated[list[str], Meta(description="peers that went silent and were treated as dead")] = []
     tick_us: Annotated[list[float], Meta(description="[us] median and p95 wall time per tick of own work")] = []
+    wall_s: Annotated[float, Meta(description="[s] wall time from the start barrier to the last tick")] = 0.0
+    cpu_s: Annotated[list[float], Meta(description="[s] user and system CPU time of the whole process")] = []
     extra: Annotated[dict[str, object], Meta(description="kind-specific results (score, events, distances)")] = {}
 
 

@@ -1,0 +1,66 @@
+"""Base station process: the team's fused world model, strategy and roles.
+
+Inputs: every robot's `report` (Wi-Fi, every comm period, phase 0, lag 1) and
+the `referee` frames (wired, lag 1). Every comm period (phase 1) it runs the
+strategy's team brain and sends one `order` per robot over Wi-Fi.
+"""
+
+from __future__ import annotations
+
+import time
+
+from arena.runtime.lockstep import Schedule
+from arena.runtime.node import Node
+from arena.strategies import registry
+from arena.strategies.base import TeamContext
+
+
+class BaseStationNode(Node):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        cfg = self.cfg
+        team = self.pid.team
+        comm = cfg.timing.comm_period
+        self.schedule = Schedule(comm, 1 % comm)
+        self.report_in = {
+            n: self.inp("report", team, n, schedule=Schedule(comm, 0), lag=1, sender=f"robot/{team}/{n}")
+            for n in range(cfg.robots)
+        }
+        self.ref_in = self.inp("referee", schedule=Schedule(cfg.timing.referee_period, 0), lag=1, sender="referee")
+        self.order_out = {n: self.out("order", team, n) for n in range(cfg.robots)}
+        strategy = registry.get(cfg.strategy_of(team))
+        self.brain = strategy.make_team(TeamContext(cfg=cfg, team=team, rng=self.rng("strategy")))
+
+    def act(self, k: int) -> None:
+        t0 = time.perf_counter()
+        reports = {}
+        for n, ib in self.report_in.items():
+            frames = ib.take(k)
+            if frames:
+                reports[n] = frames[-1]
+        referee = self.ref_in.latest_by(k)
+        orders = self.brain.step(k, reports, referee)
+        for n, out in self.order_out.items():
+            out.send(orders[n])
+        self.last_tick = k
+        self.timed(t0)
+
+    def loop(self) -> None:
+        last = self.cfg.total_ticks
+        if self.cfg.realtime:
+            while True:
+                r = self.ref_in.recv_clock()
+                if r is None:
+                    return
+                k = self.schedule.first_after(r)
+                if k > last:
+                    return
+                for ib in self.report_in.values():
+                    ib.poll(k)
+                self.act(k)
+        else:
+            for k in self.schedule.ticks(last):
+                for ib in self.report_in.values():
+                    ib.sync(k)
+                self.ref_in.sync(k)
+                self.act(k)

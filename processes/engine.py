@@ -1,0 +1,170 @@
+"""Game rule engine process: the pymunk world, the tick clock, ball events.
+
+Per tick k (lockstep):
+
+1. apply the referee frames delivered by k (KICKOFF and DROP_BALL placements,
+   the side switch);
+2. publish every robot's `sense` for tick k, `world` (G_V), and every referee
+   period the ball `events` (G_Re) gathered since the previous frame;
+3. step the physics from k to k+1 with the commands delivered by k, i.e. the
+   robots' `cmd` of tick k-1: while the engine steps, the robots already think
+   about tick k (a one-tick actuation delay, as on a real robot).
+
+In real-time mode the engine paces ticks to the wall clock and never waits for
+a command: a robot without a fresh command keeps its last setpoint until
+`cmd_timeout`, then stops.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from arena.processes.physics import Physics
+from arena.processes.sensors import sense
+from arena.runtime.config import TEAMS
+from arena.runtime.lockstep import EVERY_TICK, Schedule
+from arena.runtime.node import Node
+from arena.schemas.messages import Cmd, EngineEvents, FieldSpec, Referee
+
+
+def check_cmd(cmd: Cmd) -> str | None:
+    """Reject commands no robot could mean: non-finite numbers, odd wheel counts."""
+    for name in ("vx", "vy", "omega", "kick_speed"):
+        if not math.isfinite(getattr(cmd, name)):
+            return f"{name} is not finite"
+    if cmd.mode == "wheels" and len(cmd.wheels) not in (3, 4):
+        return f"{len(cmd.wheels)} wheel speeds (expected 3 or 4)"
+    if not all(math.isfinite(w) for w in cmd.wheels):
+        return "a wheel speed is not finite"
+    return None
+
+
+class EngineNode(Node):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        cfg = self.cfg
+        self.robots = [(team, n) for team in TEAMS for n in range(cfg.robots)]
+        self.physics = Physics(cfg)
+        self.physics.attack_dir_a = 1
+        self.physics.kickoff_positions("a")
+        self.sensor_rng = {r: self.rng("sensor", *r) for r in self.robots}
+        self.cmd_in = {
+            (team, n): self.inp(
+                "cmd", team, n, schedule=EVERY_TICK, lag=1, sender=f"robot/{team}/{n}", check=check_cmd
+            )
+            for team, n in self.robots
+        }
+        p = cfg.timing.referee_period
+        self.ref_in = self.inp("referee", schedule=Schedule(p, 0), lag=1, sender="referee")
+        self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
+        self.world_out = self.out("world")
+        self.events_out = self.out("events")
+        self.field_out = self.out("field")
+        self.events_schedule = Schedule(p, p - 1)
+        self.world_schedule = Schedule(cfg.timing.world_period, 0)
+        self.pending_events: list = []
+        self.transport.serve(self.keys.config(), cfg.to_json().encode())
+
+    # -------------------------------------------------------------- per tick
+    def apply_referee(self, frames: list[Referee]) -> None:
+        ph = self.physics
+        for frame in frames:
+            ph.attack_dir_a = frame.attack_dir_a
+            for c in frame.commands:
+                if c.name == "KICKOFF" and c.team in TEAMS:
+                    ph.kickoff_positions(c.team)
+                elif c.name == "DROP_BALL":
+                    ph.place_ball(c.x, c.y)
+
+    def publish(self, k: int) -> None:
+        ph, sp = self.physics, self.cfg.sensor
+        for r, out in self.sense_out.items():
+            out.send(sense(ph, r[0], r[1], k, self.sensor_rng[r], sp))
+        if self.world_schedule.due(k):
+            self.world_out.send(ph.world(k))
+        if self.events_schedule.due(k):
+            self.events_out.send(EngineEvents(tick=k, events=self.pending_events))
+            self.pending_events = []
+
+    def field_spec(self) -> FieldSpec:
+        f, cfg = self.cfg.field, self.cfg
+        return FieldSpec(
+            tick=0,
+            length=f.length,
+            width=f.width,
+            runoff=f.runoff,
+            goal_width=f.goal_width,
+            goal_height=f.goal_height,
+            goal_depth=f.goal_depth,
+            center_circle_radius=f.center_circle_radius,
+            penalty_area_depth=f.penalty_area_depth,
+            penalty_area_width=f.penalty_area_width,
+            goal_area_depth=f.goal_area_depth,
+            goal_area_width=f.goal_area_width,
+            penalty_mark_distance=f.penalty_mark_distance,
+            robots_per_team=cfg.robots,
+            dt=cfg.timing.dt,
+            total_ticks=cfg.total_ticks,
+        )
+
+    def loop(self) -> None:
+        self.field_out.send(self.field_spec())
+        if self.cfg.realtime:
+            self._loop_realtime()
+            return
+        last = self.cfg.total_ticks
+        ph = self.physics
+        for k in range(last + 1):
+            self.ref_in.sync(k)
+            t0 = time.perf_counter()
+            self.apply_referee(self.ref_in.take(k))
+            self.publish(k)
+            self.last_tick = k
+            if k == last:
+                self.timed(t0)
+                break
+            work = time.perf_counter() - t0
+            for r, ib in self.cmd_in.items():
+                ib.sync(k)
+                frames = ib.take(k)
+                if frames:
+                    ph.set_command(r[0], r[1], frames[-1])
+            t1 = time.perf_counter()
+            self.pending_events.extend(ph.step())
+            self._work_s.append(work + time.perf_counter() - t1)
+
+    def _loop_realtime(self) -> None:
+        last = self.cfg.total_ticks
+        dt = self.cfg.timing.dt
+        timeout_ticks = max(1, int(round(self.cfg.robot.cmd_timeout / dt)))
+        last_cmd = {r: 0 for r in self.robots}
+        ph = self.physics
+        start = time.monotonic()
+        for k in range(last + 1):
+            t0 = time.perf_counter()
+            self.ref_in.poll(k)
+            self.apply_referee(self.ref_in.take(k))
+            self.publish(k)
+            self.last_tick = k
+            if k == last:
+                break
+            for r, ib in self.cmd_in.items():
+                ib.poll(k)
+                frames = ib.take(k)
+                if frames:
+                    ph.set_command(r[0], r[1], frames[-1])
+                    last_cmd[r] = k
+                elif k - last_cmd[r] > timeout_ticks:
+                    ph.set_command(r[0], r[1], Cmd(tick=k))
+            self.pending_events.extend(ph.step())
+            self.timed(t0)
+            delay = start + (k + 1) * dt - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+
+    def summary_extra(self) -> dict[str, object]:
+        return {
+            "distance_m": {f"{t}/{n}": round(d, 3) for (t, n), d in sorted(self.physics.distance.items())},
+            "ticks": self.last_tick,
+        }

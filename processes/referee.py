@@ -1,0 +1,75 @@
+"""Referee process: runs the RefereeBox on the engine's ball events (G_Re).
+
+Inputs: `engine/events` every referee period (lag 1). Output: `referee` every
+referee period, a snapshot of the box's state plus the commands issued since
+the previous frame (Re_G for the engine, and for both base stations).
+"""
+
+from __future__ import annotations
+
+import time
+
+from arena.processes.referee_box import RefereeBox
+from arena.runtime.lockstep import Schedule
+from arena.runtime.node import Node
+from arena.schemas.messages import Referee
+
+
+class RefereeNode(Node):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        p = self.cfg.timing.referee_period
+        self.schedule = Schedule(p, 0)
+        self.events_in = self.inp("events", schedule=Schedule(p, p - 1), lag=1, sender="engine")
+        self.ref_out = self.out("referee")
+        self.box = RefereeBox(self.cfg)
+
+    def act(self, k: int) -> None:
+        t0 = time.perf_counter()
+        events = [ev for frame in self.events_in.take(k) for ev in frame.events]
+        cmds = self.box.step(k, events)
+        st = self.box.state
+        self.ref_out.send(
+            Referee(
+                tick=k,
+                stage=st.stage,
+                command=st.command,
+                command_team=st.command_team,
+                spot_x=st.spot[0],
+                spot_y=st.spot[1],
+                score_a=st.score["a"],
+                score_b=st.score["b"],
+                attack_dir_a=st.attack_dir_a,
+                commands=cmds,
+            )
+        )
+        self.last_tick = k
+        self.timed(t0)
+
+    def loop(self) -> None:
+        last = self.cfg.total_ticks
+        if self.cfg.realtime:
+            self.act(0)
+            while True:
+                e = self.events_in.recv_clock()
+                if e is None:
+                    return
+                k = self.schedule.first_after(e)
+                self.act(min(k, last))
+                if k >= last:
+                    return
+        else:
+            for k in self.schedule.ticks(last):
+                self.events_in.sync(k)
+                self.act(k)
+
+    def summary_extra(self) -> dict[str, object]:
+        st = self.box.state
+        return {
+            "score": [st.score["a"], st.score["b"]],
+            "events": dict(self.box.counts),
+            "log": [
+                {"tick": e.tick, "command": e.command.name, "team": e.command.team, "cause": e.cause}
+                for e in self.box.log
+            ],
+        }

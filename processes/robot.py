@@ -1,0 +1,60 @@
+"""Robot process: perception in, behaviour, command out (one per robot).
+
+Inputs: `sense` from the engine every tick (lag 0: the robot acts on what it
+senses now) and its base station's `order` (Wi-Fi, every comm period, phase 1,
+lag 1). Outputs: `cmd` every tick (the engine applies it from the next tick on,
+a one-tick actuation delay) and a `report` every comm period (phase 0).
+"""
+
+from __future__ import annotations
+
+import time
+
+from arena.runtime.lockstep import EVERY_TICK, Schedule
+from arena.runtime.node import Node
+from arena.strategies import registry
+from arena.strategies.base import RobotContext
+
+
+class RobotNode(Node):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        cfg = self.cfg
+        team, n = self.pid.team, self.pid.robot
+        comm = cfg.timing.comm_period
+        self.report_schedule = Schedule(comm, 0)
+        self.sense_in = self.inp("sense", team, n, schedule=EVERY_TICK, lag=0, sender="engine")
+        self.order_in = self.inp(
+            "order", team, n, schedule=Schedule(comm, 1 % comm), lag=1, sender=f"basestation/{team}"
+        )
+        self.cmd_out = self.out("cmd", team, n)
+        self.report_out = self.out("report", team, n)
+        strategy = registry.get(cfg.strategy_of(team))
+        self.brain = strategy.make_robot(RobotContext(cfg=cfg, team=team, n=n, rng=self.rng("strategy")))
+
+    def act(self, k: int) -> None:
+        t0 = time.perf_counter()
+        sense = self.sense_in.latest_by(k)
+        order = self.order_in.latest_by(k)
+        self.cmd_out.send(self.brain.step(k, sense, order))
+        if self.report_schedule.due(k):
+            self.report_out.send(self.brain.report(k, sense))
+        self.last_tick = k
+        self.timed(t0)
+
+    def loop(self) -> None:
+        last = self.cfg.total_ticks
+        if self.cfg.realtime:
+            while True:
+                k = self.sense_in.recv_clock()
+                if k is None:
+                    return
+                self.order_in.poll(k)
+                self.act(k)
+                if k >= last:
+                    return
+        else:
+            for k in range(last + 1):
+                self.sense_in.sync(k)
+                self.order_in.sync(k)
+                self.act(k)
