@@ -1,0 +1,251 @@
+"""The `arena` command: one subcommand per job.
+
+Bad input never ends in a traceback: a bad flag or value prints one line
+`arena <cmd>: error: ...` and exits with code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+from typing import NoReturn
+
+from arena.runtime.config import KINDS, ConfigError, MatchConfig, ProcessId
+
+EXAMPLES = {
+    "match": """examples:
+  arena match --home basic-static --away advance-dynamic --half-time 60 --seed 7
+  arena match --home BS --away BS --half-time 30 --seed 7 --json
+  arena match --home AD --away BS --link congested-wifi --link-param wifi.latency_ms=30
+  arena match --home BS --away BS --external a/1      # start robot a/1 by hand (HIL)
+  arena match --home BS --away BS --realtime --half-time 5""",
+    "run": """examples:
+  # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
+  arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
+  arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
+  arena run router --match demo --listen tcp/0.0.0.0:7447""",
+    "up": """examples:
+  arena up compose.yaml            # the services of compose.yaml as local processes
+  arena up compose.yaml --json""",
+    "bench": """examples:
+  arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
+  arena bench match --runs 5 --half-time 120 --link wifi""",
+    "schemas": """examples:
+  arena schemas --check            # is schemas/README.md up to date with schemas/messages.py?
+  arena schemas --write""",
+}
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but errors are one line and exit 2."""
+
+    def error(self, message: str) -> NoReturn:
+        print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = True) -> None:
+    p.add_argument("--home", required=required, metavar="STRATEGY", help="team a's strategy (name or BS/BD/AS/AD)")
+    p.add_argument("--away", required=required, metavar="STRATEGY", help="team b's strategy")
+    p.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team, goalkeeper included (3)")
+    p.add_argument("--half-time", type=float, default=300.0, metavar="SECONDS", help="simulated half length (300)")
+    if seed:
+        p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (0)")
+    p.add_argument("--link", default="ideal", metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
+    p.add_argument(
+        "--link-param",
+        action="append",
+        default=[],
+        metavar="CLASS.PARAM=V",
+        help="override one link parameter, e.g. wifi.latency_ms=12 (repeatable)",
+    )
+
+
+def build_parser() -> Parser:
+    top = Parser(
+        prog="arena",
+        description="Wheeled-robot soccer (RoboCup MSL / KRSBI-B) as separate processes over zenoh.",
+        epilog="Run 'arena <command> --help' for examples.",
+    )
+    sub = top.add_subparsers(dest="command", metavar="<command>", parser_class=Parser)
+    sub.required = True
+
+    def add(name: str, help_text: str) -> argparse.ArgumentParser:
+        return sub.add_parser(
+            name, help=help_text, description=help_text, epilog=EXAMPLES.get(name),
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
+
+    m = add("match", "play one match, every process its own OS process, and print the score")
+    _add_match_flags(m, required=True)
+    m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
+    m.add_argument("--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand")
+    m.add_argument("--listen", metavar="ENDPOINT", help="router endpoint (default: a unix socket in a temp dir)")
+    m.add_argument("--logs", metavar="DIR", help="keep every process's log in DIR")
+    m.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    m.add_argument("--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up")
+
+    r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
+    r.add_argument("kind", choices=[*KINDS, "router"], help="process kind")
+    r.add_argument("--match", required=True, metavar="ID", help="match id (its key prefix arena/<ID>/)")
+    net = r.add_mutually_exclusive_group(required=True)
+    net.add_argument("--connect", metavar="ENDPOINT", help="zenoh endpoint to connect to, e.g. tcp/10.0.0.5:7447")
+    net.add_argument("--listen", metavar="ENDPOINT", help="zenoh endpoint to listen on")
+    r.add_argument("--team", choices=["a", "b"], help="team (robot, basestation)")
+    r.add_argument("--robot", type=int, metavar="N", help="robot number, 0 = goalkeeper (robot)")
+    r.add_argument("--seed", type=int, metavar="S", help="master seed; must match the match's")
+    r.add_argument("--realtime", action="store_true", help="the match runs in real-time mode")
+    r.add_argument("--config", metavar="FILE", help="match configuration JSON (default: ask the engine)")
+    r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
+    r.add_argument("--startup-timeout", type=float, default=60.0, metavar="S", help="wait for the match (60)")
+    r.add_argument("--log-level", default="WARNING", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
+    eng = r.add_argument_group("engine only: the match it hosts when no --config is given")
+    _add_match_flags(eng, required=False, seed=False)
+
+    u = add("up", "start the services of a compose file as local processes (no Docker needed)")
+    u.add_argument("file", help="compose.yaml")
+    u.add_argument("--json", action="store_true", help="print the match result as JSON")
+    u.add_argument("--timeout", type=float, default=600.0, metavar="S", help="give up after S seconds (600)")
+
+    b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
+    b.add_argument("what", choices=["match"], help="what to measure")
+    b.add_argument("--runs", type=int, default=3, metavar="N", help="runs (3)")
+    b.add_argument("--half-time", type=float, default=60.0, metavar="SECONDS", help="half length (60)")
+    b.add_argument("--robots", type=int, default=3, metavar="N")
+    b.add_argument("--link", default="ideal", metavar="PRESET")
+    b.add_argument("--json", action="store_true")
+
+    s = add("schemas", "the wire contract: check or rewrite schemas/README.md from schemas/messages.py")
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--check", action="store_true", help="exit 1 if schemas/README.md is stale")
+    g.add_argument("--write", action="store_true", help="rewrite schemas/README.md")
+    return top
+
+
+def match_config(args: argparse.Namespace, realtime: bool = False, external=()) -> MatchConfig:
+    from arena.runtime.links import parse_override, resolve
+    from arena.strategies import registry
+
+    overrides: dict[str, dict[str, float]] = {}
+    for text in args.link_param:
+        cls, param, value = parse_override(text)
+        overrides.setdefault(cls, {})[param] = value
+    resolve(args.link, overrides)  # validates preset, classes and values
+    home = registry.resolve_name(args.home) if args.home else "basic-static"
+    away = registry.resolve_name(args.away) if args.away else "basic-static"
+    cfg = MatchConfig(
+        seed=args.seed if args.seed is not None else 0,
+        home=home,
+        away=away,
+        robots=args.robots,
+        half_time=args.half_time,
+        link=args.link,
+        link_overrides=overrides,
+        realtime=realtime,
+        external=tuple(ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e)) for e in external),
+    )
+    cfg.validate()
+    return cfg
+
+
+def cmd_match(args: argparse.Namespace) -> int:
+    from arena.tools import launcher, report
+
+    cfg = match_config(args, realtime=args.realtime, external=args.external)
+    if args.startup_timeout is not None or cfg.external:
+        import dataclasses
+
+        timeout = args.startup_timeout if args.startup_timeout is not None else 600.0
+        cfg = cfg.replace(timing=dataclasses.replace(cfg.timing, startup_timeout=timeout))
+    show = not args.json and sys.stderr.isatty()
+    try:
+        result = launcher.play_match(
+            cfg,
+            listen=args.listen,
+            progress=show,
+            log_dir=args.logs,
+            announce=lambda text: print(text, file=sys.stderr, flush=True),
+        )
+    except launcher.MatchError as exc:
+        print(f"arena match: error: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        result.pop("referee_log", None)
+        print(json.dumps(result, indent=2))
+    else:
+        report.print_match(result)
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from arena.runtime.session import NetConfig
+    from arena.tools import run as runner
+
+    logging.basicConfig(level=args.log_level, format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr)
+    net = NetConfig(
+        mode=args.mode,
+        connect=(args.connect,) if args.connect else (),
+        listen=(args.listen,) if args.listen else (),
+    )
+    if args.kind == "router":
+        return runner.main_guarded(runner.run_router, args.match, net)
+    try:
+        pid = runner.process_id(args.kind, args.team, args.robot)
+        cfg = None
+        if args.config:
+            cfg = runner.load_config(args.config)
+        elif args.kind == "engine":
+            cfg = match_config(args, realtime=args.realtime)
+        from arena.runtime.keys import check_match_id
+
+        check_match_id(args.match)
+    except (ConfigError, ValueError) as exc:
+        print(f"arena run: error: {exc}", file=sys.stderr)
+        return 2
+    return runner.main_guarded(
+        runner.run, pid, args.match, net, cfg, args.seed, args.realtime, args.startup_timeout
+    )
+
+
+def cmd_up(args: argparse.Namespace) -> int:
+    from arena.tools import compose, report
+
+    try:
+        result = compose.up(args.file, timeout=args.timeout)
+    except compose.ComposeError as exc:
+        print(f"arena up: error: {exc}", file=sys.stderr)
+        return 2 if exc.bad_input else 1
+    if args.json:
+        result.pop("referee_log", None)
+        print(json.dumps(result, indent=2))
+    else:
+        report.print_match(result)
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from arena.tools import bench
+
+    return bench.bench_match(args)
+
+
+def cmd_schemas(args: argparse.Namespace) -> int:
+    from arena.schemas import contract
+
+    return contract.main(check=args.check, write=args.write)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handlers = {"match": cmd_match, "run": cmd_run, "up": cmd_up, "bench": cmd_bench, "schemas": cmd_schemas}
+    try:
+        return handlers[args.command](args)
+    except ConfigError as exc:
+        print(f"arena {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"arena {args.command}: interrupted; every process of the match was stopped", file=sys.stderr)
+        return 130

@@ -1,0 +1,181 @@
+"""`arena up compose.yaml`: the compose file's services as local processes.
+
+No Docker engine runs on our machines, so this reads the very same file
+`docker compose up` would, expands its `${VAR:-default}` variables, and starts
+each service's `command` as a local process, the router first. It sets
+`ARENA_MATCH` to a fresh match id and `ARENA_LISTEN`/`ARENA_CONNECT` to a unix
+socket in a private temp dir, so that a local run is isolated like any match.
+Then it supervises the services and prints the match result like `arena match`.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+from arena.runtime.config import ConfigError, MatchConfig, ProcessId
+from arena.runtime.keys import Keys
+from arena.runtime.session import NetConfig, open_session
+from arena.runtime.transport import ZenohTransport
+from arena.tools import launcher
+
+_VAR = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)(?::?-([^}]*))?\}")
+
+
+class ComposeError(RuntimeError):
+    def __init__(self, message: str, bad_input: bool = False):
+        super().__init__(message)
+        self.bad_input = bad_input
+
+
+def expand(text: str, env: dict[str, str]) -> str:
+    return _VAR.sub(lambda m: env.get(m.group(1)) or (m.group(2) or ""), text)
+
+
+def load_services(path: str, env: dict[str, str]) -> dict[str, list[str]]:
+    """service name -> argv, in start order (services others depend on first)."""
+    try:
+        raw = Path(path).read_text()
+    except OSError as exc:
+        raise ComposeError(f"cannot read {path}: {exc.strerror}", bad_input=True) from None
+    try:
+        doc = yaml.safe_load(expand(raw, env))
+    except yaml.YAMLError as exc:
+        raise ComposeError(f"{path} is not valid YAML: {str(exc).splitlines()[0]}", bad_input=True) from None
+    services = (doc or {}).get("services") if isinstance(doc, dict) else None
+    if not isinstance(services, dict) or not services:
+        raise ComposeError(f"{path} has no services", bad_input=True)
+    commands: dict[str, list[str]] = {}
+    deps: dict[str, list[str]] = {}
+    for name, svc in services.items():
+        cmd = (svc or {}).get("command")
+        if isinstance(cmd, str):
+            cmd = cmd.split()
+        if not isinstance(cmd, list) or not cmd or cmd[0] != "arena":
+            raise ComposeError(f"service {name!r}: command must be an 'arena ...' list", bad_input=True)
+        commands[name] = [str(c) for c in cmd]
+        d = (svc or {}).get("depends_on") or []
+        deps[name] = list(d) if isinstance(d, (list, dict)) else []
+    order: list[str] = []
+
+    def visit(n: str, stack: tuple[str, ...] = ()) -> None:
+        if n in order:
+            return
+        if n in stack:
+            raise ComposeError(f"dependency cycle at service {n!r}", bad_input=True)
+        for d in deps.get(n, []):
+            if d not in commands:
+                raise ComposeError(f"service {n!r} depends on unknown service {d!r}", bad_input=True)
+            visit(d, (*stack, n))
+        order.append(n)
+
+    for n in commands:
+        visit(n)
+    return {n: commands[n] for n in order}
+
+
+def _process_of(argv: list[str]) -> ProcessId | None:
+    """The ProcessId an `arena run <kind> ...` command line starts (None for the router)."""
+    kind = argv[2] if len(argv) > 2 and argv[1] == "run" else ""
+    if kind == "router":
+        return None
+    team = argv[argv.index("--team") + 1] if "--team" in argv else ""
+    robot = int(argv[argv.index("--robot") + 1]) if "--robot" in argv else -1
+    if kind == "robot":
+        return ProcessId("robot", team, robot)
+    if kind == "basestation":
+        return ProcessId("basestation", team)
+    return ProcessId(kind)
+
+
+def up(path: str, timeout: float = 600.0) -> dict:
+    t_start = time.monotonic()
+    tmp = Path(tempfile.mkdtemp(prefix="arena-up-"))
+    sock = tmp / "router.sock"
+    match = launcher.new_match_id(0)
+    env = dict(os.environ)
+    env.update(
+        ARENA_MATCH=match,
+        ARENA_LISTEN=f"unixsock-stream/{sock}",
+        ARENA_CONNECT=f"unixsock-stream/{sock}",
+    )
+    services = load_services(path, env)
+    routers = [n for n, argv in services.items() if _process_of(argv) is None]
+    if len(routers) != 1:
+        raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
+    children: list[launcher.Child] = []
+    ok = False
+    try:
+        router = routers[0]
+        children.append(launcher.spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
+        _wait_for_socket(sock, children[0])
+        with open_session(NetConfig(mode="client", connect=(env["ARENA_CONNECT"],))) as session:
+            transport = ZenohTransport(session)
+            keys = Keys(match)
+            collector = launcher.open_collector(transport, keys)
+            for name, argv in services.items():
+                if name != router:
+                    children.append(launcher.spawn(name, _process_of(argv), _argv(argv), tmp, env=env))
+            cfg = _fetch(transport, keys, children)
+            declared = {c.pid for c in children if c.name != "router"}
+            missing = [str(p) for p in cfg.processes() if p not in declared]
+            if missing:
+                raise ComposeError(f"{path} has no service for: {', '.join(missing)}", bad_input=True)
+            named = [c for c in children if c.pid.kind != "router"]
+            for c in named:
+                c.name = str(c.pid)
+            try:
+                got = launcher.supervise(
+                    transport, collector, keys, cfg, named, [str(p) for p in cfg.processes()],
+                    launcher.Progress(cfg.total_ticks, False), timeout=timeout,
+                )
+            except launcher.MatchError as exc:
+                raise ComposeError(str(exc)) from None
+            finally:
+                transport.close()
+        ok = True
+        result = launcher.assemble(cfg, got, time.monotonic() - t_start, children)
+        result["services"] = list(services)
+        return result
+    finally:
+        launcher.stop_all(children)
+        if ok:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _argv(argv: list[str]) -> list[str]:
+    """`arena ...` from the compose file, run with this very Python."""
+    return [sys.executable, "-m", "arena", *argv[1:]]
+
+
+def _wait_for_socket(sock: Path, router: launcher.Child, limit: float = 30.0) -> None:
+    deadline = time.monotonic() + limit
+    while not sock.exists():
+        if router.popen.poll() is not None:
+            raise ComposeError(f"the router service exited with code {router.popen.returncode}:\n{router.tail()}")
+        if time.monotonic() > deadline:
+            raise ComposeError("the router service did not start listening")
+        time.sleep(0.05)
+
+
+def _fetch(transport: ZenohTransport, keys: Keys, children: list[launcher.Child]) -> MatchConfig:
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline:
+        for c in children:
+            if c.popen.poll() not in (None, 0):
+                raise ComposeError(f"service {c.name} exited with code {c.popen.returncode}:\n{c.tail()}")
+        payload = transport.query(keys.config(), timeout=1.0)
+        if payload is not None:
+            try:
+                return MatchConfig.from_json(payload.decode())
+            except ConfigError as exc:
+                raise ComposeError(str(exc)) from None
+        time.sleep(0.1)
+    raise ComposeError("no engine answered with the match configuration within 60 s")

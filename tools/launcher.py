@@ -1,0 +1,366 @@
+"""`arena match`: one match as a group of OS processes, supervised.
+
+The launcher hosts the match's zenoh router (a unix socket in a private temp
+dir unless `--listen` says otherwise), starts every process with the same
+`arena run <kind> ...` command a user would type, waits for each one's
+`Summary`, and assembles the match result. Ctrl-C, or any child exiting with
+an error, ends the whole group; children also die with the launcher
+(PR_SET_PDEATHSIG), so no orphan survives.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import msgspec
+
+from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.keys import Keys
+from arena.runtime.session import NetConfig, open_session
+from arena.runtime.transport import ZenohTransport
+from arena.schemas.messages import Referee, Summary
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """Runs in the child before exec: SIGKILL it if the launcher dies."""
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    except OSError:
+        pass
+
+
+class MatchError(RuntimeError):
+    """The match could not be played to the end; the message says why."""
+
+
+@dataclass
+class Child:
+    name: str
+    pid: ProcessId
+    popen: subprocess.Popen
+    log_path: Path
+
+    def tail(self, lines: int = 8) -> str:
+        try:
+            text = self.log_path.read_text(errors="replace").rstrip().splitlines()
+        except OSError:
+            return ""
+        return "\n".join("    " + line for line in text[-lines:])
+
+
+def new_match_id(seed: int) -> str:
+    """Unique per run (isolation), never part of any digest."""
+    return f"m{seed}-{os.getpid()}-{os.urandom(3).hex()}"
+
+
+def run_argv(pid: ProcessId, match: str, connect: str, config_path: str | None = None) -> list[str]:
+    argv = [sys.executable, "-m", "arena", "run", pid.kind, "--match", match, "--connect", connect]
+    if pid.team:
+        argv += ["--team", pid.team]
+    if pid.kind == "robot":
+        argv += ["--robot", str(pid.robot)]
+    if config_path:
+        argv += ["--config", config_path]
+    return argv
+
+
+def spawn(name: str, pid: ProcessId, argv: list[str], log_dir: Path, env: dict[str, str] | None = None) -> Child:
+    log_path = log_dir / (name.replace("/", "_") + ".log")
+    fh = open(log_path, "wb")  # noqa: SIM115 - handed to the child
+    try:
+        popen = subprocess.Popen(
+            argv,
+            stdin=subprocess.DEVNULL,
+            stdout=fh,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # Ctrl-C reaches the launcher only; it stops the group
+            preexec_fn=_die_with_parent,
+            env=env,
+        )
+    finally:
+        fh.close()
+    return Child(name, pid, popen, log_path)
+
+
+def stop_all(children: list[Child], grace: float = 3.0) -> None:
+    for c in children:
+        if c.popen.poll() is None:
+            c.popen.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + grace
+    for c in children:
+        left = max(0.0, deadline - time.monotonic())
+        try:
+            c.popen.wait(timeout=left)
+        except subprocess.TimeoutExpired:
+            c.popen.kill()
+            c.popen.wait()
+
+
+@dataclass
+class Progress:
+    """Optional live progress (a rich bar on a terminal)."""
+
+    total_ticks: int
+    enabled: bool
+    _bar: object = None
+    _task: object = None
+    score: tuple[int, int] = (0, 0)
+
+    def __enter__(self) -> Progress:
+        if self.enabled:
+            from rich.progress import BarColumn, Progress as RichProgress, TextColumn, TimeRemainingColumn
+
+            self._bar = RichProgress(
+                TextColumn("[bold]match[/]"),
+                BarColumn(),
+                TextColumn("{task.fields[status]}"),
+                TimeRemainingColumn(),
+                transient=True,
+            )
+            self._bar.__enter__()
+            self._task = self._bar.add_task("match", total=self.total_ticks, status="starting")
+        return self
+
+    def update(self, ref: Referee) -> None:
+        if self._bar is not None:
+            self._bar.update(
+                self._task, completed=ref.tick, status=f"{ref.stage.lower():12s} {ref.score_a}:{ref.score_b}"
+            )
+
+    def __exit__(self, *exc: object) -> None:
+        if self._bar is not None:
+            self._bar.__exit__(None, None, None)
+
+
+@dataclass
+class Collected:
+    summaries: dict[str, Summary] = field(default_factory=dict)
+    pids: dict[str, int] = field(default_factory=dict)
+    started: float = 0.0
+    ended: float = 0.0
+
+
+def open_collector(transport: ZenohTransport, keys: Keys):
+    """Subscribe to the summaries and announce a collector, before any process starts."""
+    channel = transport.subscribe(keys.summary_all())
+    transport.declare_alive(keys.collector())
+    return channel
+
+
+def supervise(
+    transport: ZenohTransport,
+    collector,
+    keys: Keys,
+    cfg: MatchConfig,
+    children: list[Child],
+    expected: list[str],
+    progress: Progress,
+    timeout: float | None = None,
+) -> Collected:
+    """Wait for every expected summary; abort on a failed child or Ctrl-C."""
+    decode_summary = msgspec.msgpack.Decoder(Summary).decode
+    decode_ref = msgspec.msgpack.Decoder(Referee).decode
+    sums = collector
+    refs = transport.subscribe(keys.key("referee")) if progress.enabled else None
+    got = Collected(started=time.monotonic())
+    deadline = None if timeout is None else got.started + timeout
+    with progress:
+        while len(got.summaries) < len(expected):
+            raw = sums.try_recv()
+            if raw is not None:
+                try:
+                    s = decode_summary(raw)
+                except (msgspec.DecodeError, msgspec.ValidationError):
+                    continue  # not ours to judge; the rest of the match goes on
+                if s.process not in got.summaries:
+                    got.summaries[s.process] = s
+                transport.publisher(keys.ack(s.process))(b"ack")
+                continue
+            if refs is not None:
+                last = None
+                while (r := refs.try_recv()) is not None:
+                    last = r
+                if last is not None:
+                    try:
+                        progress.update(decode_ref(last))
+                    except (msgspec.DecodeError, msgspec.ValidationError):
+                        pass
+            for c in children:
+                code = c.popen.poll()
+                if code is not None and code != 0 and c.name not in got.summaries:
+                    raise MatchError(f"{c.name} (pid {c.popen.pid}) exited with code {code}:\n{c.tail()}")
+                if code == 0 and c.name not in got.summaries:
+                    # Give its summary a moment to arrive before calling it lost.
+                    c_deadline = getattr(c, "_exit_seen", None)
+                    if c_deadline is None:
+                        c._exit_seen = time.monotonic()  # type: ignore[attr-defined]
+                    elif time.monotonic() - c_deadline > 5.0:
+                        raise MatchError(f"{c.name} (pid {c.popen.pid}) exited without a summary:\n{c.tail()}")
+            if deadline is not None and time.monotonic() > deadline:
+                missing = sorted(set(expected) - set(got.summaries))
+                raise MatchError(f"match timed out after {timeout:g} s waiting for: {', '.join(missing)}")
+            time.sleep(0.02)
+    got.ended = time.monotonic()
+    return got
+
+
+def percentile(sorted_values: list[float], q: float) -> float:
+    if not sorted_values:
+        return 0.0
+    i = min(len(sorted_values) - 1, max(0, int(round(q * (len(sorted_values) - 1)))))
+    return sorted_values[i]
+
+
+def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
+    """The match result (what `arena match --json` prints)."""
+    order = [str(p) for p in cfg.processes()]
+    sums = got.summaries
+    combined = hashlib.blake2b(digest_size=16)
+    for name in order:
+        if name in sums:
+            combined.update(name.encode() + b"=" + sums[name].digest.encode() + b";")
+    referee = sums.get("referee")
+    engine = sums.get("engine")
+    links: dict[str, dict] = {}
+    for name in order:
+        s = sums.get(name)
+        if s is None:
+            continue
+        for cls, agg in s.links.items():
+            acc = links.setdefault(cls, {"sent": 0, "dropped": 0, "_delays": []})
+            acc["sent"] += int(agg["frames"])
+            acc["dropped"] += int(agg["dropped"])
+            acc["_delays"].extend(s.delays_ms.get(cls, []))
+    for acc in links.values():
+        d = sorted(acc.pop("_delays"))
+        acc["drop_rate"] = round(acc["dropped"] / acc["sent"], 5) if acc["sent"] else 0.0
+        acc["delay_ms_mean"] = round(sum(d) / len(d), 3) if d else 0.0
+        acc["delay_ms_p95"] = round(percentile(d, 0.95), 3)
+    rejected = Counter()
+    for s in sums.values():
+        rejected.update(s.rejected_reasons)
+    pid_of = {c.name: c.popen.pid for c in children}
+    processes = []
+    for p in cfg.processes():
+        name = str(p)
+        s = sums.get(name)
+        processes.append(
+            {
+                "kind": p.kind,
+                "team": p.team or None,
+                "robot": p.robot if p.kind == "robot" else None,
+                "pid": s.pid if s is not None else pid_of.get(name),
+                "external": p.short in cfg.external or name in cfg.external,
+                "tick_us_median": round(s.tick_us[0], 1) if s and s.tick_us else None,
+                "tick_us_p95": round(s.tick_us[1], 1) if s and s.tick_us else None,
+            }
+        )
+    score = list(referee.extra.get("score", [0, 0])) if referee else [0, 0]
+    ticks = engine.tick if engine else 0
+    sim_seconds = ticks * cfg.timing.dt
+    # Simulation speed is measured by the engine from its start barrier to its
+    # last tick; process start-up is reported apart (wall_seconds).
+    play = max(1e-9, engine.wall_s if engine and engine.wall_s > 0 else got.ended - got.started)
+    return {
+        "home": cfg.home,
+        "away": cfg.away,
+        "score": score,
+        "seed": cfg.seed,
+        "robots": cfg.robots,
+        "half_time": cfg.half_time,
+        "link": cfg.link,
+        "realtime": cfg.realtime,
+        "ticks": ticks,
+        "sim_seconds": round(sim_seconds, 3),
+        "wall_seconds": round(wall_total, 3),
+        "play_wall_seconds": round(play, 3),
+        "rtf": round(sim_seconds / play, 2),
+        "digest": combined.hexdigest(),
+        "process_digests": {name: sums[name].digest for name in order if name in sums},
+        "processes": processes,
+        "links": links,
+        "events": dict(sorted(referee.extra.get("events", {}).items())) if referee else {},
+        "distance_m": engine.extra.get("distance_m", {}) if engine else {},
+        "rejected": sum(rejected.values()),
+        "rejected_reasons": dict(rejected),
+        "dead": sorted({d for s in sums.values() for d in s.dead}),
+        "referee_log": referee.extra.get("log", []) if referee else [],
+    }
+
+
+def play_match(
+    cfg: MatchConfig,
+    *,
+    listen: str | None = None,
+    progress: bool = False,
+    log_dir: str | None = None,
+    announce=None,
+) -> dict:
+    """Play one match as separate processes and return its result dict.
+
+    `announce(text)` is called with instructions for `--external` processes.
+    Raises MatchError when the match cannot be completed.
+    """
+    t_start = time.monotonic()
+    match = new_match_id(cfg.seed)
+    keys = Keys(match)
+    tmp = Path(tempfile.mkdtemp(prefix="arena-"))
+    endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
+    connect = endpoint.replace("0.0.0.0", "127.0.0.1")
+    cfg_path = tmp / "config.json"
+    cfg_path.write_text(cfg.to_json())
+    logs = Path(log_dir) if log_dir else tmp
+    logs.mkdir(parents=True, exist_ok=True)
+    children: list[Child] = []
+    ok = False
+    try:
+        with open_session(NetConfig(mode="router", listen=(endpoint,))) as session:
+            transport = ZenohTransport(session)
+            collector = open_collector(transport, keys)
+            external = {ProcessId.parse(e) for e in cfg.external}
+            for p in cfg.processes():
+                if p in external:
+                    continue
+                children.append(spawn(str(p), p, run_argv(p, match, connect, str(cfg_path)), logs))
+            if external and announce is not None:
+                lines = [f"waiting for {len(external)} external process(es); start each with:"]
+                for p in sorted(external):
+                    argv = run_argv(p, match, connect)[2:]
+                    lines.append("  arena " + " ".join(argv[1:]))
+                announce("\n".join(lines))
+            try:
+                got = supervise(
+                    transport,
+                    collector,
+                    keys,
+                    cfg,
+                    children,
+                    [str(p) for p in cfg.processes()],
+                    Progress(cfg.total_ticks, progress),
+                )
+            finally:
+                transport.close()
+        for c in children:
+            try:
+                c.popen.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
+        ok = True
+        return assemble(cfg, got, time.monotonic() - t_start, children)
+    finally:
+        stop_all(children)
+        if log_dir is None and ok:
+            shutil.rmtree(tmp, ignore_errors=True)

@@ -1,0 +1,42 @@
+"""Human-readable output (rich tables) for match results."""
+
+from __future__ import annotations
+
+from rich.console import Console
+from rich.table import Table
+
+
+def print_match(result: dict, console: Console | None = None) -> None:
+    console = console or Console()
+    a, b = result["score"]
+    console.print(
+        f"[bold]{result['home']}[/] (a) [bold]{a} : {b}[/] [bold]{result['away']}[/] (b)   "
+        f"seed {result['seed']}, link {result['link']}"
+    )
+    console.print(
+        f"{result['sim_seconds']:.1f} s simulated in {result['play_wall_seconds']:.2f} s "
+        f"(rtf {result['rtf']:.1f}x); {result['wall_seconds']:.2f} s with start-up; digest {result['digest'][:16]}"
+    )
+    goals = [e for e in result.get("referee_log", []) if e["command"] == "GOAL"]
+    if goals:
+        dt = result["sim_seconds"] / max(1, result["ticks"])
+        console.print("goals: " + ", ".join(f"{e['team']} {e['tick'] * dt:.1f}s" for e in goals))
+    t = Table(title="links", show_header=True)
+    for col in ("class", "sent", "dropped", "drop %", "delay mean ms", "delay p95 ms"):
+        t.add_column(col, justify="right")
+    for cls, s in sorted(result["links"].items()):
+        t.add_row(cls, str(s["sent"]), str(s["dropped"]), f"{100 * s['drop_rate']:.2f}",
+                  f"{s['delay_ms_mean']:.2f}", f"{s['delay_ms_p95']:.2f}")
+    console.print(t)
+    d = Table(title="distance per robot [m]")
+    d.add_column("robot")
+    d.add_column("m", justify="right")
+    for name, m in result["distance_m"].items():
+        d.add_row(name, f"{m:.1f}")
+    console.print(d)
+    events = ", ".join(f"{k} {v}" for k, v in result["events"].items())
+    console.print(f"referee: {events}")
+    if result["rejected"]:
+        console.print(f"[yellow]rejected inputs: {result['rejected']} {result['rejected_reasons']}[/]")
+    if result["dead"]:
+        console.print(f"[red]treated as dead: {', '.join(result['dead'])}[/]")
