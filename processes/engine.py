@@ -20,8 +20,11 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
+
 from arena.processes.physics import Physics
 from arena.processes.sensors import sense
+from arena.runtime import seeds
 from arena.runtime.config import TEAMS
 from arena.runtime.lockstep import EVERY_TICK, Schedule
 from arena.runtime.node import Node
@@ -48,7 +51,9 @@ class EngineNode(Node):
         self.physics = Physics(cfg)
         self.physics.attack_dir_a = 1
         self.physics.kickoff_positions("a")
-        self.sensor_rng = {r: self.rng("sensor", *r) for r in self.robots}
+        self.sensor_rng = {
+            r: np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r)) for r in self.robots
+        }
         self.cmd_in = {
             (team, n): self.inp(
                 "cmd", team, n, schedule=EVERY_TICK, lag=1, sender=f"robot/{team}/{n}", check=check_cmd
@@ -79,8 +84,9 @@ class EngineNode(Node):
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor
+        states = ph.robot_states()
         for r, out in self.sense_out.items():
-            out.send(sense(ph, r[0], r[1], k, self.sensor_rng[r], sp))
+            out.send(sense(ph, r[0], r[1], k, self.sensor_rng[r], sp, states))
         if self.world_schedule.due(k):
             self.world_out.send(ph.world(k))
         if self.events_schedule.due(k):

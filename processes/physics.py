@@ -604,6 +604,14 @@ class Physics:
             self._refresh()
         return self._snap
 
+    def robot_states(self) -> list[tuple[str, int, float, float, float, float, float, float]]:
+        """Every robot's (team, n, x, y, theta, vx, vy, omega), field frame, in one pass."""
+        s = self._fresh()
+        return [
+            (r.team, r.n, s[r.off], s[r.off + 1], wrap_angle(s[r.off + 2]), s[r.off + 3], s[r.off + 4], s[r.off + 5])
+            for r in self._robots
+        ]
+
     def robot_pose(self, team: str, n: int) -> tuple[float, float, float]:
         """(x [m], y [m], theta [rad] in (-pi, pi]) in the field frame."""
         s, o = self._fresh(), self._by_id[(team, n)].off

@@ -14,54 +14,70 @@ tick (the G_R_n data pair), all in SI units:
   noisy field-frame position (same noise model), sorted by range, no number;
 * has_ball: whether its dribbler holds the ball.
 
-Every draw comes from the caller's `random.Random`, in a fixed order, so a
-seeded generator reproduces the same readings.
+Noise comes from the caller's numpy `Generator`, one per robot. Every call
+draws the same number of standard normals (3 + 2 + 2 per other robot, seen or
+not), so a robot's noise stream never depends on what it happened to see, and
+one vectorised draw replaces ~30 calls of `random.gauss` (the engine's hottest
+Python code before).
 """
 
 from __future__ import annotations
 
 import math
-import random
+
+import numpy as np
 
 from arena.processes.physics import Physics, wrap_angle
 from arena.runtime.config import SensorParams
 from arena.schemas.messages import BallSeen, Pose, RobotSeen, Sense
 
+RobotStates = list[tuple[str, int, float, float, float, float, float, float]]
 
-def sense(physics: Physics, team: str, n: int, tick: int, rng: random.Random, p: SensorParams) -> Sense:
-    """What robot (team, n) senses at `tick`; see the module docstring."""
-    gauss = rng.gauss
-    x, y, theta = physics.robot_pose(team, n)
-    vx, vy, omega = physics.robot_velocity(team, n)
+
+def sense(
+    physics: Physics,
+    team: str,
+    n: int,
+    tick: int,
+    rng: np.random.Generator,
+    p: SensorParams,
+    states: RobotStates | None = None,
+) -> Sense:
+    """What robot (team, n) senses at `tick`; see the module docstring.
+
+    `states` is `physics.robot_states()`; pass it when sensing for every robot
+    of a tick, so that the snapshot is read once.
+    """
+    if states is None:
+        states = physics.robot_states()
+    z = rng.standard_normal(3 + 2 * len(states)).tolist()
+    me = next(st for st in states if st[0] == team and st[1] == n)
+    _, _, x, y, theta, vx, vy, omega = me
     c, s = math.cos(theta), math.sin(theta)
     pose = Pose(
-        x=x + gauss(0.0, p.pose_sigma),
-        y=y + gauss(0.0, p.pose_sigma),
-        theta=wrap_angle(theta + gauss(0.0, p.heading_sigma)),
+        x=x + p.pose_sigma * z[0],
+        y=y + p.pose_sigma * z[1],
+        theta=wrap_angle(theta + p.heading_sigma * z[2]),
     )
-
     bx, by = physics.ball_state()[:2]
-    rng_ball = math.hypot(bx - x, by - y)
-    if rng_ball <= p.ball_range:
-        sigma = p.det_sigma + p.det_sigma_per_m * rng_ball
-        ball = BallSeen(visible=True, x=bx + gauss(0.0, sigma), y=by + gauss(0.0, sigma))
+    d_ball = math.hypot(bx - x, by - y)
+    if d_ball <= p.ball_range:
+        sigma = p.det_sigma + p.det_sigma_per_m * d_ball
+        ball = BallSeen(visible=True, x=bx + sigma * z[3], y=by + sigma * z[4])
     else:
         ball = BallSeen()
 
     near = []
-    for other in physics.robot_ids:
-        if other[0] == team and other[1] == n:
+    i = 5
+    for t, m, ox, oy, *_ in states:
+        if t == team and m == n:
             continue
-        ox, oy, _ = physics.robot_pose(*other)
         d = math.hypot(ox - x, oy - y)
         if d <= p.robot_range:
-            near.append((d, other[0], ox, oy))
+            sigma = p.det_sigma + p.det_sigma_per_m * d
+            near.append((d, t, ox + sigma * z[i], oy + sigma * z[i + 1]))
+        i += 2
     near.sort()
-    robots = []
-    for d, t, ox, oy in near:
-        sigma = p.det_sigma + p.det_sigma_per_m * d
-        robots.append(RobotSeen(team=t, x=ox + gauss(0.0, sigma), y=oy + gauss(0.0, sigma)))
-
     return Sense(
         tick=tick,
         pose=pose,
@@ -69,6 +85,6 @@ def sense(physics: Physics, team: str, n: int, tick: int, rng: random.Random, p:
         vy=c * vy - s * vx,
         omega=omega,
         ball=ball,
-        robots=robots,
+        robots=[RobotSeen(team=t, x=nx, y=ny) for _, t, nx, ny in near],
         has_ball=physics.holder() == (team, n),
     )

@@ -131,14 +131,13 @@ class LinkEmulator:
         self._ideal = model.is_ideal()
         self.frames = 0
         self.dropped = 0
-        self.delays_ms: list[float] = []
+        self.delays_ms: list[float] = []  # drawn delays of delivered frames (non-ideal links)
 
     def decide(self) -> float | None:
         """Delay in ms for the next frame, or None if it is lost."""
         self.frames += 1
         if self._ideal:
-            self.delays_ms.append(0.0)
-            return 0.0
+            return 0.0  # no delay statistics to keep: every delay is 0
         m = self.model
         r = self._rng.random
         # Step the Gilbert-Elliott chain, then draw loss in the new state.

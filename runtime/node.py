@@ -12,6 +12,7 @@ A process kind subclasses `Node`, declares its links in `__init__` with
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import logging
 import os
@@ -162,6 +163,11 @@ class Node:
     def run(self) -> msgs.Summary:
         try:
             self.barrier()
+            # Everything built so far lives for the whole match: keep it out of
+            # the collector's way (the tick loop allocates only short-lived,
+            # acyclic objects that reference counting frees).
+            gc.collect()
+            gc.freeze()
             t0 = time.perf_counter()
             self.loop()
             self._wall_s = time.perf_counter() - t0

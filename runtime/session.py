@@ -13,11 +13,16 @@ to one another. Measured on 2 cores (engine + 6 robots, lockstep ping-pong):
 clients through the router 0.95 ms per tick, peers meshed behind a router
 0.57 ms per tick. A hardware-in-the-loop process on another machine uses
 `--mode client` and talks through the router.
+
+zenoh's default lease (10 s) is kept: a shorter one multiplies keep-alive
+traffic over the full mesh of peers, and a hung peer is caught sooner by the
+lockstep watchdog (`timing.wait_timeout`) anyway.
 """
 
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass, field
 
 import zenoh
@@ -42,14 +47,18 @@ class NetConfig:
             # open a direct link to us; nothing outside this machine can.
             listen = ["tcp/127.0.0.1:0"]
         c.insert_json5("listen/endpoints", json.dumps(listen))
-        # A hung peer shows as gone after ~1 s instead of ~10 s (notes-zenoh-mcap.md).
-        c.insert_json5("transport/link/tx/lease", "1000")
-        c.insert_json5("transport/link/tx/keep_alive", "4")
         for path, value in self.extra:
             c.insert_json5(path, value)
         return c
 
 
+# Eleven processes share two cores: one worker thread per zenoh runtime pool
+# instead of one per core saves CPU on every tick (see docs/performance.md).
+# A user's own ZENOH_RUNTIME setting wins.
+SMALL_RUNTIME = "(rx:(worker_threads:1),tx:(worker_threads:1),app:(worker_threads:1),acc:(worker_threads:1),net:(worker_threads:1))"
+
+
 def open_session(net: NetConfig) -> zenoh.Session:
     """Open a zenoh session; use as `with open_session(net) as session:`."""
+    os.environ.setdefault("ZENOH_RUNTIME", SMALL_RUNTIME)
     return zenoh.open(net.zenoh_config())

@@ -55,7 +55,12 @@ class _ZenohChannel:
 
 
 class ZenohTransport:
-    """Lockstep traffic is RELIABLE with congestion control BLOCK: nothing is dropped by zenoh."""
+    """Lockstep traffic is RELIABLE with congestion control BLOCK: nothing is dropped by zenoh.
+
+    Not `express`: measured on 2 cores, an express put costs ~40 us of CPU
+    (one write per message) against ~12 us batched, with no measurable
+    latency cost in the lockstep ping-pong (0.57 ms per tick either way).
+    """
 
     FIFO = 1 << 14  # frames buffered per subscription
 
@@ -69,8 +74,7 @@ class ZenohTransport:
             encoding=zenoh.Encoding("application/msgpack"),
             congestion_control=zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.RELIABLE,
-            priority=zenoh.Priority.REAL_TIME,
-            express=True,
+            express=False,
         )
         self._keep.append(pub)
         return pub.put

@@ -266,6 +266,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
                 "external": p.short in cfg.external or name in cfg.external,
                 "tick_us_median": round(s.tick_us[0], 1) if s and s.tick_us else None,
                 "tick_us_p95": round(s.tick_us[1], 1) if s and s.tick_us else None,
+                "cpu_s": round(sum(s.cpu_s), 3) if s and s.cpu_s else None,
             }
         )
     score = list(referee.extra.get("score", [0, 0])) if referee else [0, 0]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import random
+
+import numpy as np
 import statistics
 
 import pytest
@@ -33,7 +35,7 @@ def make() -> Physics:
 def test_pose_noise_statistics():
     ph = make()
     ph.place_robot("a", 0, 1.0, 2.0, 0.5)
-    rng = random.Random(1)
+    rng = np.random.default_rng(1)
     readings = [sense(ph, "a", 0, 0, rng, P).pose for _ in range(N)]
     for values, truth, sigma in (
         ([r.x for r in readings], 1.0, P.pose_sigma),
@@ -47,7 +49,7 @@ def test_pose_noise_statistics():
 def test_heading_is_wrapped():
     ph = make()
     ph.place_robot("a", 0, 0.0, 0.0, math.pi - 0.001)
-    rng = random.Random(2)
+    rng = np.random.default_rng(2)
     thetas = [sense(ph, "a", 0, 0, rng, P).pose.theta for _ in range(500)]
     assert all(-math.pi < t <= math.pi for t in thetas)
     assert min(thetas) < -3.0 and max(thetas) > 3.0, "noise must wrap across +-pi"
@@ -57,7 +59,7 @@ def test_heading_is_wrapped():
 def test_ball_noise_grows_with_range(distance):
     ph = make()
     ph.place_ball(0.0, distance)
-    rng = random.Random(3)
+    rng = np.random.default_rng(3)
     balls = [sense(ph, "a", 0, 0, rng, P).ball for _ in range(N)]
     assert all(b.visible for b in balls)
     sigma = P.det_sigma + P.det_sigma_per_m * distance
@@ -68,7 +70,7 @@ def test_ball_noise_grows_with_range(distance):
 
 def test_ball_range_limit():
     ph = make()
-    rng = random.Random(4)
+    rng = np.random.default_rng(4)
     ph.place_ball(P.ball_range - 0.05, 0.0)
     assert sense(ph, "a", 0, 0, rng, P).ball.visible
     ph.place_ball(P.ball_range + 0.05, 0.0)
@@ -80,7 +82,7 @@ def test_robot_range_limit_team_colour_and_order():
     ph.place_robot("b", 1, 0.0, P.robot_range - 0.05, 0.0)
     ph.place_robot("a", 1, 2.0, 0.0, 0.0)
     ph.place_robot("b", 0, -P.robot_range - 0.05, 0.0, 0.0)
-    rng = random.Random(5)
+    rng = np.random.default_rng(5)
     seen = sense(ph, "a", 0, 0, rng, P).robots
     assert [r.team for r in seen] == ["a", "b"], "sorted by range, self and far robots left out"
     assert (seen[0].x, seen[0].y) == pytest.approx((2.0, 0.0), abs=0.2)
@@ -92,7 +94,7 @@ def test_range_limits_follow_the_parameters():
     ph = make()
     p = dataclasses.replace(P, ball_range=1.0, robot_range=1.0)
     ph.place_robot("b", 0, 1.5, 0.0, 0.0)
-    s = sense(ph, "a", 0, 0, random.Random(6), p)
+    s = sense(ph, "a", 0, 0, np.random.default_rng(6), p)
     assert not s.ball.visible and s.robots == []
 
 
@@ -102,7 +104,7 @@ def test_odometry_is_in_the_body_frame():
     ph.set_command("a", 0, Cmd(tick=0, vx=1.0, vy=0.5, omega=0.2))
     for _ in range(100):
         ph.step()
-    s = sense(ph, "a", 0, 100, random.Random(7), P)
+    s = sense(ph, "a", 0, 100, np.random.default_rng(7), P)
     assert (s.vx, s.vy, s.omega) == pytest.approx((1.0, 0.5, 0.2), abs=0.02)
     assert s.tick == 100
 
@@ -110,7 +112,7 @@ def test_odometry_is_in_the_body_frame():
 def test_has_ball_comes_from_the_dribbler():
     ph = make()
     ph.place_ball(0.225 + 0.11 + 0.02, 0.0)
-    rng = random.Random(8)
+    rng = np.random.default_rng(8)
     assert not sense(ph, "a", 0, 0, rng, P).has_ball
     ph.set_command("a", 0, Cmd(tick=0, dribbler=True))
     ph.step()
@@ -123,10 +125,10 @@ def test_seeded_reproducibility_and_no_global_random():
     saved = random.getstate()
     try:
         random.seed(1)
-        first = [sense(ph, "a", 0, k, random.Random(42), P) for k in range(3)]
+        first = [sense(ph, "a", 0, k, np.random.default_rng(42), P) for k in range(3)]
         random.seed(2)
-        again = [sense(ph, "a", 0, k, random.Random(42), P) for k in range(3)]
+        again = [sense(ph, "a", 0, k, np.random.default_rng(42), P) for k in range(3)]
     finally:
         random.setstate(saved)
     assert first == again
-    assert sense(ph, "a", 0, 0, random.Random(43), P) != first[0]
+    assert sense(ph, "a", 0, 0, np.random.default_rng(43), P) != first[0]
