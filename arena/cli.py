@@ -83,6 +83,7 @@ def build_parser() -> Parser:
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
     m.add_argument("--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand")
     m.add_argument("--listen", metavar="ENDPOINT", help="router endpoint (default: a unix socket in a temp dir)")
+    m.add_argument("--match", metavar="ID", help="match id, i.e. key prefix arena/<ID>/ (default: a fresh one)")
     m.add_argument("--logs", metavar="DIR", help="keep every process's log in DIR")
     m.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     m.add_argument("--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up")
@@ -154,6 +155,13 @@ def cmd_match(args: argparse.Namespace) -> int:
     from arena.tools import launcher, report
 
     cfg = match_config(args, realtime=args.realtime, external=args.external)
+    if args.match:
+        from arena.runtime.keys import check_match_id
+
+        try:
+            check_match_id(args.match)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
     if args.startup_timeout is not None or cfg.external:
         import dataclasses
 
@@ -163,6 +171,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     try:
         result = launcher.play_match(
             cfg,
+            match=args.match,
             listen=args.listen,
             progress=show,
             log_dir=args.logs,

@@ -10,8 +10,8 @@ team-play work lands they share this behaviour:
 * goalkeeper: stays on its goal line following the ball's y, clears the ball
   when it is close;
 * attacker: gets behind the ball on the line to the opponent goal, dribbles in
-  and shoots from 4 m;
-* defender: waits between the ball and its own goal, 3 m out.
+  and shoots from 6 m;
+* defender: waits between the ball and its own goal, 1.6 m out.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, Sense, Tea
 from arena.strategies.base import RobotContext, Strategy, TeamContext
 
 PLAY_COMMANDS = frozenset({"START"})
-SHOOT_RANGE = 4.0  # [m] distance to the goal centre from which the attacker shoots
+SHOOT_RANGE = 6.0  # [m] distance to the goal centre from which the attacker shoots
 KICK_SPEED = 6.0  # [m/s] same for every strategy, as in the paper
 CRUISE = 2.5  # [m/s] navigation speed cap
 DRIBBLE_SPEED = 1.2  # [m/s]
@@ -139,23 +139,41 @@ class SimpleRobot:
         if self.role == "defender":
             gx, gy = own_x, 0.0
             d = math.hypot(bx - gx, by - gy) or 1.0
-            r = min(3.0, d * 0.6)
+            r = min(1.6, d * 0.5)
             tx, ty = gx + (bx - gx) / d * r, gy + (by - gy) / d * r
             return self._goto(tick, p, tx, ty, math.atan2(by - p.y, bx - p.x), CRUISE)
-        # attacker
-        to_goal = math.atan2(0.0 - by, goal_x - bx)
-        dist_goal = math.hypot(goal_x - bx, by)
+        # attacker: aim at the half of the goal mouth the keeper leaves open
+        aim_y = self._open_corner(sense, goal_x)
+        to_goal = math.atan2(aim_y - by, goal_x - bx)
+        d_ball = math.hypot(bx - p.x, by - p.y)
+        aim = math.atan2(aim_y - p.y, goal_x - p.x)  # robot -> aim point
+        facing = abs(_wrap(aim - p.theta)) < 0.2
+        in_front = d_ball < 0.42 and abs(_wrap(math.atan2(by - p.y, bx - p.x) - p.theta)) < 0.3
+        if (sense.has_ball or in_front) and facing and math.hypot(goal_x - p.x, p.y) < SHOOT_RANGE:
+            return Cmd(tick=tick, dribbler=True, kick_speed=KICK_SPEED)
         if sense.has_ball:
-            if dist_goal < SHOOT_RANGE and abs(_wrap(to_goal - p.theta)) < 0.25:
-                return Cmd(tick=tick, dribbler=True, kick_speed=KICK_SPEED)
-            heading = math.atan2(-p.y, goal_x - p.x)
-            return self._goto(tick, p, goal_x, 0.0, heading, DRIBBLE_SPEED, dribbler=True)
-        behind_x = bx - 0.35 * math.cos(to_goal)
-        behind_y = by - 0.35 * math.sin(to_goal)
+            return self._goto(tick, p, goal_x, aim_y, aim, DRIBBLE_SPEED, dribbler=True)
+        # Get behind the ball on its line to the goal, a little off to one side
+        # so that two attackers do not meet head-on.
+        side = 0.15 if self.team == "a" else -0.15
+        behind_x = bx - 0.35 * math.cos(to_goal) - side * math.sin(to_goal)
+        behind_y = by - 0.35 * math.sin(to_goal) + side * math.cos(to_goal)
         dx, dy = behind_x - p.x, behind_y - p.y
-        if dx * dx + dy * dy < 0.15**2 and abs(_wrap(to_goal - p.theta)) < 0.3:
-            return self._goto(tick, p, bx, by, to_goal, 1.0, dribbler=True)
+        if dx * dx + dy * dy < 0.2**2 and abs(_wrap(to_goal - p.theta)) < 0.4:
+            return self._goto(tick, p, bx, by, to_goal, 1.5, dribbler=True)
         return self._goto(tick, p, behind_x, behind_y, to_goal, CRUISE, dribbler=True)
+
+    def _open_corner(self, sense: Sense, goal_x: float) -> float:
+        """y of the aim point: 0.6 of the half-width, on the side away from the keeper."""
+        other = "b" if self.team == "a" else "a"
+        keeper_y = 0.0
+        best = 1.5  # [m] only a robot this close to the goal centre counts as the keeper
+        for r in sense.robots:
+            if r.team == other:
+                d = math.hypot(r.x - goal_x, r.y)
+                if d < best:
+                    best, keeper_y = d, r.y
+        return -0.6 * self.goal_half if keeper_y > 0 else 0.6 * self.goal_half
 
     def _turn(self, tick: int, sense: Sense, omega: float) -> Cmd:
         return Cmd(tick=tick, omega=omega)

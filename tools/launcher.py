@@ -305,6 +305,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
 def play_match(
     cfg: MatchConfig,
     *,
+    match: str | None = None,
     listen: str | None = None,
     progress: bool = False,
     log_dir: str | None = None,
@@ -316,7 +317,7 @@ def play_match(
     Raises MatchError when the match cannot be completed.
     """
     t_start = time.monotonic()
-    match = new_match_id(cfg.seed)
+    match = match or new_match_id(cfg.seed)
     keys = Keys(match)
     tmp = Path(tempfile.mkdtemp(prefix="arena-"))
     endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
