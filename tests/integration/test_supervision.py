@@ -1,0 +1,69 @@
+"""Isolation of concurrent matches, Ctrl-C and crashes: the whole group stops, nothing is orphaned."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+
+from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for
+
+MATCH = ("match", "--home", "BS", "--away", "BS", "--seed", "3", "--json")
+
+
+def arena_children(pid: int) -> set[int]:
+    return {p for p in descendants(pid) if " -m arena run " in cmdline(p)}
+
+
+def all_ten(pid: int) -> set[int]:
+    return wait_for(lambda: (k if len(k := arena_children(pid)) == 10 else None), 60, "ten live processes")
+
+
+def test_two_matches_at_once_do_not_hear_each_other(reap):
+    """Same seed and even the same match id (key prefix): separate routers keep them apart."""
+    a = spawn(*MATCH, "--half-time", "20", "--match", "twin")
+    b = spawn(*MATCH, "--half-time", "20", "--match", "twin")
+    reap.extend([a, b])
+    out_a, err_a = a.communicate(timeout=300)
+    out_b, err_b = b.communicate(timeout=300)
+    assert a.returncode == 0, err_a
+    assert b.returncode == 0, err_b
+    ra, rb = json.loads(out_a), json.loads(out_b)
+    assert ra["rejected"] == 0 and rb["rejected"] == 0, "a frame from the other match would be out of sequence"
+    assert ra["dead"] == [] and rb["dead"] == []
+    assert ra["digest"] == rb["digest"], "same seed, no cross-talk: the same match twice"
+    assert {p["pid"] for p in ra["processes"]}.isdisjoint({p["pid"] for p in rb["processes"]})
+
+
+def test_ctrl_c_stops_every_process(reap):
+    proc = spawn(*MATCH, "--half-time", "300")
+    reap.append(proc)
+    kids = all_ten(proc.pid)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130
+    assert "interrupted" in err and "Traceback" not in err
+    survivors = [p for p in kids if alive(p)]
+    assert survivors == [], f"orphans: {survivors}"
+
+
+def test_a_crashing_child_ends_the_match_with_a_clear_message(reap):
+    proc = spawn(*MATCH, "--half-time", "300")
+    reap.append(proc)
+    kids = all_ten(proc.pid)
+    victim = next(p for p in kids if "--team a --robot 2" in cmdline(p))
+    os.kill(victim, signal.SIGKILL)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 1
+    assert f"robot/a/2 (pid {victim}) exited with code -9" in err
+    assert "Traceback" not in err.splitlines()[0]
+    wait_for(lambda: not [p for p in kids if alive(p)], 10, "every process of the match to stop")
+
+
+def test_a_killed_launcher_leaves_no_orphans(reap):
+    proc = spawn(*MATCH, "--half-time", "300")
+    reap.append(proc)
+    kids = all_ten(proc.pid)
+    proc.kill()
+    proc.wait()
+    wait_for(lambda: not [p for p in kids if alive(p)], 10, "the children to die with their launcher")

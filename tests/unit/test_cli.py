@@ -1,0 +1,44 @@
+"""Bad input on the command line: one line, exit code 2, never a traceback."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+
+def arena(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "arena", *args], capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["match", "--home", "BS", "--away", "BS", "--robots", "lots"], "invalid int value"),
+        (["match", "--home", "tiki-taka", "--away", "BS"], "unknown strategy 'tiki-taka'"),
+        (["match", "--home", "BS"], "required: --away"),
+        (["match", "--home", "BS", "--away", "BS", "--bogus"], "unrecognized arguments: --bogus"),
+        (["match", "--home", "BS", "--away", "BS", "--link", "5g"], "unknown link preset '5g'"),
+        (["match", "--home", "BS", "--away", "BS", "--link-param", "wifi.warp=9"], "unknown link parameter 'warp'"),
+        (["match", "--home", "BS", "--away", "BS", "--external", "c/9"], "bad process name"),
+        (["match", "--home", "BS", "--away", "BS", "--half-time", "-3"], "--half-time must be positive"),
+        (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
+        (["run", "robot", "--match", "m/x", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"], "bad match id"),
+        (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read --config"),
+        (["up", "/nonexistent/compose.yaml"], "cannot read"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(args, needle):
+    r = arena(*args)
+    assert r.returncode == 2, r.stderr
+    assert needle in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_help_texts_show_examples():
+    for cmd in ("match", "run", "up", "bench"):
+        r = arena(cmd, "--help")
+        assert r.returncode == 0 and "examples:" in r.stdout

@@ -1,0 +1,84 @@
+"""Configuration, process names, seeds, strategies and the wire contract document."""
+
+from __future__ import annotations
+
+import pytest
+
+from arena.runtime import seeds
+from arena.runtime.config import ConfigError, MatchConfig, ProcessId
+from arena.runtime.keys import KEYS, Keys
+from arena.schemas import contract
+from arena.strategies import registry
+
+
+def test_config_round_trips_through_json():
+    cfg = MatchConfig(seed=9, home="advance-dynamic", robots=4, link="wifi", link_overrides={"wifi": {"p_gb": 0.1}})
+    assert MatchConfig.from_json(cfg.to_json()) == cfg
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ({"robots": 0}, "--robots"),
+        ({"half_time": -1}, "--half-time"),
+        ({"robots": "three"}, "invalid match configuration"),
+        ({"external": ["robot/a/9"]}, "no such process"),
+    ],
+)
+def test_bad_config_is_rejected_with_a_reason(data, message):
+    with pytest.raises(ConfigError, match=message):
+        MatchConfig.from_dict(data)
+
+
+def test_processes_of_a_match():
+    names = [str(p) for p in MatchConfig(robots=2).processes()]
+    assert names == ["engine", "referee", "basestation/a", "basestation/b", "robot/a/0", "robot/a/1", "robot/b/0", "robot/b/1"]
+
+
+@pytest.mark.parametrize(
+    ("text", "pid"),
+    [("a/1", ProcessId("robot", "a", 1)), ("robot/b/0", ProcessId("robot", "b", 0)), ("basestation/a", ProcessId("basestation", "a")), ("engine", ProcessId("engine"))],
+)
+def test_process_names(text, pid):
+    assert ProcessId.parse(text) == pid
+
+
+@pytest.mark.parametrize("text", ["c/1", "robot/a", "a/x", "pitch"])
+def test_bad_process_names(text):
+    with pytest.raises(ConfigError, match="bad process name"):
+        ProcessId.parse(text)
+
+
+def test_seeds_are_derived_per_component_and_stable():
+    assert seeds.derive(7, "link", "wifi") == seeds.derive(7, "link", "wifi")
+    assert seeds.derive(7, "link", "wifi") != seeds.derive(8, "link", "wifi")
+    assert seeds.derive(7, "link", "wifi") != seeds.derive(7, "link", "wired")
+    assert seeds.derive(7, "a", "bc") != seeds.derive(7, "ab", "c")
+    assert 0 <= seeds.derive(7) < 2**63
+
+
+def test_strategy_names_and_aliases():
+    assert registry.resolve_name("AD") == "advance-dynamic"
+    assert registry.resolve_name("basic-static") == "basic-static"
+    assert registry.resolve_name("bs") == "basic-static"
+    with pytest.raises(ConfigError, match="unknown strategy 'tiki-taka'"):
+        registry.resolve_name("tiki-taka")
+
+
+def test_keys_are_prefixed_per_match():
+    k = Keys("m1")
+    assert k.key("cmd", "a", 1) == "arena/m1/robot/a/1/cmd"
+    assert k.rel(k.key("order", "b", 2)) == "team/b/order/2"
+    with pytest.raises(ValueError, match="bad match id"):
+        Keys("a/b")
+
+
+def test_contract_document_is_up_to_date():
+    assert contract.README.read_text() == contract.render(), "run `arena schemas --write`"
+
+
+def test_contract_has_one_row_per_key_and_a_section_per_message():
+    text = contract.README.read_text()
+    for spec in KEYS:
+        assert f"`arena/<match>/{spec.pattern}`" in text
+        assert f"### {spec.message.__name__}" in text

@@ -1,0 +1,130 @@
+"""Lockstep links over the in-memory transport: schedules, lags, emulation, rejection, dead peers."""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import random
+
+import pytest
+
+from arena.runtime.links import LinkEmulator, LinkModel
+from arena.runtime.lockstep import EVERY_TICK, Inbound, Outbound, Rejections, Schedule, Watchdog
+from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.schemas.messages import Cmd, encode
+
+KEY = "arena/t/robot/a/1/cmd"
+
+
+@pytest.mark.parametrize(
+    ("period", "phase", "k", "last", "due"),
+    [(1, 0, 7, 7, True), (5, 0, 7, 5, False), (5, 1, 6, 6, True), (5, 1, 0, -1, False), (5, 4, 13, 9, False)],
+)
+def test_schedule(period, phase, k, last, due):
+    s = Schedule(period, phase)
+    assert s.last_at_or_before(k) == last
+    assert s.due(k) is due
+    assert s.first_after(s.last_at_or_before(k)) > k or s.last_at_or_before(k) == -1
+
+
+class Harness:
+    def __init__(self, model=LinkModel(), schedule=EVERY_TICK, lag=1, timeout=5.0):
+        self.bus = MemoryBus()
+        self.rx = MemoryTransport(self.bus)
+        self.tx = MemoryTransport(self.bus)
+        self.rej = Rejections(logging.getLogger("test"))
+        self.dead: dict[str, str] = {}
+        self.gone: set[str] = set()
+        self.wd = Watchdog(self.rx, timeout)
+        self.inbound = Inbound(
+            key=KEY, msg_type=Cmd, channel=self.rx.subscribe(KEY), schedule=schedule, lag=lag,
+            link_class="sensor", sender="robot/a/1", emulator=LinkEmulator(model, random.Random(1)),
+            dt=0.02, rejections=self.rej, watchdog=self.wd, is_dead=self.gone.__contains__,
+            on_dead=self.dead.__setitem__,
+        )
+        self.put = self.tx.publisher(KEY)
+
+    def close(self):
+        self.wd.stop()
+
+
+@pytest.fixture
+def h():
+    harness = Harness()
+    yield harness
+    harness.close()
+
+
+def test_frame_is_delivered_after_its_lag(h):
+    h.put(encode(Cmd(tick=0, vx=1.0)))
+    h.inbound.sync(1)
+    assert h.inbound.take(0) == []
+    assert [c.vx for c in h.inbound.take(1)] == [1.0]
+
+
+def test_garbage_and_wrong_types_are_rejected_and_counted(h):
+    h.put(b"\x00\xff garbage")
+    h.put(encode(Cmd(tick=0)).replace(b"tick", b"tock"))  # required field missing
+    h.put(b"\x81\xa4tick\xa3one")  # {"tick": "one"}
+    h.put(encode(Cmd(tick=0)))
+    h.inbound.sync(1)
+    assert h.rej.by_reason["malformed"] == 3
+    assert len(h.inbound.take(1)) == 1
+
+
+def test_out_of_sequence_frames_are_rejected(h):
+    h.put(encode(Cmd(tick=0)))
+    h.put(encode(Cmd(tick=5)))  # skips ticks 1-4
+    h.put(encode(Cmd(tick=0)))  # replay
+    h.put(encode(Cmd(tick=1)))
+    h.inbound.sync(2)
+    assert h.rej.by_reason["out-of-sequence"] == 2
+    assert h.inbound.last_seen == 1
+
+
+def test_delay_rounds_up_to_the_next_tick():
+    harness = Harness(model=LinkModel(latency_ms=25.0))  # 25 ms -> 2 ticks of 20 ms
+    try:
+        harness.put(encode(Cmd(tick=0)))
+        harness.inbound.sync(1)
+        assert harness.inbound.take(1) == []
+        assert len(harness.inbound.take(2)) == 1
+    finally:
+        harness.close()
+
+
+def test_dropped_frames_are_waited_for_then_discarded():
+    harness = Harness(model=LinkModel(p_gb=1.0, p_bg=0.0, loss_bad=1.0))  # everything lost
+    try:
+        for k in range(3):
+            harness.put(encode(Cmd(tick=k)))
+        harness.inbound.sync(3)
+        assert harness.inbound.take(10) == []
+        assert harness.inbound.emulator.dropped == 3
+    finally:
+        harness.close()
+
+
+def test_a_silent_sender_is_declared_dead_after_the_timeout():
+    harness = Harness(timeout=0.3)
+    try:
+        harness.inbound.sync(1)  # nobody sends tick 0
+        assert "robot/a/1" in harness.dead
+        assert harness.inbound.dead
+    finally:
+        harness.close()
+
+
+def test_a_vanished_sender_is_declared_dead_at_once(h):
+    h.gone.add("robot/a/1")
+    h.rx.wake(KEY)
+    h.inbound.sync(1)
+    assert "liveliness" in h.dead["robot/a/1"]
+
+
+def test_outbound_digest_covers_key_and_payload():
+    d1, d2 = hashlib.blake2b(), hashlib.blake2b()
+    sent = []
+    Outbound(KEY, "robot/a/1/cmd", sent.append, d1).send(Cmd(tick=0))
+    Outbound(KEY, "robot/a/2/cmd", sent.append, d2).send(Cmd(tick=0))
+    assert sent[0] == sent[1] and d1.digest() != d2.digest()
