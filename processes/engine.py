@@ -63,7 +63,7 @@ class EngineNode(Node):
         p = cfg.timing.referee_period
         self.ref_in = self.inp("referee", schedule=Schedule(p, 0), lag=1, sender="referee")
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
-        self.world_out = self.out("world")
+        self.world_out = self.out("world", viewers_only=True)
         self.events_out = self.out("events")
         self.field_out = self.out("field")
         self.events_schedule = Schedule(p, p - 1)

@@ -62,9 +62,12 @@ class Node:
         self._collector = False
 
     # ----------------------------------------------------------------- wiring
-    def out(self, name: str, team: str = "", n: int | None = None) -> Outbound[Any]:
+    def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
+        """An outbound key. `viewers_only`: nobody in the lockstep waits for it, so it
+        is not put on the wire while nobody listens (it still counts in the digest)."""
         key = self.keys.key(name, team, n)
-        ob: Outbound[Any] = Outbound(key, self.keys.rel(key), self.transport.publisher(key), self.digest)
+        put = self.transport.publisher(key, when_matched=viewers_only)
+        ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
         self.outbound.append(ob)
         return ob
 
@@ -168,6 +171,7 @@ class Node:
             # acyclic objects that reference counting frees).
             gc.collect()
             gc.freeze()
+            gc.set_threshold(50_000, 50, 100)
             t0 = time.perf_counter()
             self.loop()
             self._wall_s = time.perf_counter() - t0

@@ -28,7 +28,9 @@ class Channel(Protocol):
 
 
 class Transport(Protocol):
-    def publisher(self, key: str) -> Callable[[bytes], None]: ...
+    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
+        """A put function for `key`. With `when_matched`, puts are skipped while no
+        remote subscriber matches (for keys nobody in the lockstep waits on)."""
     def subscribe(self, key: str) -> Channel: ...
     def wake(self, key: str) -> None:
         """Deliver WAKE to this process's own subscribers of `key` only."""
@@ -68,7 +70,7 @@ class ZenohTransport:
         self.session = session
         self._keep: list[object] = []  # declared entities live as long as the transport
 
-    def publisher(self, key: str) -> Callable[[bytes], None]:
+    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
         pub = self.session.declare_publisher(
             key,
             encoding=zenoh.Encoding("application/msgpack"),
@@ -77,7 +79,20 @@ class ZenohTransport:
             express=False,
         )
         self._keep.append(pub)
-        return pub.put
+        if not when_matched:
+            return pub.put
+        matched = [pub.matching_status]
+
+        def on_change(status: zenoh.MatchingStatus) -> None:
+            matched[0] = status.matching
+
+        self._keep.append(pub.declare_matching_listener(on_change))
+
+        def put(payload: bytes) -> None:
+            if matched[0]:
+                pub.put(payload)
+
+        return put
 
     def subscribe(self, key: str) -> Channel:
         sub = self.session.declare_subscriber(key, zenoh.handlers.FifoChannel(self.FIFO))
@@ -185,7 +200,7 @@ class MemoryTransport:
         self.bus = bus
         self._tokens: list[str] = []
 
-    def publisher(self, key: str) -> Callable[[bytes], None]:
+    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:  # noqa: ARG002
         bus = self.bus
 
         def put(payload: bytes) -> None:
