@@ -28,7 +28,7 @@ from arena.runtime import seeds
 from arena.runtime.config import TEAMS
 from arena.runtime.lockstep import EVERY_TICK, Schedule
 from arena.runtime.node import Node
-from arena.schemas.messages import Cmd, EngineEvents, FieldSpec, Referee
+from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee
 
 
 def check_cmd(cmd: Cmd) -> str | None:
@@ -70,6 +70,14 @@ class EngineNode(Node):
         self.world_schedule = Schedule(cfg.timing.world_period, 0)
         self.pending_events: list = []
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
+
+    def on_peer_dead(self, peer: str) -> None:
+        """Tell the referee (G_Re) that a robot is gone; its wheels are stopped in the loop."""
+        pid = peer.split("/")
+        if pid[0] == "robot" and len(pid) == 3:
+            self.pending_events.append(
+                BallEvent(kind="ROBOT_DEAD", tick=self.physics.tick, team=pid[1], robot=int(pid[2]))
+            )
 
     # -------------------------------------------------------------- per tick
     def apply_referee(self, frames: list[Referee]) -> None:
@@ -136,6 +144,8 @@ class EngineNode(Node):
                 frames = ib.take(k)
                 if frames:
                     ph.set_command(r[0], r[1], frames[-1])
+                elif ib.dead:
+                    ph.set_command(r[0], r[1], Cmd(tick=k))  # a dead robot's wheels stop
             t1 = time.perf_counter()
             self.pending_events.extend(ph.step())
             self._work_s.append(work + time.perf_counter() - t1)

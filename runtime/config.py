@@ -91,7 +91,11 @@ class TimingParams:
     referee_period: int = 5  # [ticks] engine events -> referee -> everyone (10 Hz)
     world_period: int = 1  # [ticks] ground-truth `world` for viewers and the recorder
     startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
-    wait_timeout: float = 5.0  # [s] wall: lockstep wait before a silent peer counts as dead
+    # [s] wall: last-resort bound on one lockstep wait. Dead and hung peers are
+    # caught by liveliness (~2 s, runtime/session.py); this catches a peer that
+    # is alive but silent. Long, because everyone downstream of a stalled peer
+    # waits too and must not be taken for dead.
+    wait_timeout: float = 60.0
 
 
 @dataclass(frozen=True)

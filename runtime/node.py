@@ -118,6 +118,10 @@ class Node:
         if peer not in self.dead:
             self.dead[peer] = why
             self.log.error("treating %s as dead: %s", peer, why)
+            self.on_peer_dead(peer)
+
+    def on_peer_dead(self, peer: str) -> None:
+        """Hook: a peer we were waiting for is dead (its inputs no longer come)."""
 
     def _on_collector(self, key: str, alive: bool) -> None:  # noqa: ARG002
         self._collector = alive

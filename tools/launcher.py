@@ -177,8 +177,9 @@ def supervise(
     refs = transport.subscribe(keys.key("referee")) if progress.enabled else None
     got = Collected(started=time.monotonic())
     deadline = None if timeout is None else got.started + timeout
+    waiting = set(expected)
     with progress:
-        while len(got.summaries) < len(expected):
+        while waiting - set(got.summaries):
             raw = sums.try_recv()
             if raw is not None:
                 try:
@@ -187,6 +188,9 @@ def supervise(
                     continue  # not ours to judge; the rest of the match goes on
                 if s.process not in got.summaries:
                     got.summaries[s.process] = s
+                    # A peer the others treated as dead (hung, unreachable) will
+                    # not report; the match is over without it.
+                    waiting -= set(s.dead)
                 transport.publisher(keys.ack(s.process))(b"ack")
                 continue
             if refs is not None:
@@ -199,6 +203,8 @@ def supervise(
                     except (msgspec.DecodeError, msgspec.ValidationError):
                         pass
             for c in children:
+                if c.name not in waiting:
+                    continue
                 code = c.popen.poll()
                 if code is not None and code != 0 and c.name not in got.summaries:
                     raise MatchError(f"{c.name} (pid {c.popen.pid}) exited with code {code}:\n{c.tail()}")
@@ -210,7 +216,7 @@ def supervise(
                     elif time.monotonic() - c_deadline > 5.0:
                         raise MatchError(f"{c.name} (pid {c.popen.pid}) exited without a summary:\n{c.tail()}")
             if deadline is not None and time.monotonic() > deadline:
-                missing = sorted(set(expected) - set(got.summaries))
+                missing = sorted(waiting - set(got.summaries))
                 raise MatchError(f"match timed out after {timeout:g} s waiting for: {', '.join(missing)}")
             time.sleep(0.02)
     got.ended = time.monotonic()
@@ -355,7 +361,10 @@ def play_match(
                 )
             finally:
                 transport.close()
+        dead = {d for s in got.summaries.values() for d in s.dead}
         for c in children:
+            if c.name in dead:
+                continue  # hung: stop_all below ends it
             try:
                 c.popen.wait(timeout=10)
             except subprocess.TimeoutExpired:

@@ -71,3 +71,15 @@ def wait_for(predicate, timeout: float, what: str, interval: float = 0.05):
             return value
         time.sleep(interval)
     raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+
+
+def wait_until_playing(endpoint: str, match: str, timeout: float = 60.0) -> None:
+    """Block until the match's referee has sent a frame (the start barrier is behind us)."""
+    import zenoh
+
+    from arena.runtime.session import NetConfig, open_session
+
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        referee = session.declare_subscriber(f"arena/{match}/referee", zenoh.handlers.FifoChannel(1000))
+        wait_for(lambda: referee.try_recv(), timeout, "the match to start")
+        referee.undeclare()

@@ -6,7 +6,7 @@ import json
 import os
 import signal
 
-from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for
+from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for, wait_until_playing
 
 MATCH = ("match", "--home", "BS", "--away", "BS", "--seed", "3", "--json")
 
@@ -67,3 +67,20 @@ def test_a_killed_launcher_leaves_no_orphans(reap):
     proc.kill()
     proc.wait()
     wait_for(lambda: not [p for p in kids if alive(p)], 10, "the children to die with their launcher")
+
+
+def test_a_hung_robot_is_declared_dead_after_a_bounded_wait(reap, tmp_path):
+    """SIGSTOP a robot: its liveliness lease (2 s) expires, and the match plays on without it."""
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "20", "--match", "hang", "--listen", endpoint)
+    reap.append(proc)
+    kids = all_ten(proc.pid)
+    wait_until_playing(endpoint, "hang")
+    victim = next(p for p in kids if "--team b --robot 2" in cmdline(p))
+    os.kill(victim, signal.SIGSTOP)
+    out, err = proc.communicate(timeout=240)
+    assert proc.returncode == 0, err
+    result = json.loads(out)
+    assert result["dead"] == ["robot/b/2"]
+    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
+    wait_for(lambda: not alive(victim), 10, "the hung robot to be stopped")
