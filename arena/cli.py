@@ -29,6 +29,11 @@ EXAMPLES = {
     "up": """examples:
   arena up compose.yaml            # the services of compose.yaml as local processes
   arena up compose.yaml --json""",
+    "tournament": """examples:
+  arena tournament                                  # the paper's experiment: 4 strategies x 10 legs = 60 matches
+  arena tournament --strategies AD,BS --legs 4 --half-time 60 --out runs/quick
+  arena tournament --out runs/paper --resume        # continue after Ctrl-C or a crash
+  arena tournament --link congested-wifi --jobs 2 --json""",
     "bench": """examples:
   arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
   arena bench match --runs 5 --half-time 120 --link wifi""",
@@ -109,6 +114,19 @@ def build_parser() -> Parser:
     u.add_argument("file", help="compose.yaml")
     u.add_argument("--json", action="store_true", help="print the match result as JSON")
     u.add_argument("--timeout", type=float, default=600.0, metavar="S", help="give up after S seconds (600)")
+
+    t = add("tournament", "round-robin of strategies: the paper's tables, charts and ratings")
+    t.add_argument("--strategies", default="AD,AS,BD,BS", metavar="A,B,...", help="strategies (AD,AS,BD,BS)")
+    t.add_argument("--legs", type=int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)")
+    t.add_argument("--half-time", type=float, default=300.0, metavar="SECONDS", help="simulated half length (300)")
+    t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
+    t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
+    t.add_argument("--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter")
+    t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
+    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per two cores)")
+    t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
+    t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
+    t.add_argument("--json", action="store_true", help="print one JSON object")
 
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument("what", choices=["match"], help="what to measure")
@@ -234,6 +252,32 @@ def cmd_up(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_tournament(args: argparse.Namespace) -> int:
+    from arena.runtime.links import parse_override, resolve
+    from arena.strategies import registry
+    from arena.tools import tournament
+
+    names = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
+    if len(set(names)) < 2:
+        raise ConfigError("--strategies needs at least two different strategies")
+    if args.legs < 1 or args.jobs < 0 or args.half_time <= 0 or not 1 <= args.robots <= 6:
+        raise ConfigError("--legs >= 1, --jobs >= 0, --half-time > 0 and --robots 1..6, please")
+    overrides: dict[str, dict[str, float]] = {}
+    for text in args.link_param:
+        cls, param, value = parse_override(text)
+        overrides.setdefault(cls, {})[param] = value
+    resolve(args.link, overrides)
+    summary, interrupted = tournament.run(args)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        tournament.print_summary(summary)
+    if interrupted:
+        print("arena tournament: interrupted; finished matches are kept (continue with --resume)", file=sys.stderr)
+        return 130
+    return 0
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from arena.tools import bench
 
@@ -249,7 +293,8 @@ def cmd_schemas(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    handlers = {"match": cmd_match, "run": cmd_run, "up": cmd_up, "bench": cmd_bench, "schemas": cmd_schemas}
+    handlers = {"match": cmd_match, "run": cmd_run, "up": cmd_up, "bench": cmd_bench, "schemas": cmd_schemas,
+                "tournament": cmd_tournament}
     try:
         return handlers[args.command](args)
     except ConfigError as exc:

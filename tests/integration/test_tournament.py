@@ -1,0 +1,38 @@
+"""`arena tournament` end to end: Ctrl-C keeps finished matches, --resume completes the rest."""
+
+from __future__ import annotations
+
+import json
+import signal
+
+from tests.integration.helpers import arena_json, spawn, wait_for
+
+ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "3", "--half-time", "2", "--seed", "5", "--jobs", "1")
+
+
+def test_interrupt_then_resume(tmp_path, reap):
+    out = tmp_path / "t"
+    proc = spawn(*ARGS, "--out", str(out))
+    reap.append(proc)
+    matches = out / "matches"
+    wait_for(lambda: matches.is_dir() and any(matches.glob("*.json")), 120, "the first finished match")
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "--resume" in err and "Traceback" not in err
+    kept = sorted(p.name for p in matches.glob("*.json"))
+    assert 1 <= len(kept) < 3
+    assert not list(matches.glob("*.tmp")), "results are written atomically"
+
+    summary = arena_json(*ARGS, "--out", str(out), "--resume")
+    assert summary["skipped"] == len(kept)
+    assert len(summary["matches"]) == 3 and summary["failed"] == []
+    table = {row["team"]: row for row in summary["table"]}
+    for row in table.values():
+        assert row["W"] + row["D"] + row["L"] == 3
+        assert row["P"] == 3 * row["W"] + row["D"]
+    assert sum(r["GF"] for r in table.values()) == sum(r["GA"] for r in table.values())
+    saved = json.loads((out / "tournament.json").read_text())
+    assert saved["table"] == summary["table"]
+    for name in ("report.md", "table1.csv", "table2.csv", "coverage.csv", "ratings.csv", "goal_difference.png", "coverage.png"):
+        assert (out / name).stat().st_size > 0, name

@@ -1,0 +1,96 @@
+"""Tournament arithmetic on hand-made results: schedule, standings, coverage, ratings."""
+
+from __future__ import annotations
+
+import pytest
+
+from arena.tools.tournament import Result, bradley_terry, coverage, ratings, schedule, standings, table1_rows
+
+AD, AS, BD, BS = "advance-dynamic", "advance-static", "basic-dynamic", "basic-static"
+
+
+def match(home, away, h, a, leg=1, dist=None):
+    first, second = sorted((home, away))
+    return Result(
+        id=f"{home}-{away}-{leg}", first=first, second=second, leg=leg, home=home, away=away, seed=leg,
+        status="ok", score=[h, a], distance_m=dist or {},
+    )
+
+
+def test_schedule_plays_every_pairing_legs_times_alternating_home_and_away():
+    fx = schedule([AD, AS, BD, BS], legs=10, seed=0)
+    assert len(fx) == 60
+    for team in (AD, AS, BD, BS):
+        assert sum(team in (f.home, f.away) for f in fx) == 30
+        assert sum(team == f.home for f in fx) == 15
+    first = [f for f in fx if (f.first, f.second) == (AD, AS)]
+    assert [(f.home, f.away) for f in first[:2]] == [(AD, AS), (AS, AD)]
+    assert len({f.seed for f in fx}) == 60
+    assert schedule([AD, AS], 3, seed=1) == schedule([AD, AS], 3, seed=1)
+    assert schedule([AD, AS], 3, seed=1) != schedule([AD, AS], 3, seed=2)
+
+
+def test_standings_arithmetic_and_ranking():
+    results = [
+        match(AD, BS, 3, 0),  # AD win
+        match(BS, AD, 1, 1, leg=2),  # draw
+        match(AS, BS, 2, 1),  # AS win
+        match(AD, AS, 0, 2),  # AS win
+        match(BS, AS, 0, 0, leg=2),  # draw
+    ]
+    table = {r["team"]: r for r in standings(results, [AD, AS, BS])}
+    assert table[AD] == {"team": AD, "W": 1, "D": 1, "L": 1, "GF": 4, "GA": 3, "GD": 1, "P": 4}
+    assert table[AS] == {"team": AS, "W": 2, "D": 1, "L": 0, "GF": 4, "GA": 1, "GD": 3, "P": 7}
+    assert table[BS] == {"team": BS, "W": 0, "D": 2, "L": 2, "GF": 2, "GA": 6, "GD": -4, "P": 2}
+    assert [r["team"] for r in standings(results, [AD, AS, BS])] == [AS, AD, BS]
+    rows = standings(results, [AD, AS, BS])
+    assert sum(r["GF"] for r in rows) == sum(r["GA"] for r in rows)
+    assert all(r["P"] == 3 * r["W"] + r["D"] for r in rows)
+
+
+def test_ties_on_points_break_by_goal_difference_then_goals_for():
+    results = [match(AD, BS, 1, 0), match(AS, BD, 5, 4), match(AD, AS, 2, 2), match(BS, BD, 0, 0)]
+    order = [r["team"] for r in standings(results, [AD, AS, BD, BS])]
+    # AD and AS both 4 points and GD +1; AS has more goals for.
+    assert order[:2] == [AS, AD]
+
+
+def test_failed_matches_do_not_count():
+    bad = match(AD, BS, 9, 0)
+    bad.status = "failed"
+    assert all(r["W"] + r["D"] + r["L"] == 0 for r in standings([bad], [AD, BS]))
+
+
+def test_coverage_ratio_is_robot1_over_robot2_from_each_teams_side():
+    results = [
+        match(AD, BS, 0, 0, dist={"a/1": 30.0, "a/2": 20.0, "b/1": 10.0, "b/2": 10.0}),
+        match(BS, AD, 0, 0, leg=2, dist={"a/1": 12.0, "a/2": 8.0, "b/1": 10.0, "b/2": 20.0}),
+    ]
+    cover = coverage(results, [AD, BS])
+    assert cover[AD] == {"robot1_m": 20.0, "robot2_m": 20.0, "ratio": 1.0}
+    assert cover[BS] == {"robot1_m": 11.0, "robot2_m": 9.0, "ratio": pytest.approx(1.222, abs=1e-3)}
+
+
+def test_bradley_terry_orders_by_strength_and_is_symmetric():
+    results = [match(AD, BS, 2, 0, leg=i) for i in range(8)] + [match(BS, AD, 1, 1, leg=9)]
+    r = bradley_terry(results, [AD, BS])
+    assert r[AD] > r[BS]
+    assert r[AD] - 1500 == pytest.approx(1500 - r[BS])
+    even = bradley_terry([match(AD, BS, 1, 0), match(BS, AD, 1, 0, leg=2)], [AD, BS])
+    assert even[AD] == pytest.approx(even[BS])
+
+
+def test_too_few_legs_gives_a_plain_note():
+    rows, notes = ratings([match(AD, BS, 1, 0)], [AD, BS], boot=100)
+    assert rows[0]["team"] == AD
+    assert notes and "cannot be told apart" in notes[0]
+    many = [match(AD, BS, 3, 0, leg=i) for i in range(40)]
+    _, notes = ratings(many, [AD, BS], boot=100)
+    assert notes == []
+
+
+def test_table1_lists_each_pairings_score_first_named_team_first():
+    results = [match(AD, BS, 1, 2), match(BS, AD, 4, 0, leg=2)]
+    header, rows = table1_rows(results, [AD, BS], legs=2)
+    assert header == ["leg", "AD vs BS"]
+    assert rows == [["1", "1-2"], ["2", "0-4"]]

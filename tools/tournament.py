@@ -1,0 +1,510 @@
+"""`arena tournament`: round-robins of strategies, with the paper's tables and statistics.
+
+Every pairing of the strategies plays `legs` matches, alternating home and
+away, each with a seed derived from the tournament seed. Every match is a full,
+isolated `arena match` process group; `--jobs` of them run at once. Each
+result is written atomically to `<out>/matches/<id>.json` as soon as it is in,
+so `--resume` skips what is done, Ctrl-C keeps it, and a crashed match (retried
+once) is recorded as failed with its reason instead of corrupting the tables.
+
+Outputs in `--out` (Markdown, CSV, JSON, PNG): the paper's Table 1 (scores per
+pairing and leg), Table 2 (W, D, L, GF, GA, GD, P; 3/1/0 points; ranked by
+points, then goal difference, then goals for), per-robot coverage distance with
+the robot 1 / robot 2 ratio (paper's Fig. 9), a goal-difference chart (Fig. 8),
+and Bradley-Terry ratings with bootstrap confidence intervals.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from dataclasses import asdict, dataclass, field
+from itertools import combinations
+from pathlib import Path
+
+from arena.runtime import seeds
+from arena.strategies import registry
+
+ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
+
+
+def short(name: str) -> str:
+    return ABBREV.get(name, name)
+
+
+# ------------------------------------------------------------------ schedule
+@dataclass(frozen=True)
+class Fixture:
+    index: int  # position in the schedule
+    first: str  # pairing as listed (the column order of Table 1)
+    second: str
+    leg: int  # 1-based
+    home: str
+    away: str
+    seed: int
+
+    @property
+    def id(self) -> str:
+        return f"{self.index:03d}-{short(self.first)}-{short(self.second)}-leg{self.leg:02d}"
+
+
+def schedule(strategies: list[str], legs: int, seed: int) -> list[Fixture]:
+    """Every pairing `legs` times, home and away alternating, seeds from the tournament seed."""
+    out: list[Fixture] = []
+    for first, second in combinations(strategies, 2):
+        for leg in range(1, legs + 1):
+            home, away = (first, second) if leg % 2 == 1 else (second, first)
+            match_seed = seeds.derive(seed, "tournament", first, second, leg) % (2**31)
+            out.append(Fixture(len(out), first, second, leg, home, away, match_seed))
+    return out
+
+
+# ------------------------------------------------------------------- results
+@dataclass
+class Result:
+    id: str
+    first: str
+    second: str
+    leg: int
+    home: str
+    away: str
+    seed: int
+    status: str  # "ok" or "failed"
+    score: list[int] = field(default_factory=lambda: [0, 0])  # [home, away]
+    distance_m: dict[str, float] = field(default_factory=dict)  # "a/1" -> m
+    reason: str = ""
+    attempts: int = 0
+    wall_seconds: float = 0.0
+    rtf: float = 0.0
+    digest: str = ""
+
+    def goals(self, team: str) -> tuple[int, int]:
+        """(for, against) for `team` in this match."""
+        h, a = self.score
+        return (h, a) if team == self.home else (a, h)
+
+    def robot_distance(self, team: str, n: int) -> float | None:
+        side = "a" if team == self.home else "b"
+        return self.distance_m.get(f"{side}/{n}")
+
+
+def write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def load_results(directory: Path) -> dict[str, Result]:
+    out: dict[str, Result] = {}
+    if not directory.is_dir():
+        return out
+    for f in sorted(directory.glob("*.json")):
+        try:
+            r = Result(**json.loads(f.read_text()))
+        except (ValueError, TypeError):
+            continue  # a torn or foreign file: the match is simply played again
+        out[r.id] = r
+    return out
+
+
+# --------------------------------------------------------------------- tables
+def standings(results: list[Result], teams: list[str]) -> list[dict]:
+    """Table 2: W D L GF GA GD P per team, ranked by P, then GD, then GF."""
+    rows = {t: {"team": t, "W": 0, "D": 0, "L": 0, "GF": 0, "GA": 0} for t in teams}
+    for r in results:
+        if r.status != "ok":
+            continue
+        for team in (r.home, r.away):
+            gf, ga = r.goals(team)
+            row = rows[team]
+            row["GF"] += gf
+            row["GA"] += ga
+            row["W" if gf > ga else "D" if gf == ga else "L"] += 1
+    for row in rows.values():
+        row["GD"] = row["GF"] - row["GA"]
+        row["P"] = 3 * row["W"] + row["D"]
+    return sorted(rows.values(), key=lambda r: (-r["P"], -r["GD"], -r["GF"], r["team"]))
+
+
+def coverage(results: list[Result], teams: list[str]) -> dict[str, dict]:
+    """Fig. 9: mean distance of robot 1 and robot 2 per match, and their ratio."""
+    out = {}
+    for t in teams:
+        d1 = [d for r in results if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 1)) is not None]
+        d2 = [d for r in results if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 2)) is not None]
+        m1 = sum(d1) / len(d1) if d1 else 0.0
+        m2 = sum(d2) / len(d2) if d2 else 0.0
+        out[t] = {"robot1_m": round(m1, 2), "robot2_m": round(m2, 2), "ratio": round(m1 / m2, 3) if m2 > 0 else None}
+    return out
+
+
+def bradley_terry(results: list[Result], teams: list[str], iters: int = 200) -> dict[str, float]:
+    """Bradley-Terry strengths by the MM algorithm; a draw counts half a win each way.
+
+    One virtual draw between every pair keeps a team that won everything finite.
+    Returned on an Elo-like scale: 1500 + 400 log10(strength / geometric mean).
+    """
+    wins = {(i, j): 0.5 for i in teams for j in teams if i != j}  # the virtual draw
+    for r in results:
+        if r.status != "ok":
+            continue
+        h, a = r.score
+        if h > a:
+            wins[(r.home, r.away)] += 1
+        elif a > h:
+            wins[(r.away, r.home)] += 1
+        else:
+            wins[(r.home, r.away)] += 0.5
+            wins[(r.away, r.home)] += 0.5
+    p = dict.fromkeys(teams, 1.0)
+    for _ in range(iters):
+        new = {}
+        for i in teams:
+            w_i = sum(wins[(i, j)] for j in teams if j != i)
+            denom = sum((wins[(i, j)] + wins[(j, i)]) / (p[i] + p[j]) for j in teams if j != i)
+            new[i] = w_i / denom if denom > 0 else p[i]
+        g = math.exp(sum(math.log(v) for v in new.values()) / len(new))
+        p = {k: v / g for k, v in new.items()}
+    return {t: 1500.0 + 400.0 * math.log10(p[t]) for t in teams}
+
+
+def ratings(results: list[Result], teams: list[str], boot: int = 400, seed: int = 0) -> tuple[list[dict], list[str]]:
+    """Ratings with 95 % intervals from a parametric bootstrap, and plain-language notes.
+
+    Each bootstrap replays every played fixture with an outcome drawn from the
+    fitted model (P(draw) = the observed draw rate, the rest split by the
+    Bradley-Terry odds) and refits. Unlike resampling the matches, this stays
+    honest for a handful of matches: one 1-0 win does not make a team certain.
+    """
+    ok = [r for r in results if r.status == "ok"]
+    point = bradley_terry(ok, teams)
+    strength = {t: 10 ** ((v - 1500.0) / 400.0) for t, v in point.items()}
+    draw_rate = sum(1 for r in ok if r.score[0] == r.score[1]) / len(ok) if ok else 0.0
+    rng = random.Random(seed)
+    samples: dict[str, list[float]] = {t: [] for t in teams}
+    for _ in range(boot if ok else 0):
+        replay = []
+        for r in ok:
+            u = rng.random()
+            p_home = (1.0 - draw_rate) * strength[r.home] / (strength[r.home] + strength[r.away])
+            score = [1, 0] if u < p_home else [0, 0] if u < p_home + draw_rate else [0, 1]
+            replay.append(Result(**{**asdict(r), "score": score}))
+        for t, v in bradley_terry(replay, teams, iters=60).items():
+            samples[t].append(v)
+    rows = []
+    for t in sorted(teams, key=lambda t: -point[t]):
+        s = sorted(samples[t]) or [point[t]]
+        lo, hi = s[int(0.025 * (len(s) - 1))], s[int(0.975 * (len(s) - 1))]
+        rows.append({"team": t, "rating": round(point[t], 1), "ci95": [round(lo, 1), round(hi, 1)]})
+    notes = []
+    for upper, lower in zip(rows, rows[1:]):
+        if upper["ci95"][0] <= lower["ci95"][1]:
+            n = sum(1 for r in ok if {r.home, r.away} == {upper["team"], lower["team"]})
+            notes.append(
+                f"{short(upper['team'])} and {short(lower['team'])} cannot be told apart: their 95 % intervals "
+                f"overlap ({n} direct matches); more legs are needed to separate them."
+            )
+    return rows, notes
+
+
+# --------------------------------------------------------------------- output
+def table1_rows(results: list[Result], strategies: list[str], legs: int) -> tuple[list[str], list[list[str]]]:
+    pairs = list(combinations(strategies, 2))
+    header = ["leg"] + [f"{short(a)} vs {short(b)}" for a, b in pairs]
+    by_key = {(r.first, r.second, r.leg): r for r in results}
+    rows = []
+    for leg in range(1, legs + 1):
+        row = [str(leg)]
+        for a, b in pairs:
+            r = by_key.get((a, b, leg))
+            if r is None:
+                row.append("")
+            elif r.status != "ok":
+                row.append("failed")
+            else:
+                row.append(f"{r.goals(a)[0]}-{r.goals(b)[0]}")
+        rows.append(row)
+    return header, rows
+
+
+def markdown(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+def csv_text(header: list[str], rows: list[list]) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(header)
+    w.writerows(rows)
+    return buf.getvalue()
+
+
+def charts(out: Path, table: list[dict], cover: dict[str, dict]) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    written = []
+    teams = [r["team"] for r in table]
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    gd = [r["GD"] for r in table]
+    ax.bar([short(t) for t in teams], gd, color=["tab:green" if g >= 0 else "tab:red" for g in gd])
+    ax.axhline(0, color="black", linewidth=0.8)
+    ax.set_ylabel("goal difference")
+    ax.set_title("Goal difference per strategy (paper Fig. 8)")
+    fig.tight_layout()
+    fig.savefig(out / "goal_difference.png", dpi=120)
+    plt.close(fig)
+    written.append(out / "goal_difference.png")
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    xs = range(len(teams))
+    ax.bar([x - 0.2 for x in xs], [cover[t]["robot1_m"] for t in teams], width=0.4, label="robot 1")
+    ax.bar([x + 0.2 for x in xs], [cover[t]["robot2_m"] for t in teams], width=0.4, label="robot 2")
+    for x, t in zip(xs, teams):
+        ratio = cover[t]["ratio"]
+        if ratio is not None:
+            ax.annotate(f"{ratio:.2f}", (x, max(cover[t]["robot1_m"], cover[t]["robot2_m"])), ha="center", va="bottom")
+    ax.set_xticks(list(xs), [short(t) for t in teams])
+    ax.set_ylabel("mean distance per match [m]")
+    ax.margins(y=0.15)
+    ax.set_title("Coverage of robot 1 and robot 2, with ratio (paper Fig. 9)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out / "coverage.png", dpi=120)
+    plt.close(fig)
+    written.append(out / "coverage.png")
+    return written
+
+
+def report(results: list[Result], strategies: list[str], legs: int, out: Path, wall: float, seed: int) -> dict:
+    """Write every table and chart to `out`; return the JSON summary."""
+    done = [r for r in results if r.status == "ok"]
+    table = standings(results, strategies)
+    cover = coverage(results, strategies)
+    rates, notes = ratings(results, strategies, seed=seed)
+    failed = [{"id": r.id, "reason": r.reason} for r in results if r.status != "ok"]
+
+    h1, rows1 = table1_rows(results, strategies, legs)
+    cols2 = ["team", "W", "D", "L", "GF", "GA", "GD", "P"]
+    rows2 = [[short(r["team"])] + [r[c] for c in cols2[1:]] for r in table]
+    cols3 = ["team", "robot1_m", "robot2_m", "ratio"]
+    rows3 = [[short(t)] + [cover[t][c] for c in cols3[1:]] for t in strategies]
+    rows4 = [[short(r["team"]), r["rating"], r["ci95"][0], r["ci95"][1]] for r in rates]
+    cols4 = ["team", "rating", "ci95_low", "ci95_high"]
+    for name, head, rows in (("table1", h1, rows1), ("table2", cols2, rows2), ("coverage", cols3, rows3), ("ratings", cols4, rows4)):
+        write_atomic(out / f"{name}.csv", csv_text(head, rows))
+    md = [
+        f"# Tournament: {', '.join(short(s) for s in strategies)}, {legs} legs, seed {seed}",
+        "",
+        f"{len(done)} of {len(results)} matches played ({len(failed)} failed), {wall:.0f} s of wall time.",
+        "",
+        "## Table 1: scores per pairing and leg (first-named team's goals first)",
+        "",
+        markdown(h1, rows1),
+        "## Table 2: standings (3 points a win, 1 a draw; ranked by P, GD, GF)",
+        "",
+        markdown(cols2, rows2),
+        "## Coverage: mean distance per match of robot 1 and robot 2 (paper Fig. 9)",
+        "",
+        markdown(cols3, rows3),
+        "## Ratings: Bradley-Terry, 95 % bootstrap intervals",
+        "",
+        markdown(cols4, rows4),
+    ]
+    if notes:
+        md += ["Notes:", ""] + [f"- {n}" for n in notes] + [""]
+    if failed:
+        md += ["## Failed matches", ""] + [f"- {f['id']}: {f['reason']}" for f in failed] + [""]
+    if done:
+        charts(out, table, cover)
+        md += ["![goal difference](goal_difference.png)", "", "![coverage](coverage.png)", ""]
+    write_atomic(out / "report.md", "\n".join(md))
+    summary = {
+        "strategies": strategies,
+        "legs": legs,
+        "seed": seed,
+        "table": table,
+        "coverage_ratio": {t: cover[t]["ratio"] for t in strategies},
+        "coverage": cover,
+        "ratings": rates,
+        "notes": notes,
+        "matches": [asdict(r) for r in results],
+        "failed": failed,
+        "wall_seconds": round(wall, 2),
+        "out": str(out),
+    }
+    write_atomic(out / "tournament.json", json.dumps(summary, indent=2))
+    return summary
+
+
+# ----------------------------------------------------------------------- run
+class Runner:
+    """Plays fixtures as `arena match` subprocesses; stoppable from the main thread."""
+
+    def __init__(self, args, out: Path):
+        self.args = args
+        self.matches_dir = out / "matches"
+        self.matches_dir.mkdir(parents=True, exist_ok=True)
+        self.logs_dir = out / "logs"
+        self.logs_dir.mkdir(exist_ok=True)
+        self._lock = threading.Lock()
+        self._running: set[subprocess.Popen] = set()
+        self.stopping = False
+
+    def command(self, fx: Fixture) -> list[str]:
+        a = self.args
+        argv = [
+            sys.executable, "-m", "arena", "match", "--home", fx.home, "--away", fx.away,
+            "--robots", str(a.robots), "--half-time", str(a.half_time), "--seed", str(fx.seed),
+            "--link", a.link, "--json",
+        ]
+        for p in a.link_param:
+            argv += ["--link-param", p]
+        return argv
+
+    def play(self, fx: Fixture) -> Result | None:
+        """Play one fixture (one retry on failure). None if stopped by Ctrl-C."""
+        base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
+        reason = ""
+        timeout = 120.0 + 2.0 * self.args.half_time  # generous: rtf >= 1 plus start-up
+        for attempt in (1, 2):
+            if self.stopping:
+                return None
+            t0 = time.monotonic()
+            log = open(self.logs_dir / f"{fx.id}.log", "w")  # noqa: SIM115 - handed to the child
+            proc = subprocess.Popen(self.command(fx), stdout=subprocess.PIPE, stderr=log, text=True, start_new_session=True)
+            with self._lock:
+                self._running.add(proc)
+            try:
+                out, _ = proc.communicate(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                proc.send_signal(signal.SIGINT)
+                out, _ = proc.communicate()
+                reason = f"timed out after {timeout:g} s"
+            finally:
+                with self._lock:
+                    self._running.discard(proc)
+                log.close()
+            if self.stopping:
+                return None
+            if proc.returncode == 0:
+                try:
+                    m = json.loads(out)
+                except json.JSONDecodeError:
+                    reason = "the match printed no JSON"
+                    continue
+                r = Result(
+                    id=fx.id, status="ok", score=m["score"], distance_m=m["distance_m"], attempts=attempt,
+                    wall_seconds=round(time.monotonic() - t0, 2), rtf=m["rtf"], digest=m["digest"], **base,
+                )
+                write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+                return r
+            tail = (self.logs_dir / f"{fx.id}.log").read_text(errors="replace").strip().splitlines()
+            reason = reason or (tail[-1] if tail else f"exit code {proc.returncode}")
+        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, **base)
+        write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+        return r
+
+    def stop(self) -> None:
+        self.stopping = True
+        with self._lock:
+            running = list(self._running)
+        for p in running:
+            if p.poll() is None:
+                p.send_signal(signal.SIGINT)  # arena match stops its whole process group
+
+
+def default_jobs() -> int:
+    """A match keeps about two cores busy: one match per two cores."""
+    return max(1, (os.cpu_count() or 2) // 2)
+
+
+def run(args) -> tuple[dict, bool]:
+    """Play (or resume) the tournament. Returns (summary, interrupted)."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    strategies = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fixtures = schedule(strategies, args.legs, args.seed)
+    runner = Runner(args, out)
+    have = load_results(runner.matches_dir) if args.resume else {}
+    # Resume keeps finished matches; failed ones get another chance.
+    todo = [fx for fx in fixtures if not (fx.id in have and have[fx.id].status == "ok")]
+    results: dict[str, Result] = {fx.id: have[fx.id] for fx in fixtures if fx.id in have and have[fx.id].status == "ok"}
+    t0 = time.monotonic()
+    interrupted = False
+    console = Console(stderr=True)
+    show = not args.json and sys.stderr.isatty()
+    with Progress(
+        TextColumn("[bold]tournament[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+        TextColumn("{task.fields[last]}"), console=console, disable=not show, transient=False,
+    ) as bar:
+        task = bar.add_task("t", total=len(fixtures), completed=len(results), last="")
+        with ThreadPoolExecutor(max_workers=args.jobs or default_jobs()) as pool:
+            futures: dict[Future, Fixture] = {pool.submit(runner.play, fx): fx for fx in todo}
+            pending = set(futures)
+            try:
+                while pending:
+                    done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                    for f in done:
+                        r = f.result()
+                        if r is None:
+                            continue
+                        results[r.id] = r
+                        last = (
+                            f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}" if r.status == "ok" else f"{r.id} failed"
+                        )
+                        bar.update(task, advance=1, last=last)
+                        if not show and not args.json:
+                            console.print(f"[{len(results)}/{len(fixtures)}] {last}")
+            except KeyboardInterrupt:
+                interrupted = True
+                runner.stop()
+                for f in pending:
+                    f.cancel()
+    ordered = [results[fx.id] for fx in fixtures if fx.id in results]
+    summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed)
+    summary["skipped"] = len(fixtures) - len(todo)
+    summary["interrupted"] = interrupted
+    return summary, interrupted
+
+
+def print_summary(summary: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    c = Console()
+    t = Table(title="standings (3/1/0; by P, GD, GF)")
+    for col in ("team", "W", "D", "L", "GF", "GA", "GD", "P", "rating (95 % CI)", "robot1/robot2"):
+        t.add_column(col, justify="right")
+    rate = {r["team"]: r for r in summary["ratings"]}
+    for row in summary["table"]:
+        team = row["team"]
+        rr = rate[team]
+        ratio = summary["coverage_ratio"][team]
+        t.add_row(
+            short(team), *(str(row[k]) for k in ("W", "D", "L", "GF", "GA", "GD", "P")),
+            f"{rr['rating']:.0f} ({rr['ci95'][0]:.0f}..{rr['ci95'][1]:.0f})", "-" if ratio is None else f"{ratio:.2f}",
+        )
+    c.print(t)
+    for note in summary["notes"]:
+        c.print(f"[yellow]note:[/] {note}")
+    for f in summary["failed"]:
+        c.print(f"[red]failed:[/] {f['id']}: {f['reason']}")
+    c.print(f"tables, charts and per-match results in {summary['out']} ({summary['wall_seconds']:.0f} s)")
