@@ -23,12 +23,14 @@ What it models (SI units throughout: m, s, kg, rad):
   max_force = mass * max_accel makes the velocity follow the command with
   linear acceleration at most max_accel (field-frame vector norm), a
   GearJoint with max_force = moment * max_alpha does the same for the turn
-  rate. The command (`Cmd`, mode "body": body-frame vx, vy and omega) is capped
-  at max_speed (vector norm) and max_omega and turned into the field frame
-  once per tick with the heading at mid-tick. Mode "wheels" is applied as a
-  zero command: wheel kinematics arrive with the kinematics module. Robots
-  collide with each other, the ball, the goals and the fence; a robot pushed
-  by another resists with its own drive force.
+  rate. The command (`Cmd`) goes through the robot model's wheels
+  (`drive.py`: IRIS omni4, paper 2 eq. 3-4, or Robotino omni3, paper 1
+  eq. 1-2): a body twist (mode "body") or wheel speeds (mode "wheels",
+  forward kinematics) become a body twist within the wheel-speed saturation,
+  max_speed and max_omega, turned into the field frame once per tick with
+  the heading at mid-tick. Robots collide with each other, the ball, the
+  goals and the fence; a robot pushed by another resists with its own drive
+  force.
 * **Dribbler.** A robot whose dribbler is on captures the ball when it lies in
   front of its front face (within `DRIBBLE_REACH` of it, centred within
   `DRIBBLE_HALF_WIDTH`, low): the ball is pinned just in front of the face by
@@ -40,22 +42,40 @@ What it models (SI units throughout: m, s, kg, rad):
 * **Kicker.** A kick fires once per `set_command` whose kick_speed > 0, as soon
   as the robot holds the ball or has it within reach in front: the ball leaves
   along the robot's heading at min(kick_speed, kick_max_speed). A lob splits
-  that speed at `LOB_ANGLE` into horizontal speed and vertical launch speed.
+  that speed at `lob_angle` into horizontal and vertical launch speed.
   For `NO_CATCH_S` after its kick the kicker's dribbler cannot recapture the
   ball, so a soft pass with the dribbler still on leaves.
+* **Play and stoppages.** The engine switches play off (`stop_play`) when
+  the referee stops the game and on again at START (`start_play`). While
+  play is off the ball is usually pinned to its restart spot (`pin_ball`:
+  the referee puts it back if a robot moves it; nobody can capture or kick
+  it), nothing counts as a touch, no event is reported and the no-progress
+  clock stands still. A new Physics is in play, unpinned.
 * **Events.** `step()` advances one control tick and returns the ball events
   of that tick, stamped with the new tick:
-  TOUCH when the last toucher (contact, capture or kick) changes;
+  TOUCH when the last toucher (contact, capture or kick) changes, and for
+  the first touch after `start_play` (the set piece is taken);
   GOAL when the ball is wholly past a goal line between the posts and crossed
   the line below the crossbar (team: the side attacking that goal, from
   `attack_dir_a`), after which the ball rests in the net until placed;
   GOAL_LINE and TOUCH_LINE when it is wholly over a goal line (elsewhere, or
   over the crossbar) or a touch line: once per crossing, re-armed when the
-  ball's centre is back inside the lines or the ball is placed;
-  NO_PROGRESS once the ball, in play, has been slower than `IDLE_SPEED` for
-  `no_progress_s`, re-armed when it moves again or is placed. Every event
-  carries the ball position and the last toucher. Placing the ball keeps the
-  last toucher.
+  ball's centre is back inside the lines or the ball is placed; GOAL_LINE's
+  team is the team defending that goal line, so that the referee can tell a
+  goal kick from a corner by the last toucher;
+  NO_PROGRESS once the ball, in play, has stayed within
+  `RulesParams.progress_radius` of one point for `no_progress_s` (default
+  `RulesParams.no_progress_s`): idle, or stuck between robots; re-armed when
+  it gets out of that circle (which then moves to it) or is placed. Every event carries the ball position and the
+  last toucher. Placing the ball keeps the last toucher.
+* **Fouls** (reported as events with the offender's team and robot):
+  FOUL_PUSHING when two robots of different teams start touching with a
+  closing speed above `RulesParams.push_speed` (the normal component of the
+  relative velocity at impact); the offender is the one that drove more
+  into the other (the larger velocity component towards it), x/y the
+  contact point. FOUL_DRIBBLING once per possession when the holder's centre
+  gets farther than `RulesParams.dribble_limit` (MSL 3 m, straight line)
+  from where it was when its dribbler took the ball; x/y the ball.
 
 Nothing here is random or reads a clock: equal inputs give equal outputs.
 """
@@ -68,6 +88,7 @@ from dataclasses import dataclass
 import pymunk
 from pymunk import batch as pmbatch
 
+from arena.processes.drive import Drive
 from arena.runtime.config import TEAMS, FieldParams, MatchConfig
 from arena.schemas.messages import BallEvent, Cmd, RobotState, World
 
@@ -87,11 +108,9 @@ DRIBBLE_HALF_WIDTH = 0.15  # [m] lateral offset of the ball centre still "in fro
 CATCH_MAX_Z = 0.11  # [m] a ball higher than this cannot be captured or kicked
 HOLD_GAP = 0.005  # [m] held ball's surface to the front face
 CHALLENGE_DIST = 0.20  # [m] challenger's footprint edge to the ball's surface
-LOB_ANGLE = math.radians(45.0)  # [rad] launch elevation of a lob
 BOUNCE_STOP = 0.5  # [m/s] vertical speed below which a landing ball stops bouncing
 NO_CATCH_S = 0.25  # [s] after its own kick or a lost challenge a dribbler cannot capture
-IDLE_SPEED = 0.05  # [m/s] ball speed below which the ball counts as idle
-NO_PROGRESS_S = 10.0  # [s] default idle time before NO_PROGRESS
+PIN_TOLERANCE = 1e-3  # [m] a pinned ball moved farther than this is put back
 
 _CAT_FENCE = 0b0001
 _CAT_GOAL = 0b0010
@@ -124,11 +143,13 @@ class _Robot:
     hold: pymunk.PivotJoint  # ball to front face, in the space while holding
     off: int = 0  # offset of this body in the batch snapshot
     cmd: Cmd | None = None
+    twist: tuple[float, float, float] = (0.0, 0.0, 0.0)  # body frame, what `cmd` gives within the limits
     kick_armed: bool = False
     dribbler: bool = False
     dist: float = 0.0  # [m] travelled
     catch_from: int = 0  # first tick at which the dribbler may capture the ball again
     ctrl_set: tuple[float, float, float] = (0.0, 0.0, 0.0)  # last control velocity written
+    carry_from: tuple[float, float] = (0.0, 0.0)  # [m] its centre when its dribbler took the ball
 
 
 class Physics:
@@ -136,13 +157,15 @@ class Physics:
 
     Attributes set by the engine: `attack_dir_a` (+1: team a attacks the +x
     goal, -1: the -x goal) and `no_progress_s` [s]. `tick` counts completed
-    steps; `step()` moves the world from `tick` to `tick + 1`.
+    steps; `step()` moves the world from `tick` to `tick + 1`. `in_play` is
+    switched by `stop_play` and `start_play`.
     """
 
-    def __init__(self, cfg: MatchConfig, no_progress_s: float = NO_PROGRESS_S) -> None:
+    def __init__(self, cfg: MatchConfig, no_progress_s: float | None = None) -> None:
         self.cfg = cfg
         self.attack_dir_a = 1
-        self.no_progress_s = no_progress_s
+        self.no_progress_s = cfg.rules.no_progress_s if no_progress_s is None else no_progress_s
+        self.in_play = True
         self.tick = 0
         f, rp, bp = cfg.field, cfg.robot, cfg.ball
         self._dt = cfg.timing.dt
@@ -159,6 +182,10 @@ class Physics:
         self._hold_dist = self._face + HOLD_GAP
         self._challenge = rp.size / 2 + bp.radius + CHALLENGE_DIST  # [m] centre to centre
         self._no_catch_ticks = math.ceil(NO_CATCH_S / self._dt)
+        self._drive = Drive(rp)
+        self._push_speed = cfg.rules.push_speed  # [m/s]
+        self._dribble_limit = cfg.rules.dribble_limit  # [m]
+        self._progress_radius = cfg.rules.progress_radius  # [m]
 
         space = pymunk.Space()
         space.iterations = SOLVER_ITERATIONS
@@ -208,6 +235,9 @@ class Physics:
             turn.max_force = moment * rp.max_alpha
             space.add(drive, turn)
             space.on_collision(_BALL_TYPE, _ROBOT_TYPE0 + i, begin=self._on_contact, data=i)
+            for j in range(i + 1, len(self._robots)):
+                if self._robots[j].team != r.team:
+                    space.on_collision(_ROBOT_TYPE0 + i, _ROBOT_TYPE0 + j, begin=self._on_impact, data=(i, j))
         self._by_id = {(r.team, r.n): r for r in self._robots}
 
         self._buf = pmbatch.Buffer()
@@ -230,8 +260,13 @@ class Physics:
         self._prev_ax = 0.0  # [m] |x| of the ball at the previous airborne substep
         self._idle_ticks = 0
         self._idle_fired = False
+        self._anchor: tuple[float, float] | None = None  # [m] centre of the no-progress circle
         self._last: _Robot | None = None
+        self._touch_armed = False  # the next touch is reported even by the last toucher
+        self._carry_fouled = False  # FOUL_DRIBBLING reported for the current possession
+        self._pin: tuple[float, float] | None = None
         self._contacts: list[int] = []
+        self._impacts: list[tuple[int, float, float]] = []  # offender, contact x, y [m]
         self._events: list[BallEvent] = []
         self._refresh()
 
@@ -268,6 +303,7 @@ class Physics:
         """
         r = self._by_id[(team, n)]
         r.cmd = cmd
+        r.twist = self._drive.twist(cmd)
         r.kick_armed = cmd.kick_speed > 0.0
         r.dribbler = cmd.dribbler
 
@@ -295,6 +331,8 @@ class Physics:
                 self._fly(s)
             if self._contacts:
                 self._handle_contacts(s)
+            if self._impacts:
+                self._handle_impacts()
         self._snap = s
         if self._dirty:
             self._refresh()
@@ -302,17 +340,11 @@ class Physics:
         return events
 
     def _apply_commands(self, s: list[float]) -> None:
-        rp = self.cfg.robot
         half_dt = self._dt / 2
         for r in self._robots:
-            cmd = r.cmd
             o = r.off
-            if cmd is not None and cmd.mode == "body":
-                vx, vy = cmd.vx, cmd.vy
-                speed = math.hypot(vx, vy)
-                if speed > rp.max_speed:
-                    vx, vy = vx * rp.max_speed / speed, vy * rp.max_speed / speed
-                w = min(max(cmd.omega, -rp.max_omega), rp.max_omega)
+            if r.cmd is not None:
+                vx, vy, w = r.twist
                 theta = s[o + 2] + half_dt * s[o + 5]
                 c, sn = math.cos(theta), math.sin(theta)
                 target = (c * vx - sn * vy, sn * vx + c * vy, w)
@@ -325,7 +357,8 @@ class Physics:
             if self._holder is r and not r.dribbler:
                 self._release()
             holder = self._holder
-            if r.kick_armed and not self._dead and (holder is r or (holder is None and self._in_reach(r, s))):
+            free = not self._dead and self._pin is None
+            if r.kick_armed and free and (holder is r or (holder is None and self._in_reach(r, s))):
                 self._kick(r, s)
             elif self._can_capture(r) and self._in_reach(r, s):
                 self._capture(r, s)
@@ -368,6 +401,25 @@ class Physics:
         arbiter.restitution = self._ball_e
         self._contacts.append(i)
 
+    def _on_impact(self, arbiter: pymunk.Arbiter, space: pymunk.Space, pair: tuple[int, int]) -> None:
+        """Robots of different teams start touching: pushing if they close fast enough."""
+        a, b = arbiter.shapes
+        i, j = pair if a.collision_type == _ROBOT_TYPE0 + pair[0] else pair[::-1]
+        nx, ny = arbiter.normal  # from shape a to shape b
+        va, vb = a.body.velocity, b.body.velocity
+        into_b = va.x * nx + va.y * ny  # [m/s] a's speed towards b
+        into_a = -(vb.x * nx + vb.y * ny)
+        if into_b + into_a > self._push_speed:
+            points = arbiter.contact_point_set.points
+            px, py = points[0].point_a if points else a.body.position
+            self._impacts.append((i if into_b >= into_a else j, px, py))
+
+    def _handle_impacts(self) -> None:
+        for offender, x, y in self._impacts:
+            r = self._robots[offender]
+            self._event("FOUL_PUSHING", r.team, x, y, robot=r.n)
+        self._impacts.clear()
+
     def _handle_contacts(self, s: list[float]) -> None:
         for i in self._contacts:
             r = self._robots[i]
@@ -381,13 +433,27 @@ class Physics:
 
     def _after_tick(self) -> None:
         s = self._snap
+        pin = self._pin
+        if pin is not None:
+            b = self._ball_off
+            if self._holder is not None or math.hypot(s[b] - pin[0], s[b + 1] - pin[1]) > PIN_TOLERANCE:
+                self.place_ball(*pin)
+                s = self._fresh()
         holder = self._holder
         if holder is not None:
             if abs(s[holder.off + 5]) > self.cfg.robot.dribble_max_omega:
                 self._release()
             elif self._challenged(holder, s):
                 self._lose(holder)
+            elif not self._carry_fouled and self._carried_too_far(holder, s):
+                self._carry_fouled = True
+                b = self._ball_off
+                self._event("FOUL_DRIBBLING", holder.team, s[b], s[b + 1], robot=holder.n)
         self._line_events(s)
+
+    def _carried_too_far(self, holder: _Robot, s: list[float]) -> bool:
+        x0, y0 = holder.carry_from
+        return math.hypot(s[holder.off] - x0, s[holder.off + 1] - y0) > self._dribble_limit
 
     def _challenged(self, holder: _Robot, s: list[float]) -> bool:
         """Another robot touches the held ball, or wants it (dribbler on) and is close."""
@@ -406,7 +472,9 @@ class Physics:
 
     # -------------------------------------------------------- ball handling
     def _can_capture(self, r: _Robot) -> bool:
-        return r.dribbler and self._holder is None and not self._dead and self.tick >= r.catch_from
+        return (
+            r.dribbler and self._holder is None and not self._dead and self._pin is None and self.tick >= r.catch_from
+        )
 
     def _in_reach(self, r: _Robot, s: list[float]) -> bool:
         if self._z > CATCH_MAX_Z:
@@ -431,6 +499,8 @@ class Physics:
         self._roll.max_force = 0.0
         self._space.add(r.hold)
         self._holder = r
+        r.carry_from = (s[o], s[o + 1])
+        self._carry_fouled = False
         self._dirty = True
         self._touch(r, s)
 
@@ -452,8 +522,8 @@ class Physics:
         speed = min(cmd.kick_speed, self.cfg.robot.kick_max_speed)
         theta = s[r.off + 2]
         if cmd.kick_lob:
-            flat = speed * math.cos(LOB_ANGLE)
-            self._vz = speed * math.sin(LOB_ANGLE)
+            flat = speed * math.cos(self.cfg.robot.lob_angle)
+            self._vz = speed * math.sin(self.cfg.robot.lob_angle)
             self._z = 0.0
             self._airborne = True
             self._prev_ax = abs(s[self._ball_off])
@@ -465,9 +535,10 @@ class Physics:
         self._touch(r, s)
 
     def _touch(self, r: _Robot, s: list[float]) -> None:
-        if self._last is r:
+        if not self.in_play or (self._last is r and not self._touch_armed):
             return
         self._last = r
+        self._touch_armed = False
         b = self._ball_off
         self._events.append(
             BallEvent(
@@ -476,11 +547,13 @@ class Physics:
             )
         )
 
-    def _event(self, kind: str, team: str, x: float, y: float) -> None:
+    def _event(self, kind: str, team: str, x: float, y: float, robot: int = -1) -> None:
+        if not self.in_play:
+            return
         last = self._last
         self._events.append(
             BallEvent(
-                kind=kind, tick=self.tick, team=team, x=x, y=y,
+                kind=kind, tick=self.tick, team=team, robot=robot, x=x, y=y,
                 last_team=last.team if last else "", last_robot=last.n if last else -1,
             )
         )
@@ -498,19 +571,26 @@ class Physics:
                 self._out = False
         elif ax > self._half_len + self._ball_r:
             self._out = True
+            attacker = "a" if (1 if x > 0 else -1) == self.attack_dir_a else "b"  # of the goal on this side
             if ay < self._half_goal and not self._cross_high:
-                scorer = "a" if (1 if x > 0 else -1) == self.attack_dir_a else "b"
-                self._event("GOAL", scorer, x, y)
+                self._event("GOAL", attacker, x, y)
                 self._stop_in_goal()
                 return
-            self._event("GOAL_LINE", "", x, y)
+            self._event("GOAL_LINE", "b" if attacker == "a" else "a", x, y)  # team: the defender
         elif ay > self._half_wid + self._ball_r:
             self._out = True
             self._event("TOUCH_LINE", "", x, y)
-        if self._out or self._airborne or math.hypot(s[b + 3], s[b + 4]) >= IDLE_SPEED:
+        anchor = self._anchor
+        if self._out or self._airborne or not self.in_play:
+            self._anchor = None
             self._idle_ticks = 0
             if not self._out:
                 self._idle_fired = False
+            return
+        if anchor is None or math.hypot(x - anchor[0], y - anchor[1]) > self._progress_radius:
+            self._anchor = (x, y)
+            self._idle_ticks = 0
+            self._idle_fired = False
             return
         self._idle_ticks += 1
         if not self._idle_fired and self._idle_ticks * self._dt >= self.no_progress_s - 1e-9:
@@ -552,7 +632,26 @@ class Physics:
         self._cross_high = False
         self._idle_ticks = 0
         self._idle_fired = False
+        self._anchor = (x, y)
         self._dirty = True
+
+    def pin_ball(self, x: float, y: float) -> None:
+        """Place the ball at rest on (x, y) [m] and keep it there until `start_play`."""
+        self.place_ball(x, y)
+        self._pin = (x, y)
+
+    def stop_play(self) -> None:
+        """The referee stopped the game: no touches, events or no-progress clock until `start_play`."""
+        self.in_play = False
+
+    def start_play(self) -> None:
+        """START: the ball is free, and the next touch is reported whoever makes it."""
+        self.in_play = True
+        self._pin = None
+        self._touch_armed = True
+        self._idle_ticks = 0
+        self._idle_fired = False
+        self._anchor = None
 
     def place_robot(self, team: str, n: int, x: float, y: float, theta: float) -> None:
         """Put robot n at rest on (x, y) [m] facing theta [rad]; it drops a held ball."""

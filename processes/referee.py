@@ -1,4 +1,4 @@
-"""Referee process: runs the RefereeBox on the engine's ball events (G_Re).
+"""Referee process: runs the RefereeBox (referee_box.py) on the engine's ball events (G_Re).
 
 Inputs: `engine/events` every referee period (lag 1). Output: `referee` every
 referee period, a snapshot of the box's state plus the commands issued since
@@ -12,7 +12,6 @@ import time
 from arena.processes.referee_box import RefereeBox
 from arena.runtime.lockstep import Schedule
 from arena.runtime.node import Node
-from arena.schemas.messages import Referee
 
 
 class RefereeNode(Node):
@@ -27,22 +26,7 @@ class RefereeNode(Node):
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         events = [ev for frame in self.events_in.take(k) for ev in frame.events]
-        cmds = self.box.step(k, events)
-        st = self.box.state
-        self.ref_out.send(
-            Referee(
-                tick=k,
-                stage=st.stage,
-                command=st.command,
-                command_team=st.command_team,
-                spot_x=st.spot[0],
-                spot_y=st.spot[1],
-                score_a=st.score["a"],
-                score_b=st.score["b"],
-                attack_dir_a=st.attack_dir_a,
-                commands=cmds,
-            )
-        )
+        self.ref_out.send(self.box.frame(k, self.box.step(k, events)))
         self.last_tick = k
         self.timed(t0)
 
@@ -64,12 +48,4 @@ class RefereeNode(Node):
                 self.act(k)
 
     def summary_extra(self) -> dict[str, object]:
-        st = self.box.state
-        return {
-            "score": [st.score["a"], st.score["b"]],
-            "events": dict(self.box.counts),
-            "log": [
-                {"tick": e.tick, "command": e.command.name, "team": e.command.team, "cause": e.cause}
-                for e in self.box.log
-            ],
-        }
+        return self.box.summary()

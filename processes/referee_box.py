@@ -1,125 +1,378 @@
-"""The referee box as a pure state machine with an append-only event log.
+"""The referee box: a pure state machine over typed changes, with an append-only log.
 
-``RefereeBox.step(tick, events) -> commands``: time is the tick it is handed,
-inputs are the engine's typed ball events (G_Re). It owns the stage, the score
-and the sides, and issues MSL RefBox commands with their target team.
+Modelled on ssl-game-controller: ``process(state, change, rules) ->
+(new_state, commands)`` never mutates its input; a change is either the clock
+(`Clock(tick)`) or a ball-status event of the engine (`Observed(tick,
+BallEvent)`, G_Re). `RefereeBox` holds the current state, feeds it the
+changes of one referee period (the events first, then the clock) and appends
+every change that did something to `log` with the state before and after it.
+Commands are MSL RefBox commands (`MSL_COMMANDS`), each with its target team
+and ball spot. The rules, one small function each, and their parameters are
+tabled in docs/rules.md:
 
-The match flow implemented here:
+* clock rules (`CLOCK_RULES`, the first that applies fires): END_GAME on the
+  last tick; FIRST_HALF and KICKOFF for team a out of PRE_GAME; at half time
+  HALF_TIME, the teams change ends (`attack_dir_a` flips), SECOND_HALF and
+  KICKOFF for team b; START when the positioning time is over; and STOP plus
+  DROP_BALL when a set piece was not taken within `take_time` of its START.
+* event rules (`EVENT_RULES`, by event kind; only while the ball is in play,
+  i.e. the command in force is START and the event happened after it):
+  GOAL -> GOAL (scorer), KICKOFF for the conceding team; TOUCH_LINE ->
+  THROWIN for the other team than the last toucher's; GOAL_LINE -> CORNER
+  if the defending team touched it last, else GOALKICK; NO_PROGRESS ->
+  DROP_BALL; FOUL_PUSHING and FOUL_DRIBBLING -> FREEKICK for the other team
+  than the offender's. A TOUCH after START marks the set piece as taken.
 
-* tick 0: FIRST_HALF, KICKOFF for team a, START after `kickoff_wait`;
-* GOAL event while the ball is in play: GOAL (scoring team), STOP, KICKOFF for
-  the conceding team, START after `kickoff_wait`;
-* ball over a touch line or goal line, or no progress for the engine's idle
-  time: STOP, DROP_BALL at the nearest spot 1 m inside the lines, START after
-  `restart_wait` (throw-ins, goal kicks and corners come with the rules work);
-* half time: HALF_TIME, the teams change ends, SECOND_HALF, KICKOFF for team b,
-  START after `kickoff_wait`;
-* the last tick: END_GAME.
-
-Every command is appended to `log` together with the stage and score before
-and after it, like ssl-game-controller's event log.
+Every restart is the MSL set-piece procedure: STOP, then the command with
+its team and ball spot (`setpieces.py`), then after the positioning time
+START for the same team. Time is the tick it is handed; nothing here reads a
+clock or draws a random number.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections import Counter
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
-from arena.runtime.config import MatchConfig
-from arena.schemas.messages import BallEvent, RefCommand
+from arena.processes import setpieces as sp
+from arena.runtime.config import TEAMS, MatchConfig
+from arena.schemas.messages import BallEvent, RefCommand, Referee
+
+MSL_COMMANDS = frozenset(
+    {
+        "START", "STOP", "KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL",
+        "GOAL", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME", "PARK",
+    }
+)
+TEAM_COMMANDS = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "GOAL"})  # need a team
+STAGES = ("PRE_GAME", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME")
+PLAYING_STAGES = frozenset({"FIRST_HALF", "SECOND_HALF"})
+_STAGE_COMMANDS = frozenset({"FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"})
+_KEEP_IN_FORCE = frozenset({"GOAL", "FIRST_HALF", "SECOND_HALF"})  # announced; the command in force stays
 
 
-@dataclass
-class LogEntry:
-    tick: int
-    command: RefCommand
-    stage_before: str
-    stage_after: str
-    score: tuple[int, int]
-    cause: str
+def check_referee(frame: Referee) -> str | None:
+    """Reject referee frames no referee box could have sent (Inbound `check=`).
+
+    Stages and command names must be the MSL RefBox's, a team "a", "b" or ""
+    (both), and a command that needs a target team must have one.
+    """
+    if frame.stage not in STAGES:
+        return f"unknown stage {frame.stage!r}"
+    if frame.command not in MSL_COMMANDS:
+        return f"unknown command {frame.command!r}"
+    if frame.command_team not in ("a", "b", ""):
+        return f"unknown team {frame.command_team!r}"
+    if frame.attack_dir_a not in (1, -1):
+        return f"attack_dir_a {frame.attack_dir_a} (expected 1 or -1)"
+    if not (math.isfinite(frame.spot_x) and math.isfinite(frame.spot_y)):
+        return "spot is not finite"
+    for c in frame.commands:
+        if c.name not in MSL_COMMANDS:
+            return f"unknown command {c.name!r}"
+        if c.team not in ("a", "b", ""):
+            return f"{c.name} for unknown team {c.team!r}"
+        if c.name in TEAM_COMMANDS and not c.team:
+            return f"{c.name} without a target team"
+        if not (math.isfinite(c.x) and math.isfinite(c.y)):
+            return f"{c.name} spot is not finite"
+    return None
 
 
-@dataclass
+# --------------------------------------------------------------------- state
+@dataclass(frozen=True)
 class RefereeState:
     stage: str = "PRE_GAME"
-    command: str = "STOP"
+    command: str = "STOP"  # the command in force
     command_team: str = ""
-    spot: tuple[float, float] = (0.0, 0.0)
-    score: dict[str, int] = field(default_factory=lambda: {"a": 0, "b": 0})
+    spot: tuple[float, float] = (0.0, 0.0)  # [m] ball spot of the command in force
+    score: tuple[int, int] = (0, 0)  # goals of team a, team b
     attack_dir_a: int = 1  # +1: team a attacks the +x goal
+    issued_at: int = 0  # tick the command in force was issued; older events are stale
     start_at: int = -1  # tick at which START is due, -1 for none
+    take_by: int = -1  # tick by which the set piece must be taken, -1 for none
+
+    @property
+    def in_play(self) -> bool:
+        return self.command == "START" and self.stage in PLAYING_STAGES
+
+
+@dataclass(frozen=True)
+class Clock:
+    """Time has come to `tick`."""
+
+    tick: int
+
+
+@dataclass(frozen=True)
+class Observed:
+    """The engine reported `event`; the referee handles it at its tick `tick`."""
+
+    tick: int
+    event: BallEvent
+
+
+Change = Clock | Observed
+
+
+@dataclass(frozen=True)
+class Rules:
+    """The configuration the rules need, with times in ticks."""
+
+    cfg: MatchConfig
+    half_ticks: int
+    total_ticks: int
+    kickoff_ticks: int
+    setpiece_ticks: int
+    take_ticks: int
+
+    @classmethod
+    def of(cls, cfg: MatchConfig) -> Rules:
+        dt, r = cfg.timing.dt, cfg.rules
+        return cls(
+            cfg=cfg,
+            half_ticks=cfg.half_ticks,
+            total_ticks=cfg.total_ticks,
+            kickoff_ticks=int(round(r.kickoff_time / dt)),
+            setpiece_ticks=int(round(r.setpiece_time / dt)),
+            take_ticks=int(round(r.take_time / dt)),
+        )
+
+
+@dataclass(frozen=True)
+class Restart:
+    """What an event rule decides: a set piece, after a goal for `goal` if set."""
+
+    command: str
+    team: str
+    spot: tuple[float, float]
+    goal: str = ""
+
+
+Result = tuple[RefereeState, list[RefCommand]]
+
+
+# ------------------------------------------------------------------ commands
+def issue(st: RefereeState, tick: int, name: str, team: str = "", spot=(0.0, 0.0)) -> tuple[RefereeState, RefCommand]:
+    """The state after announcing `name`, and the command itself."""
+    cmd = RefCommand(name=name, team=team, x=spot[0], y=spot[1], tick=tick)
+    if name in _STAGE_COMMANDS:
+        st = dataclasses.replace(st, stage=name)
+    if name not in _KEEP_IN_FORCE:
+        st = dataclasses.replace(st, command=name, command_team=team, spot=spot, issued_at=tick)
+    return st, cmd
+
+
+def restart(st: RefereeState, tick: int, r: Restart, rules: Rules) -> Result:
+    """STOP, the set-piece command, and START due after the positioning time."""
+    out = []
+    if r.goal:
+        a, b = st.score
+        st = dataclasses.replace(st, score=(a + 1, b) if r.goal == "a" else (a, b + 1))
+        st, c = issue(st, tick, "GOAL", r.goal, r.spot)
+        out.append(c)
+    st, c = issue(st, tick, "STOP")
+    out.append(c)
+    st, c = issue(st, tick, r.command, r.team, r.spot)
+    out.append(c)
+    wait = rules.kickoff_ticks if r.command == "KICKOFF" else rules.setpiece_ticks
+    return dataclasses.replace(st, start_at=tick + wait, take_by=-1), out
+
+
+# --------------------------------------------------------------- event rules
+def goal_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
+    """GOAL: the scorer's goal counts; the conceding team kicks off."""
+    if ev.team not in TEAMS:
+        return None
+    return Restart("KICKOFF", sp.other(ev.team), (0.0, 0.0), goal=ev.team)
+
+
+def touch_line_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
+    """TOUCH_LINE: throw-in for the other team than the last toucher's (nobody touched: drop ball)."""
+    if ev.last_team not in TEAMS:
+        return Restart("DROP_BALL", "", sp.drop_ball_spot(ev.x, ev.y, rules.cfg))
+    return Restart("THROWIN", sp.other(ev.last_team), sp.throw_in_spot(ev.x, ev.y, rules.cfg))
+
+
+def goal_line_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
+    """GOAL_LINE: corner if the defending team (`ev.team`) touched it last, else goal kick."""
+    defender = ev.team if ev.team in TEAMS else sp.defender_of_goal_line(ev.x, st.attack_dir_a)
+    if ev.last_team == defender:
+        return Restart("CORNER", sp.other(defender), sp.corner_spot(ev.x, ev.y, rules.cfg))
+    return Restart("GOALKICK", defender, sp.goal_kick_spot(ev.x, ev.y, rules.cfg))
+
+
+def no_progress_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
+    """NO_PROGRESS: drop ball where the ball lies, kept inside the lines."""
+    return Restart("DROP_BALL", "", sp.drop_ball_spot(ev.x, ev.y, rules.cfg))
+
+
+def foul_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
+    """FOUL_PUSHING, FOUL_DRIBBLING: free kick for the other team where the foul happened."""
+    if ev.team not in TEAMS:
+        return None
+    return Restart("FREEKICK", sp.other(ev.team), sp.free_kick_spot(ev.x, ev.y, rules.cfg))
+
+
+EventRule = Callable[[RefereeState, BallEvent, Rules], Restart | None]
+EVENT_RULES: dict[str, EventRule] = {
+    "GOAL": goal_rule,
+    "TOUCH_LINE": touch_line_rule,
+    "GOAL_LINE": goal_line_rule,
+    "NO_PROGRESS": no_progress_rule,
+    "FOUL_PUSHING": foul_rule,
+    "FOUL_DRIBBLING": foul_rule,
+}
+
+
+def on_event(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result:
+    if not st.in_play or ev.tick <= st.issued_at:
+        return st, []  # stopped, or it happened before START: stale
+    if ev.kind == "TOUCH":
+        return (dataclasses.replace(st, take_by=-1) if st.take_by >= 0 else st), []
+    rule = EVENT_RULES.get(ev.kind)
+    decision = rule(st, ev, rules) if rule else None
+    if decision is None:
+        return st, []
+    return restart(st, tick, decision, rules)
+
+
+# --------------------------------------------------------------- clock rules
+def end_game(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    if tick < rules.total_ticks:
+        return None
+    st, c = issue(st, tick, "END_GAME")
+    return dataclasses.replace(st, start_at=-1, take_by=-1), [c]
+
+
+def first_half(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    if st.stage != "PRE_GAME":
+        return None
+    st, c = issue(st, tick, "FIRST_HALF")
+    st, k = issue(st, tick, "KICKOFF", "a", (0.0, 0.0))
+    return dataclasses.replace(st, start_at=tick + rules.kickoff_ticks, take_by=-1), [c, k]
+
+
+def half_time(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    """Half time: the teams change ends; the team that did not kick off first does now."""
+    if st.stage != "FIRST_HALF" or tick < rules.half_ticks:
+        return None
+    st, h = issue(st, tick, "HALF_TIME")
+    st = dataclasses.replace(st, attack_dir_a=-st.attack_dir_a)
+    st, s = issue(st, tick, "SECOND_HALF")
+    st, k = issue(st, tick, "KICKOFF", "b", (0.0, 0.0))
+    return dataclasses.replace(st, start_at=tick + rules.kickoff_ticks, take_by=-1), [h, s, k]
+
+
+def positioning_over(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    """START for the set piece's team; a set piece other than a drop ball must then be taken."""
+    if st.start_at < 0 or tick < st.start_at or st.stage not in PLAYING_STAGES:
+        return None
+    taken_by = tick + rules.take_ticks if st.command in sp.SET_PIECES - {"DROP_BALL"} else -1
+    st, c = issue(st, tick, "START", st.command_team, st.spot)
+    return dataclasses.replace(st, start_at=-1, take_by=taken_by), [c]
+
+
+def set_piece_not_taken(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    if not st.in_play or st.take_by < 0 or tick < st.take_by:
+        return None
+    return restart(st, tick, Restart("DROP_BALL", "", st.spot), rules)
+
+
+ClockRule = Callable[[RefereeState, int, Rules], Result | None]
+CLOCK_RULES: tuple[ClockRule, ...] = (end_game, first_half, half_time, positioning_over, set_piece_not_taken)
+
+
+def on_clock(st: RefereeState, tick: int, rules: Rules) -> Result:
+    if st.stage == "END_GAME":
+        return st, []
+    for rule in CLOCK_RULES:
+        result = rule(st, tick, rules)
+        if result is not None:
+            return result
+    return st, []
+
+
+def process(state: RefereeState, change: Change, rules: Rules) -> Result:
+    """The pure transition: the state after `change`, and the commands it issues."""
+    match change:
+        case Clock(tick=tick):
+            return on_clock(state, tick, rules)
+        case Observed(tick=tick, event=ev):
+            return on_event(state, tick, ev, rules)
+    raise TypeError(f"not a referee change: {change!r}")
+
+
+# ------------------------------------------------------------------- the box
+@dataclass(frozen=True)
+class LogEntry:
+    id: int
+    tick: int
+    change: Change
+    state_pre: RefereeState
+    state: RefereeState
+    commands: tuple[RefCommand, ...]
+
+    @property
+    def cause(self) -> str:
+        match self.change:
+            case Observed(event=ev):
+                who = f" {ev.team}/{ev.robot}" if ev.robot >= 0 else (f" {ev.team}" if ev.team else "")
+                return f"{ev.kind.lower()}{who}"
+            case _:
+                return "clock"
 
 
 class RefereeBox:
-    def __init__(self, cfg: MatchConfig, kickoff_wait: float = 1.0, restart_wait: float = 1.0):
-        self.cfg = cfg
-        self.half_ticks = cfg.half_ticks
-        self.total_ticks = cfg.total_ticks
-        self.kickoff_wait = int(round(kickoff_wait / cfg.timing.dt))  # [ticks]
-        self.restart_wait = int(round(restart_wait / cfg.timing.dt))  # [ticks]
+    """The current state and the log; `step` feeds one referee period's changes through `process`."""
+
+    def __init__(self, cfg: MatchConfig):
+        self.rules = Rules.of(cfg)
         self.state = RefereeState()
         self.log: list[LogEntry] = []
         self.counts: Counter[str] = Counter()
 
-    # ---------------------------------------------------------------- helpers
-    def _issue(self, out: list[RefCommand], tick: int, name: str, team: str = "", spot=(0.0, 0.0), cause: str = "") -> None:
-        st = self.state
-        before = st.stage
-        cmd = RefCommand(name=name, team=team, x=spot[0], y=spot[1], tick=tick)
-        if name in ("FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"):
-            st.stage = name
-        if name not in ("GOAL", "FIRST_HALF", "SECOND_HALF"):
-            st.command, st.command_team, st.spot = name, team, spot
-        out.append(cmd)
-        self.counts[name] += 1
-        self.log.append(LogEntry(tick, cmd, before, st.stage, (st.score["a"], st.score["b"]), cause))
-
-    def _kickoff(self, out: list[RefCommand], tick: int, team: str, cause: str) -> None:
-        self._issue(out, tick, "KICKOFF", team, (0.0, 0.0), cause)
-        self.state.start_at = tick + self.kickoff_wait
-
-    def _inside_spot(self, x: float, y: float) -> tuple[float, float]:
-        hx = self.cfg.field.length / 2.0 - 1.0
-        hy = self.cfg.field.width / 2.0 - 1.0
-        return (max(-hx, min(hx, x)), max(-hy, min(hy, y)))
-
-    @property
-    def in_play(self) -> bool:
-        return self.state.command == "START" and self.state.stage in ("FIRST_HALF", "SECOND_HALF")
-
-    # ------------------------------------------------------------------- step
     def step(self, tick: int, events: list[BallEvent]) -> list[RefCommand]:
-        st = self.state
+        """The commands of referee tick `tick`: the engine's events first, then the clock."""
         out: list[RefCommand] = []
-        if st.stage == "END_GAME":
-            return out
-        if tick >= self.total_ticks:
-            self._issue(out, tick, "END_GAME", cause="time")
-            st.start_at = -1
-            return out
-        if st.stage == "PRE_GAME":
-            self._issue(out, tick, "FIRST_HALF", cause="start")
-            self._kickoff(out, tick, "a", "first half")
-            return out
-        if st.stage == "FIRST_HALF" and tick >= self.half_ticks:
-            self._issue(out, tick, "HALF_TIME", cause="time")
-            st.attack_dir_a = -st.attack_dir_a
-            self._issue(out, tick, "SECOND_HALF", cause="sides switched")
-            self._kickoff(out, tick, "b", "second half")
-            return out
-        for ev in events:
-            if not self.in_play:
-                break
-            if ev.kind == "GOAL" and ev.team in ("a", "b"):
-                st.score[ev.team] += 1
-                self._issue(out, tick, "GOAL", ev.team, (ev.x, ev.y), cause=f"goal by {ev.team}")
-                self._issue(out, tick, "STOP", cause="goal")
-                self._kickoff(out, tick, "b" if ev.team == "a" else "a", "after goal")
-            elif ev.kind in ("TOUCH_LINE", "GOAL_LINE", "NO_PROGRESS"):
-                self._issue(out, tick, "STOP", cause=ev.kind.lower())
-                self._issue(out, tick, "DROP_BALL", "", self._inside_spot(ev.x, ev.y), cause=ev.kind.lower())
-                st.start_at = tick + self.restart_wait
-        if st.start_at >= 0 and tick >= st.start_at and not out:
-            self._issue(out, tick, "START", st.command_team, st.spot, cause="positioning time over")
-            st.start_at = -1
+        for change in [*(Observed(tick, ev) for ev in events), Clock(tick)]:
+            pre = self.state
+            state, cmds = process(pre, change, self.rules)
+            if state == pre and not cmds:
+                continue
+            self.state = state
+            self.log.append(LogEntry(len(self.log), tick, change, pre, state, tuple(cmds)))
+            self.counts.update(c.name for c in cmds)
+            out.extend(cmds)
         return out
+
+    def frame(self, tick: int, commands: list[RefCommand]) -> Referee:
+        """The `referee` message for tick `tick` (Re_G and to the base stations)."""
+        st = self.state
+        return Referee(
+            tick=tick,
+            stage=st.stage,
+            command=st.command,
+            command_team=st.command_team,
+            spot_x=st.spot[0],
+            spot_y=st.spot[1],
+            score_a=st.score[0],
+            score_b=st.score[1],
+            attack_dir_a=st.attack_dir_a,
+            commands=commands,
+        )
+
+    def summary(self) -> dict[str, object]:
+        """Score, command counts and one log line per command, for the match summary."""
+        return {
+            "score": list(self.state.score),
+            "events": dict(self.counts),
+            "log": [
+                {"tick": e.tick, "command": c.name, "team": c.team, "cause": e.cause}
+                for e in self.log
+                for c in e.commands
+            ],
+        }

@@ -11,7 +11,7 @@ import msgspec
 import zenoh
 
 from arena.runtime.session import NetConfig, open_session
-from arena.schemas.messages import Cmd, Report, encode
+from arena.schemas.messages import RefCommand, Referee, Report, encode
 from tests.integration.helpers import ARENA, arena_json, spawn, wait_for
 
 REPO = Path(__file__).resolve().parents[2]
@@ -43,16 +43,34 @@ def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
     assert result["rejected"] == 0 and result["dead"] == []
 
 
-def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path, reap):
+def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payloads) -> dict:
+    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key`. Returns the match JSON.
+
+    `tick` is the tick of the first referee frame heard: the match is at or past it.
+    """
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    logs = tmp_path / "logs"
     match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", "5",
-        "--match", "noisy", "--listen", endpoint, "--json", "--logs", str(logs),
+        "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", str(seed),
+        "--match", match_id, "--listen", endpoint, "--json", "--logs", str(tmp_path / "logs"),
     )
     reap.append(match)
     wait_for(lambda: Path(endpoint.split("/", 1)[1]).exists(), 30, "the router socket")
-    key = "arena/noisy/robot/a/1/cmd"
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        # Wait until the match is being played: the referee has sent a frame. Stop
+        # listening before publishing: on the referee key we would hear ourselves.
+        referee = session.declare_subscriber(f"arena/{match_id}/referee", zenoh.handlers.FifoChannel(1000))
+        first = wait_for(lambda: referee.try_recv(), 60, "the match to start")
+        referee.undeclare()
+        tick = msgspec.msgpack.decode(first.payload.to_bytes(), type=Referee).tick
+        pub = session.declare_publisher(f"arena/{match_id}/{key}", congestion_control=zenoh.CongestionControl.BLOCK)
+        for payload in payloads(tick):
+            pub.put(payload)
+        out, err = match.communicate(timeout=240)
+    assert match.returncode == 0, err
+    return json.loads(out)
+
+
+def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path, reap):
     bad = [
         b"\xde\xad\xbe\xef",  # not msgpack
         b"",  # empty
@@ -61,22 +79,43 @@ def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path,
         encode(Report(tick=0, robot=1, pose={"x": 0, "y": 0, "theta": 0})),  # another message type (no tick order)
         msgspec.msgpack.encode({"tick": 999_999, "vx": float("nan")}),  # out of sequence
     ]
-    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
-        # Wait until the match is being played: the referee has sent a frame.
-        referee = session.declare_subscriber("arena/noisy/referee", zenoh.handlers.FifoChannel(1000))
-        wait_for(lambda: referee.try_recv(), 60, "the match to start")
-        pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK)
-        for payload in bad * 5:
-            pub.put(payload)
-        referee.undeclare()
-        out, err = match.communicate(timeout=240)
-    assert match.returncode == 0, err
-    result = json.loads(out)
+    result = _put_during_a_match(tmp_path, reap, "noisy", 5, "robot/a/1/cmd", lambda tick: bad * 5)
     assert result["rejected"] >= len(bad) * 5 - 5, result["rejected_reasons"]
     assert result["rejected_reasons"].get("malformed", 0) >= 4 * 5
-    log = (logs / "engine.log").read_text()
+    log = (tmp_path / "logs" / "engine.log").read_text()
     assert "rejected input on arena/noisy/robot/a/1/cmd: malformed" in log
     assert "out-of-sequence" in log
+    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
+
+
+def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path, reap):
+    """Unknown command names and teams on the `referee` key: rejected, counted, logged; the match goes on.
+
+    Each burst holds one frame for every referee tick of the next 600 (about
+    a second of play; publishing takes milliseconds). A receiver takes the
+    burst's frame for the tick it waits for next before the real referee's, so
+    that frame passes the sequence check and meets `check_referee`.
+    """
+    span = 120  # frames per burst
+
+    def bursts(tick: int) -> list[bytes]:
+        ticks = range(tick + 5, tick + 5 * (span + 1), 5)
+        frames = [Referee(tick=t, stage="FIRST_HALF", command="CELEBRATE") for t in ticks]  # not an MSL command
+        frames += [Referee(tick=t, stage="FIRST_HALF", command="START", commands=[RefCommand(name="CORNER")])
+                   for t in ticks]  # a corner for nobody
+        frames += [Referee(tick=t, stage="FIRST_HALF", command="START", command_team="c") for t in ticks]  # no team c
+        return [encode(f) for f in frames]
+
+    result = _put_during_a_match(tmp_path, reap, "refnoise", 6, "referee", bursts)
+    reasons = result["rejected_reasons"]
+    assert reasons.get("invalid", 0) >= 3, reasons  # at least one per receiver: engine and two base stations
+    assert reasons.get("malformed", 0) == 3 * span, reasons
+    logs = tmp_path / "logs"
+    for process in ("engine", "basestation_a", "basestation_b"):
+        log = (logs / f"{process}.log").read_text()
+        assert "rejected input on arena/refnoise/referee: invalid:" in log, process
+        assert "malformed: Invalid enum value 'c'" in log, process
+    assert "unknown command 'CELEBRATE'" in (logs / "engine.log").read_text()
     assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
 
 

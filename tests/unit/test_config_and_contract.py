@@ -23,6 +23,7 @@ def test_config_round_trips_through_json():
         ({"half_time": -1}, "--half-time"),
         ({"robots": "three"}, "invalid match configuration"),
         ({"external": ["robot/a/9"]}, "no such process"),
+        ({"robot": {"model": "omni5"}}, "robot.model must be omni4 or omni3"),
     ],
 )
 def test_bad_config_is_rejected_with_a_reason(data, message):

@@ -55,3 +55,41 @@ def test_links_really_drop_under_congested_wifi(seed5):
     wifi = [s.links["wifi"] for s in summaries.values() if "wifi" in s.links]
     assert sum(w["dropped"] for w in wifi) > 0
     assert all(s.rejected == 0 and not s.dead for s in summaries.values())
+
+
+def _noisy_referee():
+    """A referee that sends a bad frame for every tick just before its real one."""
+    from arena.processes.referee import RefereeNode
+    from arena.schemas.messages import RefCommand, Referee
+
+    bad = [
+        dict(command="CELEBRATE"),  # not an MSL RefBox command: invalid
+        dict(command="START", commands=[RefCommand(name="KICKOFF")]),  # a kickoff for nobody: invalid
+        dict(command="START", command_team="c"),  # no such team: does not decode
+        dict(command="START", commands=[RefCommand(name="GOAL", team="c")]),  # likewise
+    ]
+
+    class NoisyReferee(RefereeNode):
+        def act(self, k: int) -> None:
+            self.ref_out.send(Referee(tick=k, stage="FIRST_HALF", **bad[(k // 5) % len(bad)]))
+            super().act(k)
+
+    return NoisyReferee
+
+
+def test_bad_referee_frames_are_rejected_by_engine_and_base_stations_and_change_nothing(monkeypatch):
+    from arena.processes import node_class
+    from arena.tools import inprocess
+
+    cfg = MatchConfig(seed=3, half_time=2.0)
+    clean, _ = play_in_process(cfg, watch=())
+    noisy = _noisy_referee()
+    monkeypatch.setattr(inprocess, "node_class", lambda kind: noisy if kind == "referee" else node_class(kind))
+    summaries, _ = play_in_process(cfg, watch=())
+    used = cfg.total_ticks // cfg.timing.referee_period  # frames sent before the last tick: 40, half of each kind
+    for name in ("engine", "basestation/a", "basestation/b"):
+        reasons = summaries[name].rejected_reasons
+        assert reasons == {"invalid": used // 2, "malformed": used // 2}, (name, reasons)
+        assert summaries[name].digest == clean[name].digest, f"{name} acted on a rejected frame"
+    assert summaries["referee"].extra["events"] == clean["referee"].extra["events"]
+    assert summaries["referee"].extra["log"][-1]["command"] == "END_GAME"

@@ -7,8 +7,9 @@ import random
 
 import pytest
 
-from arena.processes.physics import Physics, wrap_angle
-from arena.runtime.config import MatchConfig
+from arena.processes.drive import Drive
+from arena.processes.physics import PIN_TOLERANCE, Physics, wrap_angle
+from arena.runtime.config import ROBOTINO, MatchConfig
 from arena.schemas.messages import BallEvent, Cmd
 
 CFG = MatchConfig()
@@ -90,12 +91,28 @@ def test_body_frame_command_follows_heading():
     assert vy == pytest.approx(0.0, abs=1e-6)
 
 
-def test_wheels_mode_is_a_zero_command_for_now():
-    ph = make()
+@pytest.mark.parametrize("rp", [R, ROBOTINO], ids=["omni4", "omni3"])
+def test_wheel_speed_commands_drive_the_robot_through_forward_kinematics(rp):
+    ph = Physics(CFG.replace(robot=rp, robots=1))
+    ph.place_robot("a", 0, -3.0, 0.0, math.pi / 2)
+    w = Drive(rp).wheel_speeds(0.8, 0.3, 0.0)  # body frame: forward and to the left
+    ph.set_command("a", 0, cmd(mode="wheels", wheels=list(w)))
+    run(ph, 100)
+    vx, vy, omega = ph.robot_velocity("a", 0)
+    assert (vx, vy, omega) == pytest.approx((-0.3, 0.8, 0.0), abs=1e-6)  # facing +y: forward is +y
+
+
+def test_body_and_wheel_commands_obey_the_same_wheel_saturation():
+    ph = make(robots=2)
     ph.place_robot("a", 0, -3.0, 0.0, 0.0)
-    ph.set_command("a", 0, cmd(mode="wheels", wheels=[50.0, 50.0, 50.0, 50.0]))
-    run(ph, 20)
-    assert ph.robot_pose("a", 0) == (-3.0, 0.0, 0.0)
+    ph.place_robot("a", 1, -3.0, 2.0, 0.0)
+    twist = (-3.5, 3.5, 6.0)  # 4.95 m/s along wheel 1's rolling direction while turning: 124 rad/s asked
+    ph.set_command("a", 0, cmd(vx=twist[0], vy=twist[1], omega=twist[2]))
+    ph.set_command("a", 1, cmd(mode="wheels", wheels=list(Drive(R).wheel_speeds(*twist))))
+    run(ph, 1)
+    assert ph._robots[0].ctrl_set == pytest.approx(ph._robots[1].ctrl_set)
+    limited = Drive(R).twist(cmd(vx=twist[0], vy=twist[1], omega=twist[2]))
+    assert max(abs(x) for x in Drive(R).wheel_speeds(*limited)) == pytest.approx(R.max_wheel_speed)
 
 
 def test_distance_sums_travel_but_not_placements():
@@ -395,6 +412,15 @@ def test_high_lob_over_the_crossbar_is_no_goal_and_low_lob_is():
     assert [e.team for e in events if e.kind == "GOAL"] == ["a"]
 
 
+@pytest.mark.parametrize(("attack_dir_a", "side", "defender"), [(1, 1, "b"), (1, -1, "a"), (-1, 1, "a"), (-1, -1, "b")])
+def test_goal_line_event_names_the_defending_team(attack_dir_a, side, defender):
+    ph = make()
+    ph.attack_dir_a = attack_dir_a
+    ph.place_ball(side * 4.0, 2.5, side * 4.0, 0.0)
+    events = run(ph, 100)
+    assert [(e.kind, e.team) for e in events] == [("GOAL_LINE", defender)]
+
+
 def test_touch_line_event_names_the_last_toucher():
     ph = make()
     ph.place_robot("a", 0, 0.0, 2.5, math.pi / 2)
@@ -445,9 +471,19 @@ def test_no_progress_rearms_when_the_ball_moves_again():
     assert kinds(events) == ["NO_PROGRESS"]
     ph.set_command("a", 0, cmd(vx=1.0))
     run(ph, 50)
-    ph.set_command("a", 0, cmd(vx=-1.0))
+    ph.set_command("a", 0, cmd(vx=-1.0))  # the robot pushes the ball on and leaves it rolling
     events = run(ph, 400)
-    assert kinds(events) == ["NO_PROGRESS"]
+    assert set(kinds(events)) == {"NO_PROGRESS"}
+    assert events[-1].x > 1.0, "re-armed once the ball had left its first circle"
+    assert ph.ball_state()[3:5] == (0.0, 0.0)
+
+
+def test_a_ball_creeping_within_the_progress_radius_makes_no_progress():
+    ph = make(no_progress_s=2.0)
+    ph.place_ball(1.0, 1.0, 0.5, 0.0)  # rolls 0.31 m: less than the progress radius
+    events = run(ph, 120)
+    assert [(e.kind, e.tick) for e in events] == [("NO_PROGRESS", 100)]
+    assert CFG.rules.progress_radius == 0.5
 
 
 # --------------------------------------------------------------- placement
@@ -519,3 +555,94 @@ def test_wrap_angle():
     assert wrap_angle(-math.pi) == math.pi
     assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
     assert wrap_angle(-7.0) == pytest.approx(-7.0 + math.tau)
+
+
+# ------------------------------------------------------------------ fouls
+def _charge(speed: float, teams: tuple[str, str] = ("a", "b")) -> list[BallEvent]:
+    """Robot 1 of teams[0] drives at `speed` [m/s] into robot 1 of teams[1], which stands still."""
+    ph = make(robots=2)
+    ph.place_ball(0.0, -3.0)
+    ph.place_robot(teams[0], 1, -2.0, 1.0, 0.0)
+    ph.place_robot(teams[1], 1 if teams[1] != teams[0] else 0, 0.0, 1.0, math.pi)
+    ph.set_command(teams[0], 1, cmd(vx=speed))
+    return run(ph, 150)
+
+
+def test_driving_into_an_opponent_fast_is_pushing():
+    events = _charge(3.0)
+    fouls = [e for e in events if e.kind == "FOUL_PUSHING"]
+    assert len(fouls) == 1
+    foul = fouls[0]
+    assert (foul.team, foul.robot) == ("a", 1)
+    assert foul.x == pytest.approx(-0.225, abs=0.05) and foul.y == pytest.approx(1.0, abs=0.25)
+
+
+@pytest.mark.parametrize(("speed", "teams"), [(1.0, ("a", "b")), (3.0, ("a", "a"))], ids=["gentle", "teammate"])
+def test_slow_contact_or_a_teammate_is_no_foul(speed, teams):
+    assert "FOUL_PUSHING" not in kinds(_charge(speed, teams))
+
+
+def test_the_robot_that_drove_in_is_the_offender():
+    ph = make(robots=2)
+    ph.place_ball(0.0, -3.0)
+    ph.place_robot("a", 1, -2.0, 1.0, 0.0)
+    ph.place_robot("b", 1, 1.0, 1.0, math.pi)
+    ph.set_command("a", 1, cmd(vx=0.5))
+    ph.set_command("b", 1, cmd(vx=2.5))  # b drives (forward = -x) much faster into a
+    fouls = [e for e in run(ph, 150) if e.kind == "FOUL_PUSHING"]
+    assert [(e.team, e.robot) for e in fouls] == [("b", 1)]
+
+
+def test_dribbling_further_than_three_metres_is_a_foul_once():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(vx=1.5, dribbler=True))
+    events = run(ph, 200)
+    fouls = [e for e in events if e.kind == "FOUL_DRIBBLING"]
+    assert len(fouls) == 1 and (fouls[0].team, fouls[0].robot) == ("a", 0)
+    assert fouls[0].x - FACE == pytest.approx(-3.0 + CFG.rules.dribble_limit, abs=0.05)
+    assert ph.holder() == ("a", 0), "the engine reports; the referee stops play"
+
+
+def test_letting_go_starts_a_new_possession():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(vx=1.5, dribbler=True))
+    events = run(ph, 100)  # 2.4 m
+    ph.set_command("a", 0, cmd(vx=1.5))
+    events += run(ph, 2)
+    ph.set_command("a", 0, cmd(vx=1.5, dribbler=True))
+    events += run(ph, 60)
+    assert "FOUL_DRIBBLING" not in kinds(events)
+
+
+# ------------------------------------------------------- play and stoppages
+def test_while_play_is_stopped_the_pinned_ball_stays_and_nothing_is_reported():
+    ph = make(no_progress_s=0.5)
+    ph.stop_play()
+    ph.pin_ball(1.0, 0.0)
+    ph.place_robot("a", 0, -1.0, 0.0, 0.0)
+    ph.set_command("a", 0, cmd(vx=2.0, dribbler=True, kick_speed=6.0))  # runs into the ball, tries to kick
+    events = run(ph, 150)
+    assert events == []
+    assert ph.ball_state()[:2] == pytest.approx((1.0, 0.0), abs=PIN_TOLERANCE)
+    assert ph.holder() is None and ph.last_toucher() is None
+
+
+def test_after_start_the_first_touch_is_reported_even_by_the_last_toucher():
+    ph = make()
+    ph.place_robot("a", 0, -3.0, 0.0, 0.0)
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(kick_speed=1.0))
+    assert kinds(ph.step()) == ["TOUCH"]
+    ph.stop_play()
+    ph.pin_ball(0.0, 0.0)
+    ph.place_robot("a", 0, -FACE - 0.3, 0.0, 0.0)
+    ph.set_command("a", 0, cmd())
+    run(ph, 10)
+    ph.start_play()
+    ph.set_command("a", 0, cmd(vx=1.0))
+    events = run(ph, 50)
+    assert [(e.kind, e.team, e.robot) for e in events] == [("TOUCH", "a", 0)]

@@ -1,0 +1,188 @@
+"""Set pieces: where the ball is put back, who keeps away from it, and where a
+robot that did not is put.
+
+The referee box (`referee_box.py`) takes the ball spots from here, the engine
+(`engine.py`) the distance rule and the placement, the simple strategy the
+distances. Everything is a pure function of positions and the configuration;
+the numbers are in `RulesParams` and `FieldParams` (runtime/config.py) and
+the table of rules is docs/rules.md.
+
+Ball spots (field frame, SI units; L, W the field's length and width):
+
+* THROWIN: on the touch line the ball crossed, at the x where it crossed,
+  kept `spot_inset` from the goal lines. The 1 m run-off is where the taker
+  stands (paper 2, "Soccer Field Object").
+* CORNER: `corner_inset` from both lines at the corner nearest to where the
+  ball went out, inside the corner arc.
+* GOALKICK: the corner of the goal area on the side the ball went out.
+* FREEKICK: where the foul happened, kept `spot_inset` inside the lines and
+  moved out of a penalty area onto its front line (penalty kicks are not
+  awarded, see docs/rules.md).
+* DROP_BALL: where the ball was, kept `drop_ball_inset` inside the lines.
+* KICKOFF: the centre spot.
+
+Distances while the teams position themselves (robot centre to ball spot):
+
+* KICKOFF: the opponents of the kicking team stay outside the centre circle
+  (its radius plus half a robot);
+* FREEKICK, GOALKICK, THROWIN, CORNER, PENALTY: the opponents of the taking
+  team keep `setpiece_distance` (>= 2 m; MSL 3 m on its bigger field);
+* DROP_BALL: every robot keeps `drop_ball_distance`.
+
+A goalkeeper (robot 0) inside its own penalty area is exempt, so that a free
+kick near its goal does not pull it out. When the positioning time is over
+(START) the engine moves every robot still too close to the nearest free spot
+just outside the distance (`legal_spot`); the robot keeps its heading.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from arena.runtime.config import TEAMS, MatchConfig
+
+SET_PIECES = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL"})
+PLACE_MARGIN = 0.05  # [m] a placed robot stands this much beyond the distance it must keep
+RING_STEP = 0.5  # [m] next ring of candidate spots when a whole ring is taken
+ANGLE_STEP = math.radians(5.0)  # [rad] between candidate spots on a ring
+CLEARANCE = 0.05  # [m] between a placed robot's bounding circle and the others', and to the fence
+
+
+def other(team: str) -> str:
+    return "b" if team == "a" else "a"
+
+
+def attack_dir(team: str, attack_dir_a: int) -> int:
+    """+1 if `team` attacks the +x goal now, -1 for the -x goal."""
+    return attack_dir_a if team == "a" else -attack_dir_a
+
+
+def defender_of_goal_line(x: float, attack_dir_a: int) -> str:
+    """The team whose goal line is on the side of x (the x = sign(x) * L/2 line)."""
+    side = 1 if x > 0 else -1
+    return "b" if side == attack_dir_a else "a"
+
+
+def _clamp(v: float, lim: float) -> float:
+    return max(-lim, min(lim, v))
+
+
+# ----------------------------------------------------------------- ball spots
+def throw_in_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
+    f, r = cfg.field, cfg.rules
+    return _clamp(x, f.length / 2 - r.spot_inset), math.copysign(f.width / 2, y)
+
+
+def corner_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
+    f, r = cfg.field, cfg.rules
+    return math.copysign(f.length / 2 - r.corner_inset, x), math.copysign(f.width / 2 - r.corner_inset, y)
+
+
+def goal_kick_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
+    f = cfg.field
+    return math.copysign(f.length / 2 - f.goal_area_depth, x), math.copysign(f.goal_area_width / 2, y)
+
+
+def free_kick_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
+    f, r = cfg.field, cfg.rules
+    x = _clamp(x, f.length / 2 - r.spot_inset)
+    y = _clamp(y, f.width / 2 - r.spot_inset)
+    front = f.length / 2 - f.penalty_area_depth  # |x| of a penalty area's front line
+    if abs(x) > front and abs(y) < f.penalty_area_width / 2:
+        x = math.copysign(front, x)
+    return x, y
+
+
+def drop_ball_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
+    f, inset = cfg.field, cfg.rules.drop_ball_inset
+    return _clamp(x, f.length / 2 - inset), _clamp(y, f.width / 2 - inset)
+
+
+# ------------------------------------------------------------------ distances
+@dataclass(frozen=True)
+class KeepAway:
+    distance: float  # [m] robot centre to ball spot
+    teams: tuple[str, ...]  # the teams that must keep it
+
+
+def keep_away(command: str, team: str, cfg: MatchConfig) -> KeepAway | None:
+    """Who keeps how far from the ball spot while `command` (for `team`) is being set up."""
+    r = cfg.rules
+    if command == "KICKOFF":
+        return KeepAway(cfg.field.center_circle_radius + cfg.robot.size / 2, (other(team),))
+    if command == "DROP_BALL":
+        return KeepAway(r.drop_ball_distance, TEAMS)
+    if command in SET_PIECES and team in TEAMS:
+        return KeepAway(r.setpiece_distance, (other(team),))
+    return None
+
+
+def in_own_penalty_area(team: str, x: float, y: float, attack_dir_a: int, cfg: MatchConfig) -> bool:
+    f = cfg.field
+    own = -attack_dir(team, attack_dir_a)  # side of its own goal
+    return own * x > f.length / 2 - f.penalty_area_depth and abs(y) < f.penalty_area_width / 2
+
+
+def too_close(
+    robots: list[tuple[str, int, float, float]],
+    command: str,
+    team: str,
+    spot: tuple[float, float],
+    attack_dir_a: int,
+    cfg: MatchConfig,
+) -> list[tuple[str, int]]:
+    """(team, n) of every robot that breaks the distance rule of `command`, in the given order."""
+    rule = keep_away(command, team, cfg)
+    if rule is None:
+        return []
+    out = []
+    for t, n, x, y in robots:
+        if t not in rule.teams or math.hypot(x - spot[0], y - spot[1]) >= rule.distance:
+            continue
+        if n == 0 and in_own_penalty_area(t, x, y, attack_dir_a, cfg):
+            continue
+        out.append((t, n))
+    return out
+
+
+def legal_spot(
+    x: float,
+    y: float,
+    spot: tuple[float, float],
+    distance: float,
+    others: list[tuple[float, float]],
+    cfg: MatchConfig,
+) -> tuple[float, float]:
+    """The free place nearest to (x, y) at least `distance` from `spot`.
+
+    Candidates lie on rings around the spot (radius distance + PLACE_MARGIN,
+    then RING_STEP further out), first in the robot's own direction from the
+    spot, then alternately ANGLE_STEP to either side. A candidate must keep
+    the robot inside the fence, out of both goals, and clear of every robot
+    in `others` (bounding circles). Deterministic; falls back to (x, y) if
+    nothing fits (never with the default field).
+    """
+    f, size = cfg.field, cfg.robot.size
+    reach = size * math.sqrt(0.5)  # [m] bounding circle radius of the square footprint
+    xmax = f.length / 2 + f.runoff - reach - CLEARANCE
+    ymax = f.width / 2 + f.runoff - reach - CLEARANCE
+    goal_y = f.goal_width / 2 + reach + CLEARANCE
+    goal_x = f.length / 2 - reach - CLEARANCE
+    gap = 2 * reach + CLEARANCE
+    dx, dy = x - spot[0], y - spot[1]
+    if math.hypot(dx, dy) > 1e-9:
+        base = math.atan2(dy, dx)
+    else:
+        base = math.atan2(-spot[1], -spot[0]) if math.hypot(*spot) > 1e-9 else math.pi
+    steps = int(math.pi / ANGLE_STEP)
+    for ring in range(8):
+        radius = distance + PLACE_MARGIN + ring * RING_STEP
+        for k in range(2 * steps):
+            a = base + (k + 1) // 2 * ANGLE_STEP * (1 if k % 2 else -1)
+            cx, cy = spot[0] + radius * math.cos(a), spot[1] + radius * math.sin(a)
+            if abs(cx) > xmax or abs(cy) > ymax or (abs(cx) > goal_x and abs(cy) < goal_y):
+                continue
+            if all(math.hypot(cx - ox, cy - oy) >= gap for ox, oy in others):
+                return cx, cy
+    return x, y
