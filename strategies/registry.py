@@ -12,9 +12,15 @@ GROUP = "soccer_arena.strategies"
 
 
 def _builtin() -> list[Strategy]:
-    from arena.strategies import simple
+    """The paper's four strategies (iris.py) and chase-and-shoot (simple.py) as `chase`."""
+    from arena.strategies import iris, simple
 
-    return simple.STRATEGIES
+    paper = {s.name for s in iris.STRATEGIES}
+    chase = [
+        Strategy(name="chase", make_team=s.make_team, make_robot=s.make_robot, description="chase-and-shoot baseline")
+        for s in simple.STRATEGIES[:1]
+    ]
+    return iris.STRATEGIES + [s for s in simple.STRATEGIES if s.name not in paper] + chase
 
 
 @cache

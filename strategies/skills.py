@@ -1,0 +1,200 @@
+"""Robot skills as pure geometry: where to stand, where to aim, when to kick.
+
+Everything here is a function of positions in the field frame (schemas/messages.py)
+and a frozen `SkillParams`; nothing keeps state, reads a clock or draws random
+numbers. The robot brain (:mod:`arena.strategies.iris`) turns the targets into
+velocity commands with a navigator of :mod:`arena.navigation`.
+
+Paper 2 (IRIS, "Advance attack and defense strategy ...") gives the behaviours:
+
+* basic strategy: pick up the ball, dribble it, kick from a set distance to goal;
+* advance attack (Fig. 7a): detect an opponent in the path (`blocker_ahead`),
+  turn the back to it and sidestep away from the near touch line
+  (`sidestep_target`), go goal-ward again once past, shoot when within shooting
+  distance and the line to the goal is clear (`line_clear`, `best_aim`);
+* advance defense (Fig. 7b): stand on the estimated kick line between the
+  opponent ball carrier and our goal, 1 m from the carrier, retreat with it down
+  to a 3 m radius around our goal centre, then follow the ball
+  (`block_point`); take the ball when within 0.5 m;
+* goalkeeper: guard the goal mouth and intercept the predicted ball path
+  (`keeper_target`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+Vec = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class SkillParams:
+    behind_ball: float = 0.38  # [m] approach point behind the ball, centre to ball centre
+    capture_lane: float = 0.18  # [m] lateral error tolerated on the final approach to the ball
+    block_distance: float = 1.0  # [m] advance defense: from the carrier on the kick line (paper 2)
+    retreat_radius: float = 3.0  # [m] advance defense: closest approach to our goal centre (paper 2)
+    take_distance: float = 0.5  # [m] advance defense: take the ball when this close (paper 2)
+    path_corridor: float = 0.6  # [m] half width of the corridor in which an opponent blocks the path
+    path_lookahead: float = 1.6  # [m] how far ahead an opponent counts as in the path
+    sidestep: float = 1.0  # [m] lateral offset of the sidestep around an opponent
+    clear_margin: float = 0.36  # [m] a robot closer than this to the kick line blocks it
+    keeper_depth: float = 0.35  # [m] goalkeeper line in front of the goal line
+    keeper_post_margin: float = 0.2  # [m] goalkeeper stays this far inside the posts
+    intercept_min_speed: float = 0.6  # [m/s] ball speed towards the goal at which the keeper intercepts
+
+
+def dist(a: Vec, b: Vec) -> float:
+    return math.hypot(a[0] - b[0], a[1] - b[1])
+
+
+def angle_to(a: Vec, b: Vec) -> float:
+    """Direction [rad] from a to b."""
+    return math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def wrap(a: float) -> float:
+    """Angle wrapped to [-pi, pi) [rad]."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def clamp(x: float, lo: float, hi: float) -> float:
+    return lo if x < lo else hi if x > hi else x
+
+
+def segment_distance(p: Vec, a: Vec, b: Vec) -> tuple[float, float]:
+    """(distance [m] from p to segment a-b, position t in [0, 1] of the closest point)."""
+    ax, ay = b[0] - a[0], b[1] - a[1]
+    n2 = ax * ax + ay * ay
+    t = 0.0 if n2 == 0.0 else clamp(((p[0] - a[0]) * ax + (p[1] - a[1]) * ay) / n2, 0.0, 1.0)
+    return math.hypot(a[0] + t * ax - p[0], a[1] + t * ay - p[1]), t
+
+
+def behind_point(ball: Vec, target: Vec, offset: float) -> Vec:
+    """The point `offset` [m] behind the ball on the line target -> ball (where to stand to push it to target)."""
+    a = angle_to(ball, target)
+    return ball[0] - offset * math.cos(a), ball[1] - offset * math.sin(a)
+
+
+def lined_up(pos: Vec, ball: Vec, target: Vec, lane: float) -> bool:
+    """True when pos is behind the ball w.r.t. target and within `lane` [m] of the line through them."""
+    a = angle_to(ball, target)
+    c, s = math.cos(a), math.sin(a)
+    along = (pos[0] - ball[0]) * c + (pos[1] - ball[1]) * s
+    across = -(pos[0] - ball[0]) * s + (pos[1] - ball[1]) * c
+    return along < 0.0 and abs(across) < lane
+
+
+def line_clear(a: Vec, b: Vec, robots: list[Vec], margin: float) -> bool:
+    """No robot centre within `margin` [m] of the segment a-b (its first 0.3 m excepted: that is us)."""
+    for r in robots:
+        d, t = segment_distance(r, a, b)
+        if d < margin and dist(r, a) > 0.3:
+            return False
+    return True
+
+
+def best_aim(ball: Vec, goal_x: float, goal_half: float, robots: list[Vec], margin: float) -> tuple[Vec, bool]:
+    """Aim point on the goal line with the most room, and whether its line is clear.
+
+    Candidates are 5 points across the mouth, 0.15 m inside the posts; the one
+    whose line from the ball keeps the largest distance to every robot wins.
+    """
+    best: Vec = (goal_x, 0.0)
+    best_room = -1.0
+    inner = goal_half - 0.15
+    for i in range(5):
+        y = -inner + i * (2.0 * inner / 4.0)
+        aim = (goal_x, y)
+        room = min((segment_distance(r, ball, aim)[0] for r in robots if dist(r, ball) > 0.3), default=math.inf)
+        if room > best_room + 1e-9:
+            best, best_room = aim, room
+    return best, best_room >= margin
+
+
+def blocker_ahead(pos: Vec, heading_to: Vec, opponents: list[Vec], corridor: float, lookahead: float) -> Vec | None:
+    """The nearest opponent in the corridor from pos towards heading_to, at most `lookahead` [m] ahead."""
+    a = angle_to(pos, heading_to)
+    c, s = math.cos(a), math.sin(a)
+    found: Vec | None = None
+    best = math.inf
+    for o in opponents:
+        along = (o[0] - pos[0]) * c + (o[1] - pos[1]) * s
+        across = -(o[0] - pos[0]) * s + (o[1] - pos[1]) * c
+        if 0.0 < along < lookahead and abs(across) < corridor and along < best:
+            found, best = o, along
+    return found
+
+
+def sidestep_target(pos: Vec, opponent: Vec, goal: Vec, step: float, beyond: float = 0.5) -> Vec:
+    """Advance attack: a point beside the opponent, on the side of the field centre line (y = 0).
+
+    Paper 2: "if the robot is on the left side of the field, the robot will move
+    to the right and vice versa", so that it ends closer to the goal. The point
+    lies `step` [m] sideways of the opponent, across the line to the goal, and
+    `beyond` [m] past it goal-ward, so that driving there circles round the opponent.
+    """
+    a = angle_to(pos, goal)
+    nx, ny = -math.sin(a), math.cos(a)  # left of the goal direction
+    side = -1.0 if pos[1] > 0.0 else 1.0  # towards y = 0 (away from the near touch line)
+    if ny * side < 0.0:
+        nx, ny = -nx, -ny
+    return opponent[0] + step * nx + beyond * math.cos(a), opponent[1] + step * ny + beyond * math.sin(a)
+
+
+def passed(pos: Vec, opponent: Vec, goal: Vec) -> bool:
+    """The opponent is no longer ahead of pos on the way to goal."""
+    a = angle_to(pos, goal)
+    return (opponent[0] - pos[0]) * math.cos(a) + (opponent[1] - pos[1]) * math.sin(a) <= 0.0
+
+
+def block_point(carrier: Vec, own_goal: Vec, p: SkillParams) -> Vec:
+    """Advance defense (paper 2, Fig. 7b): on the kick line carrier -> own goal centre.
+
+    `block_distance` from the carrier towards our goal, but never closer than
+    `retreat_radius` to the goal centre: once the carrier is within
+    retreat_radius + block_distance, the defender stays on the retreat circle
+    at the carrier's bearing (it follows the ball instead of backing up).
+    """
+    d = dist(carrier, own_goal)
+    a = angle_to(own_goal, carrier)
+    r = max(p.retreat_radius, d - p.block_distance)
+    return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
+
+
+def predict_crossing(ball: Vec, vel: Vec, line_x: float) -> float | None:
+    """y [m] at which a ball rolling with vel [m/s] from ball crosses x = line_x, None if it moves away."""
+    dx = line_x - ball[0]
+    if vel[0] == 0.0 or dx * vel[0] <= 0.0:
+        return None
+    return ball[1] + vel[1] * dx / vel[0]
+
+
+def keeper_target(ball: Vec, ball_vel: Vec, own_goal_x: float, goal_half: float, p: SkillParams) -> tuple[Vec, bool]:
+    """Goalkeeper stand point and whether it is intercepting a shot.
+
+    The keeper line is `keeper_depth` in front of our goal line. A ball moving
+    towards our goal faster than `intercept_min_speed` is intercepted where its
+    path crosses that line (clamped a little outside the posts); otherwise the
+    keeper stands where the line from the ball to the goal centre crosses the
+    keeper line, inside the posts.
+    """
+    inward = -1.0 if own_goal_x > 0 else 1.0
+    line_x = own_goal_x + inward * p.keeper_depth
+    toward = -ball_vel[0] * inward
+    if toward > p.intercept_min_speed:
+        y = predict_crossing(ball, ball_vel, line_x)
+        if y is not None and abs(y) < goal_half + 0.5:
+            return (line_x, clamp(y, -goal_half - 0.1, goal_half + 0.1)), True
+    lim = goal_half - p.keeper_post_margin
+    dx = ball[0] - own_goal_x
+    if abs(dx) < 1e-6:
+        y = clamp(ball[1], -lim, lim)
+    else:
+        y = ball[1] * p.keeper_depth / abs(dx)
+    return (line_x, clamp(y, -lim, lim)), False
+
+
+def pass_speed(distance: float, arrive: float, decel: float, max_speed: float) -> float:
+    """Kick speed [m/s] so that a rolling ball (decel [m/s^2]) arrives with `arrive` [m/s] after distance [m]."""
+    return min(max_speed, math.sqrt(arrive * arrive + 2.0 * decel * max(0.0, distance)))

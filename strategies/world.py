@@ -1,0 +1,219 @@
+"""Perception and fusion: the base station's P_A, P_B, P_ball (paper 2, eq. 5) and a robot's own view.
+
+Base station (`TeamModel.update`), from the robots' reports R_n_B = {P_An, P_Bn, P_ball}:
+
+* P_A: each robot's own reported pose (the freshest report wins);
+* P_ball: the inverse-variance weighted mean of every visible ball detection
+  in the reports of this comm period; a detection at range r has the sensor's
+  sigma(r) = det_sigma + det_sigma_per_m * r, so near detections dominate. With
+  no detection the previous estimate is kept and ages. The ball velocity is the
+  difference of consecutive estimates, smoothed (`vel_smoothing`);
+* P_B: opponent detections of all reports, greedily clustered (a detection
+  within `merge_radius` of a cluster joins it, weighted as above), at most
+  `robots` clusters; an opponent seen before and not re-detected keeps its
+  last position while younger than `opponent_memory`.
+
+Robot (`RobotView.update`): its own pose is the sensed one; the ball is its own
+detection when visible, otherwise the base station's P_ball of the latest order
+(aged by the order's delay) or its own last detection, whichever is younger;
+opponents are its own detections plus the order's P_B entries that no own
+detection explains. Robots never see ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from arena.runtime.config import SensorParams
+from arena.schemas.messages import Order, Report, Sense
+
+Vec = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class FusionParams:
+    merge_radius: float = 0.5  # [m] detections closer than this are the same robot
+    opponent_memory: int = 100  # [ticks] an unseen opponent is forgotten after this long
+    ball_memory: int = 250  # [ticks] a ball estimate older than this is not used
+    vel_smoothing: float = 0.5  # [-] weight of the newest velocity sample (exponential filter)
+    max_ball_speed: float = 10.0  # [m/s] faster jumps between estimates are noise, not motion
+
+
+def detection_sigma(sensor: SensorParams, rng_m: float) -> float:
+    """Sensor noise [m] of a detection at range rng_m [m]."""
+    return sensor.det_sigma + sensor.det_sigma_per_m * rng_m
+
+
+@dataclass
+class Track:
+    x: float
+    y: float
+    tick: int
+
+    @property
+    def xy(self) -> Vec:
+        return self.x, self.y
+
+
+class BallFilter:
+    """Position and smoothed velocity from a sequence of stamped estimates."""
+
+    def __init__(self, p: FusionParams, dt: float):
+        self.p = p
+        self.dt = dt
+        self.track: Track | None = None
+        self.vel: Vec = (0.0, 0.0)
+
+    def observe(self, tick: int, x: float, y: float) -> None:
+        t = self.track
+        if t is not None and tick > t.tick:
+            span = (tick - t.tick) * self.dt
+            vx, vy = (x - t.x) / span, (y - t.y) / span
+            if math.hypot(vx, vy) <= self.p.max_ball_speed and tick - t.tick <= 10:
+                w = self.p.vel_smoothing
+                self.vel = (w * vx + (1 - w) * self.vel[0], w * vy + (1 - w) * self.vel[1])
+            else:
+                self.vel = (0.0, 0.0)
+        self.track = Track(x, y, tick)
+
+    def age(self, tick: int) -> int:
+        return tick - self.track.tick if self.track is not None else 1 << 30
+
+
+def cluster(detections: list[tuple[float, float, float]], radius: float) -> list[tuple[float, float, float]]:
+    """Greedy weighted clustering of (x, y, weight) in order; returns (x, y, total weight) per cluster."""
+    out: list[list[float]] = []  # sum wx, sum wy, sum w
+    for x, y, w in detections:
+        for c in out:
+            if math.hypot(c[0] / c[2] - x, c[1] / c[2] - y) < radius:
+                c[0] += w * x
+                c[1] += w * y
+                c[2] += w
+                break
+        else:
+            out.append([w * x, w * y, w])
+    return [(c[0] / c[2], c[1] / c[2], c[2]) for c in out]
+
+
+class TeamModel:
+    """The base station's fused world model (eq. 5)."""
+
+    def __init__(self, team: str, robots: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams()):
+        self.team = team
+        self.other = "b" if team == "a" else "a"
+        self.robots = robots
+        self.sensor = sensor
+        self.p = p
+        self.own: dict[int, tuple[float, float, float, int]] = {}  # n -> x, y, theta, tick
+        self.has_ball: dict[int, bool] = {}
+        self.ball = BallFilter(p, dt)
+        self.opponents: list[Track] = []
+
+    def update(self, tick: int, reports: dict[int, Report]) -> None:
+        balls: list[tuple[float, float, float]] = []
+        seen: list[tuple[float, float, float]] = []
+        newest = -1
+        for n in sorted(reports):
+            rep = reports[n]
+            px, py = rep.pose.x, rep.pose.y
+            if n not in self.own or rep.tick >= self.own[n][3]:
+                self.own[n] = (px, py, rep.pose.theta, rep.tick)
+                self.has_ball[n] = rep.has_ball
+            if rep.ball.visible:
+                s = detection_sigma(self.sensor, math.hypot(rep.ball.x - px, rep.ball.y - py))
+                balls.append((rep.ball.x, rep.ball.y, 1.0 / (s * s)))
+                newest = max(newest, rep.tick)
+            for r in rep.robots:
+                if r.team == self.other:
+                    s = detection_sigma(self.sensor, math.hypot(r.x - px, r.y - py))
+                    seen.append((r.x, r.y, 1.0 / (s * s)))
+        if balls:
+            bx, by, _ = cluster(balls, math.inf)[0]
+            self.ball.observe(newest, bx, by)
+        fresh = sorted(cluster(seen, self.p.merge_radius), key=lambda c: -c[2])[: self.robots]
+        tracks = [Track(x, y, tick) for x, y, _ in fresh]
+        for old in self.opponents:
+            if len(tracks) >= self.robots or tick - old.tick > self.p.opponent_memory:
+                continue
+            if all(math.hypot(old.x - t.x, old.y - t.y) >= self.p.merge_radius for t in tracks):
+                tracks.append(old)
+        self.opponents = tracks
+
+    def holder(self) -> int | None:
+        held = [n for n, h in sorted(self.has_ball.items()) if h]
+        return held[0] if held else None
+
+    def ball_xy(self, tick: int) -> Vec | None:
+        t = self.ball.track
+        if t is None or tick - t.tick > self.p.ball_memory:
+            return None
+        return t.xy
+
+
+class RobotView:
+    """One robot's picture of the world for this tick."""
+
+    def __init__(self, team: str, n: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams()):
+        self.team = team
+        self.other = "b" if team == "a" else "a"
+        self.n = n
+        self.p = p
+        self.sensor = sensor
+        self.dt = dt
+        self.own_ball = BallFilter(p, dt)
+        self.pose: tuple[float, float, float] | None = None
+        self.vel: Vec = (0.0, 0.0)  # [m/s] field frame
+        self.ball: Vec | None = None
+        self.ball_vel: Vec = (0.0, 0.0)
+        self.ball_age = 1 << 30  # [ticks]
+        self.opponents: list[Vec] = []
+        self.mates: dict[int, tuple[float, float, str]] = {}  # n -> x, y, role
+        self.has_ball = False
+        self.mate_obstacles: list[Vec] = []
+
+    def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
+        if sense is not None:
+            p = sense.pose
+            self.pose = (p.x, p.y, p.theta)
+            c, s = math.cos(p.theta), math.sin(p.theta)
+            self.vel = (c * sense.vx - s * sense.vy, s * sense.vx + c * sense.vy)
+            self.has_ball = sense.has_ball
+            if sense.ball.visible:
+                self.own_ball.observe(tick, sense.ball.x, sense.ball.y)
+        elif order is not None and self.pose is None:
+            for tp in order.own:
+                if tp.robot == self.n:
+                    self.pose = (tp.x, tp.y, tp.theta)
+        own_age = self.own_ball.age(tick)
+        order_age = order.ball_age + (tick - order.tick) if order is not None and order.ball_valid else 1 << 30
+        if own_age <= order_age and self.own_ball.track is not None:
+            self.ball, self.ball_vel, self.ball_age = self.own_ball.track.xy, self.own_ball.vel, own_age
+        elif order is not None and order.ball_valid:
+            self.ball, self.ball_vel, self.ball_age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age
+        else:
+            self.ball, self.ball_vel, self.ball_age = None, (0.0, 0.0), 1 << 30
+        if self.ball_age > self.p.ball_memory:
+            self.ball = None
+        seen = [(r.x, r.y) for r in sense.robots if r.team == self.other] if sense is not None else []
+        self.opponents = list(seen)
+        mates: dict[int, tuple[float, float, str]] = {}
+        if order is not None:
+            for tp in order.opponents:
+                if tp.age + (tick - order.tick) > self.p.opponent_memory:
+                    continue
+                if all(math.hypot(tp.x - x, tp.y - y) >= self.p.merge_radius for x, y in seen):
+                    self.opponents.append((tp.x, tp.y))
+            for tp in order.own:
+                if tp.robot != self.n:
+                    mates[tp.robot] = (tp.x, tp.y, tp.role)
+        self.mates = mates
+        near = [(r.x, r.y) for r in sense.robots if r.team == self.team] if sense is not None else []
+        for x, y, _ in mates.values():
+            if all(math.hypot(x - a, y - b) >= self.p.merge_radius for a, b in near):
+                near.append((x, y))
+        self.mate_obstacles = near
+
+    def others(self) -> list[Vec]:
+        """Every other robot's position (obstacles): own detections first, then the base station's."""
+        return self.opponents + self.mate_obstacles
