@@ -1,0 +1,411 @@
+"""Recorder process: the match's MCAP log (docs/recording.md).
+
+The recorder does not subscribe to the match's data keys: every other process
+taps what it sends and publishes it in batches (runtime/tap.py), which costs
+the match a fraction of what a second copy of every frame would. The recorder
+collects the batches on `arena/<m>/tap/**` and writes:
+
+* one MCAP channel per data key, topic = the key without `arena/<m>/`
+  (`robot/a/1/cmd`), message encoding `msgpack`, the payload byte for byte, and
+  a schema record named after the key's message type (schema encoding `""`:
+  msgpack is self-describing; the types' JSON Schemas are in the `schemas`
+  metadata, for information);
+* `/scene` and `/referee_log`, the Foxglove layer (processes/scene.py);
+* metadata `arena` (configuration, seed, strategies, git revision), `versions`,
+  `schemas`, one `summary/<process>` per process Summary, and `recording`
+  (complete or not).
+
+Log time = publish time = the frame's tick x dt, in ns of simulated time.
+Records are written in the order (tick, process in `cfg.processes()` order,
+send order within the process), which depends only on (configuration, seed):
+a process's batch carries a watermark tick, and frames are written once every
+process's watermark has passed them.
+
+Crash safety: SIGTERM and SIGINT finish the file (summary section, footer).
+A chunk is closed and flushed to the OS every `FLUSH_TICKS` of simulated time,
+so after SIGKILL the file is readable up to the last whole chunk.
+
+Cost: the recorder is never on the lockstep's critical path (nobody waits for
+it), so it runs at a lower CPU priority (`NICE`) and catches up in the gaps
+the lockstep leaves; its work per message is kept small (processes/mcap_out.py).
+"""
+
+from __future__ import annotations
+
+import bisect
+import importlib.metadata
+import os
+import platform
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+from typing import IO
+
+import msgspec
+
+from arena.processes import scene
+from arena.processes.mcap_out import McapWriter
+from arena.runtime.config import TEAMS, ConfigError
+from arena.runtime.keys import KEYS
+from arena.runtime.node import Node
+from arena.schemas.messages import EngineEvents, Referee, Summary, TapBatch, World
+
+FORMAT = "1"  # version of the layout described in docs/recording.md
+POLL_S = 0.02  # [s] wall: idle pause between polls of the tap and summary channels
+GONE_GRACE_S = 2.0  # [s] wall: after a peer's liveliness token vanished, wait this long for its last data
+FLUSH_TICKS = 50  # [ticks] close a chunk and flush it to the OS every second of simulated time
+CHUNK_SIZE = 1 << 20  # [bytes] upper bound of one uncompressed chunk (FLUSH_TICKS usually comes first)
+SCENE_HZ = 25.0  # [Hz] scene updates, at most one per world frame
+NICE = 19  # [-] added niceness (Linux): the lockstep processes come first when the cores are busy
+VERSIONED = ("soccer-arena", "eclipse-zenoh", "msgspec", "mcap", "foxglove-sdk", "pymunk", "numpy")
+NEVER = 1 << 62  # [ticks] watermark of a process that has sent its final batch
+
+
+class _Role(msgspec.Struct):
+    """The one field of an `Order` the scene labels need (decoding the rest is wasted)."""
+
+    role: str = ""
+
+
+def data_topics(cfg) -> list[tuple[str, object]]:
+    """(topic, KeySpec) for every data key of this match, in KEYS order."""
+    out = []
+    for spec in KEYS:
+        teams = TEAMS if "<team>" in spec.pattern else ("",)
+        numbers = range(cfg.robots) if "<n>" in spec.pattern else (None,)
+        out.extend((spec.rel(t, n), spec) for t in teams for n in numbers)
+    return out
+
+
+def git_revision() -> str:
+    """`git rev-parse HEAD` of the installed package's checkout, `-dirty` if tracked files
+    differ from it; best effort: `unknown` outside a checkout or without git."""
+    here = Path(__file__).resolve().parent
+
+    def git(*args: str) -> subprocess.CompletedProcess | None:
+        try:
+            return subprocess.run(["git", *args], cwd=here, capture_output=True, text=True, timeout=5)
+        except (OSError, subprocess.SubprocessError):
+            return None
+
+    head = git("rev-parse", "HEAD")
+    if head is None or head.returncode != 0 or not head.stdout.strip():
+        return "unknown"
+    dirty = git("diff", "--quiet", "HEAD")
+    return head.stdout.strip() + ("-dirty" if dirty is not None and dirty.returncode == 1 else "")
+
+
+def versions() -> dict[str, str]:
+    out = {"python": platform.python_version()}
+    for name in VERSIONED:
+        try:
+            out[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+class McapSink:
+    """The MCAP writer with this project's channels; counts messages per topic."""
+
+    def __init__(self, stream: IO[bytes], cfg, library: str):
+        self.stream = stream
+        self.writer = McapWriter(stream, chunk_size=CHUNK_SIZE, library=library)
+        self.channels: dict[str, int] = {}
+        self.counts: dict[str, int] = {}  # messages per topic (also each channel's next sequence number)
+        self._schemas: dict[str, int] = {}
+        self.types: dict[str, type] = {}  # schema name -> message type
+        for topic, spec in data_topics(cfg):
+            self.channels[topic] = self.writer.register_channel(
+                topic=topic,
+                message_encoding="msgpack",
+                schema_id=self._schema(spec.message),
+                metadata={
+                    "data_pair": spec.data_pair,
+                    "sender": spec.sender,
+                    "receivers": spec.receivers,
+                    "link_class": spec.link_class,
+                },
+            )
+        for topic in (scene.SCENE_TOPIC, scene.LOG_TOPIC):
+            s = scene.schema(topic)
+            sid = self.writer.register_schema(name=s.name, encoding=s.encoding, data=s.data)
+            self.channels[topic] = self.writer.register_channel(topic=topic, message_encoding="protobuf", schema_id=sid)
+        self.counts = dict.fromkeys(self.channels, 0)
+
+    def _schema(self, msg_type: type) -> int:
+        name = msg_type.__name__
+        if name not in self._schemas:
+            self._schemas[name] = self.writer.register_schema(name=name, encoding="", data=b"")
+            self.types[name] = msg_type
+        return self._schemas[name]
+
+    def add(self, topic: str, ns: int, payload: bytes) -> None:
+        ch = self.channels.get(topic)
+        if ch is None:  # a key this match's configuration does not know: keep it anyway
+            ch = self.channels[topic] = self.writer.register_channel(topic=topic, message_encoding="msgpack", schema_id=0)
+            self.counts[topic] = 0
+        seq = self.counts[topic]
+        self.counts[topic] = seq + 1
+        self.writer.add_message(ch, ns, payload, ns, seq)
+
+    def metadata(self, name: str, data: dict[str, str]) -> None:
+        self.writer.add_metadata(name, data)
+
+    def flush(self) -> None:
+        self.writer.flush_chunk()
+
+    def finish(self) -> None:
+        self.writer.finish()
+        self.stream.close()
+
+
+class RecorderNode(Node):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        cfg = self.cfg
+        if not cfg.record:
+            raise ConfigError("this match does not record: start it with --record FILE.mcap")
+        self.path = cfg.record
+        self.peers = [str(p) for p in cfg.processes() if p.kind != "recorder"]
+        self.rank = {name: i for i, name in enumerate(self.peers)}
+        self.tap_in = self.transport.subscribe(self.keys.tap_all())
+        self.summary_in = self.transport.subscribe(self.keys.summary_all())
+        self._decode_batch = msgspec.msgpack.Decoder(TapBatch).decode
+        self._decode_summary = msgspec.msgpack.Decoder(Summary).decode
+        self._decode_world = msgspec.msgpack.Decoder(World).decode
+        self._decode_referee = msgspec.msgpack.Decoder(Referee).decode
+        self._decode_events = msgspec.msgpack.Decoder(EngineEvents).decode
+        self._decode_role = msgspec.msgpack.Decoder(_Role).decode
+        self.water = dict.fromkeys(self.peers, 0)  # per process: no frame below this tick will come
+        self.sent = dict.fromkeys(self.peers, 0)  # per process: frames received so far (send order)
+        self.batches = dict.fromkeys(self.peers, 0)  # per process: next expected batch number
+        self.finals: set[str] = set()
+        self.summaries: dict[str, Summary] = {}
+        self.pending: list[tuple[int, int, int, str, bytes]] = []  # (tick, rank, seq, topic, payload)
+        self.missing: list[str] = []
+        self.interrupted = ""
+        self.sink: McapSink | None = None
+        self.counts: dict[str, int] = {}  # messages written per topic
+        self.scene = scene.SceneBuilder(cfg)
+        dt = cfg.timing.dt
+        self._dt_ns = dt * 1e9
+        self._scene_every = max(1, round(1.0 / (SCENE_HZ * dt)))  # [ticks]
+        self._next_scene = 0
+        self._next_flush = FLUSH_TICKS
+        self._gone_since: dict[str, float] = {}
+        self._derive = self._derivations()
+        # The file is created before the start barrier: a path that cannot be
+        # written stops this process before anybody plays.
+        try:
+            self._open()
+        except OSError as exc:
+            raise ConfigError(f"cannot write --record {self.path}: {exc.strerror}") from None
+
+    # ------------------------------------------------------------------ file
+    def _open(self) -> None:
+        cfg = self.cfg
+        stream = open(self.path, "wb")  # noqa: SIM115 - closed by McapSink.finish
+        version = versions()
+        self.sink = McapSink(stream, cfg, library=f"soccer-arena/{version['soccer-arena']}")
+        self.counts = self.sink.counts
+        self.sink.metadata(
+            "arena",
+            {
+                "format": FORMAT,
+                "config": cfg.to_json(),
+                "seed": str(cfg.seed),
+                "home": cfg.home,
+                "away": cfg.away,
+                "robots": str(cfg.robots),
+                "half_time": repr(cfg.half_time),
+                "link": cfg.link,
+                "realtime": str(cfg.realtime).lower(),
+                "dt": repr(cfg.timing.dt),
+                "match": self.keys.match,
+                "processes": msgspec.json.encode(self.peers).decode(),
+                "git_revision": git_revision(),
+            },
+        )
+        self.sink.metadata("versions", version)
+        self.sink.metadata(
+            "schemas",
+            {name: msgspec.json.encode(msgspec.json.schema(t)).decode() for name, t in self.sink.types.items()},
+        )
+        self.sink.flush()
+
+    def _close(self) -> None:
+        if self.sink is None:
+            return
+        self.missing = [n for n in self.peers if n not in self.finals]
+        for name in self.peers:
+            s = self.summaries.get(name)
+            if s is not None:
+                self.sink.metadata(f"summary/{name}", {"json": msgspec.json.encode(s).decode()})
+        self.sink.metadata(
+            "recording",
+            {
+                "complete": str(not self.missing and not self.interrupted).lower(),
+                "missing": ",".join(self.missing),
+                "interrupted": self.interrupted,
+                "last_tick": str(self.last_tick),
+            },
+        )
+        self.sink.finish()
+        self.sink = None
+
+    # ----------------------------------------------------------------- intake
+    def _on_batch(self, raw: bytes) -> None:
+        try:
+            batch = self._decode_batch(raw)
+        except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+            self.rejections.reject(self.keys.tap_all(), "malformed", str(exc)[:120])
+            return
+        name = batch.process
+        rank = self.rank.get(name)
+        if rank is None:
+            self.rejections.reject(self.keys.tap(name), "unknown-process")
+            return
+        if batch.seq != self.batches[name]:
+            self.rejections.reject(self.keys.tap(name), "out-of-sequence", f"batch {batch.seq}, expected {self.batches[name]}")
+        self.batches[name] = batch.seq + 1
+        seq = self.sent[name]
+        for f in batch.frames:
+            self.pending.append((f.tick, rank, seq, f.key, f.payload))
+            seq += 1
+        self.sent[name] = seq
+        if batch.final:
+            self.finals.add(name)
+            self.water[name] = NEVER
+        else:
+            self.water[name] = max(self.water[name], batch.tick)
+
+    def _on_summary(self, raw: bytes) -> None:
+        try:
+            s = self._decode_summary(raw)
+        except (msgspec.DecodeError, msgspec.ValidationError):
+            return  # not ours to judge: the collector reports it
+        if s.process in self.rank:
+            self.summaries.setdefault(s.process, s)
+
+    def _drain(self) -> bool:
+        got = False
+        while (raw := self.tap_in.try_recv()) is not None:
+            self._on_batch(raw)
+            got = True
+        while (raw := self.summary_in.try_recv()) is not None:
+            self._on_summary(raw)
+            got = True
+        if got:
+            self._write_ready(min(self.water.values()))
+        return got
+
+    def _finished(self) -> bool:
+        now = time.monotonic()
+        for name in self.peers:
+            if name in self.finals and name in self.summaries:
+                continue
+            if name in self.gone:
+                since = self._gone_since.setdefault(name, now)
+                if name in self.summaries or now - since >= GONE_GRACE_S:
+                    continue
+            return False
+        return True
+
+    # ----------------------------------------------------------------- output
+    def _write_ready(self, watermark: int) -> None:
+        """Write every pending frame with a tick below `watermark`, in (tick, process, send) order."""
+        pending = self.pending
+        pending.sort()
+        cut = bisect.bisect_left(pending, watermark, key=lambda r: r[0])
+        if cut == 0:
+            return
+        ready, self.pending = pending[:cut], pending[cut:]
+        for tick, _, _, topic, payload in ready:
+            self._write(tick, topic, payload)
+
+    def _write(self, tick: int, topic: str, payload: bytes) -> None:
+        if tick >= self._next_flush:
+            self.sink.flush()
+            self._next_flush = tick - tick % FLUSH_TICKS + FLUSH_TICKS
+        ns = round(tick * self._dt_ns)
+        self.sink.add(topic, ns, payload)
+        if tick > self.last_tick:
+            self.last_tick = tick
+        derive = self._derive.get(topic)
+        if derive is not None:
+            try:
+                derive(tick, ns, payload)
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self.rejections.reject(topic, "malformed", str(exc)[:120])
+
+    # The Foxglove layer, derived from the frames as they are written.
+    def _derivations(self) -> dict[str, object]:
+        out: dict[str, object] = {"world": self._scene_frame, "referee": self._referee_log, "engine/events": self._events_log}
+        for team in TEAMS:
+            for n in range(self.cfg.robots):
+                out[f"team/{team}/order/{n}"] = self._role_of(team, n)
+        return out
+
+    def _scene_frame(self, tick: int, ns: int, payload: bytes) -> None:
+        if tick >= self._next_scene:
+            self._next_scene = tick + self._scene_every
+            self.sink.add(scene.SCENE_TOPIC, ns, self.scene.update(self._decode_world(payload), ns))
+
+    def _referee_log(self, tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG002 - derivation signature
+        for log in self.scene.referee_log(self._decode_referee(payload), ns):
+            self.sink.add(scene.LOG_TOPIC, ns, log)
+
+    def _events_log(self, tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG002 - derivation signature
+        for log in self.scene.events_log(self._decode_events(payload), ns):
+            self.sink.add(scene.LOG_TOPIC, ns, log)
+
+    def _role_of(self, team: str, n: int):
+        def role(tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG001 - derivation signature
+            self.scene.roles[(team, n)] = self._decode_role(payload).role
+
+        return role
+
+    # ------------------------------------------------------------------- loop
+    def _on_signal(self, stop: threading.Event):
+        def handler(signum, frame):  # noqa: ARG001 - signal handler signature
+            self.interrupted = signal.Signals(signum).name
+            stop.set()
+
+        return handler
+
+    def loop(self) -> None:
+        stop = threading.Event()
+        previous = {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                previous[sig] = signal.signal(sig, self._on_signal(stop))
+            os.nice(NICE)  # a process of its own (arena run recorder); never a test's thread
+        try:
+            silent_since = time.monotonic()
+            while not self._finished() and not stop.is_set():
+                if self._drain():
+                    silent_since = time.monotonic()
+                    continue
+                if time.monotonic() - silent_since > self.cfg.timing.wait_timeout:
+                    self.log.error("no tap batch for %g s: closing the recording", self.cfg.timing.wait_timeout)
+                    break
+                time.sleep(POLL_S)
+            self._drain()
+            self._write_ready(NEVER)
+        finally:
+            self._close()
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+        if self.interrupted:
+            raise SystemExit(128 + signal.Signals[self.interrupted].value)
+
+    def summary_extra(self) -> dict[str, object]:
+        return {
+            "path": self.path,
+            "messages": dict(sorted(self.counts.items())),
+            "complete": not self.missing and not self.interrupted,
+            "missing": self.missing,
+        }

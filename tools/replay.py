@@ -1,0 +1,208 @@
+"""`arena replay FILE.mcap --process robot/a/1`: one process against its recorded inputs.
+
+A lockstep match is a pure function of (configuration, seed), and so is each
+process given its inputs. Replay rebuilds the `MatchConfig` from the file's
+metadata and runs that ONE process's `Node` class (processes/__init__.py)
+over an in-memory bus, in this process:
+
+1. the other processes' liveliness tokens are faked on the bus, so the node
+   passes its start barrier as in the match;
+2. every frame recorded on each of its input keys is put on the bus, in the
+   order its sender sent them. The node's own link emulators, seeded from the
+   configuration, drop and delay exactly the frames they did in the match;
+3. once the node plays, the other processes' tokens are withdrawn: their
+   wake-ups queue behind the recorded frames, so the node uses every recorded
+   frame and stops waiting only where the recording ends (a truncated file);
+4. what the node publishes on its output keys is compared, frame by frame,
+   with what the file recorded for that process.
+
+The result is `match: true`, or the first frame (lowest tick) that differs,
+with its key and both decoded values. Any robot, both base stations, the
+referee and the engine can be replayed. A real-time match is not
+deterministic and cannot be replayed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+import threading
+from dataclasses import dataclass, field
+
+import msgspec
+
+from arena.processes import node_class
+from arena.runtime.config import ConfigError, ProcessId
+from arena.runtime.keys import Keys
+from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.tools.recording import Recording, RecordingError, load
+
+REPLAY_TIMEOUT = 600.0  # [s] wall: give up on a replay that does not finish (a bug, never a slow file)
+
+
+class ReplayError(ValueError):
+    """The replay cannot be done; the message is one line."""
+
+
+@dataclass
+class Difference:
+    tick: int
+    key: str
+    index: int  # frame number on that key, from 0
+    recorded: object  # decoded msgpack (None: no such frame recorded)
+    replayed: object  # decoded msgpack (None: the replay sent no such frame)
+    fields: list[str] = field(default_factory=list)  # top-level fields that differ
+
+
+@dataclass
+class ReplayResult:
+    process: str
+    match: bool
+    frames: int  # output frames compared
+    keys: dict[str, int]  # output frames compared per key
+    first_difference: Difference | None = None
+    digest_match: bool | None = None  # the replay's digest against the recorded Summary's (None: not recorded)
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def _decode(payload: bytes | None) -> object:
+    return None if payload is None else msgspec.msgpack.decode(payload)
+
+
+def _difference(key: str, index: int, recorded: bytes | None, replayed: bytes | None) -> Difference:
+    a, b = _decode(recorded), _decode(replayed)
+    frame = a if isinstance(a, dict) else b
+    tick = frame.get("tick", -1) if isinstance(frame, dict) else -1
+    fields = []
+    if isinstance(a, dict) and isinstance(b, dict):
+        fields = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
+    return Difference(tick=tick, key=key, index=index, recorded=a, replayed=b, fields=fields)
+
+
+def replay(source: str | Recording, process: str) -> ReplayResult:
+    """Replay `process` (e.g. "robot/a/1", "a/1", "basestation/b") from a recording."""
+    rec = source if isinstance(source, Recording) else load(source)
+    try:
+        pid = ProcessId.parse(process)
+    except ConfigError as exc:
+        raise ReplayError(str(exc)) from None
+    cfg = rec.cfg
+    if pid.kind == "recorder" or pid not in cfg.processes():
+        raise ReplayError(f"{process}: no such process in this recording ({cfg.robots} robots per team)")
+    if cfg.realtime:
+        raise ReplayError("this match ran with --realtime, which is not deterministic: only lockstep matches replay")
+    cfg = cfg.replace(record="")  # the replayed node taps nothing
+    name = str(pid)
+    bus = MemoryBus()
+    keys = Keys("replay")
+    node = node_class(pid.kind)(pid, cfg, MemoryTransport(bus), keys)
+    outputs = [(keys.rel(ob.key), bus.subscribe(None, ob.key)) for ob in node.outbound]
+    for ib in node.inbound:
+        for payload in rec.payloads(keys.rel(ib.key)):
+            bus.deliver(ib.key, payload)
+    others = [str(p) for p in cfg.processes() if p != pid]
+    token_owner = object()
+    for other in others:
+        bus.set_alive(keys.alive(other), token_owner, True)
+
+    playing = threading.Event()
+    errors: list[BaseException] = []
+    summary = []
+    loop = node.loop
+
+    def play() -> None:
+        playing.set()
+        loop()
+
+    node.loop = play
+
+    def run() -> None:
+        try:
+            summary.append(node.run())
+        except BaseException as exc:  # handed to the caller below
+            errors.append(exc)
+        finally:
+            playing.set()
+
+    thread = threading.Thread(target=run, name=f"replay {name}", daemon=True)
+    thread.start()
+    playing.wait(REPLAY_TIMEOUT)
+    for other in others:
+        bus.set_alive(keys.alive(other), token_owner, False)
+    thread.join(REPLAY_TIMEOUT)
+    if thread.is_alive():
+        raise ReplayError(f"{name} did not finish within {REPLAY_TIMEOUT:g} s")
+    if errors:
+        raise errors[0]
+
+    first: Difference | None = None
+    counts: dict[str, int] = {}
+    for rel, channel in outputs:
+        got = []
+        while (raw := channel.try_recv()) is not None:
+            got.append(raw)
+        want = rec.payloads(rel)
+        if rec.truncated:
+            got = got[: len(want)]  # the recording ends early; compare what it has
+        counts[rel] = min(len(got), len(want))
+        for i in range(max(len(got), len(want))):
+            a = want[i] if i < len(want) else None
+            b = got[i] if i < len(got) else None
+            if a != b:
+                d = _difference(rel, i, a, b)
+                if first is None or d.tick < first.tick:
+                    first = d
+                break
+    recorded_summary = rec.summaries.get(name)
+    digest_match = None
+    if recorded_summary is not None and summary and not rec.truncated:
+        digest_match = recorded_summary.digest == summary[0].digest
+    note = f"recording truncated ({rec.problem}): compared up to its end" if rec.truncated else ""
+    return ReplayResult(
+        process=name,
+        match=first is None,
+        frames=sum(counts.values()),
+        keys=counts,
+        first_difference=first,
+        digest_match=digest_match,
+        note=note,
+    )
+
+
+def _describe(r: ReplayResult) -> str:
+    if r.match:
+        digest = {True: ", digest equal", False: ", but the digest differs", None: ""}[r.digest_match]
+        return f"{r.process}: match: true ({r.frames} frames on {len(r.keys)} keys{digest})"
+    d = r.first_difference
+    lines = [f"{r.process}: match: false, first difference at tick {d.tick} on {d.key} (frame {d.index})"]
+    if isinstance(d.recorded, dict) and isinstance(d.replayed, dict):
+        for f in d.fields:
+            lines.append(f"  {f}: recorded {d.recorded.get(f)!r}, replayed {d.replayed.get(f)!r}")
+    else:
+        lines.append(f"  recorded: {d.recorded!r}")
+        lines.append(f"  replayed: {d.replayed!r}")
+    return "\n".join(lines)
+
+
+def main(path: str, processes: list[str], as_json: bool = False) -> int:
+    try:
+        rec = load(path)
+        names = [str(p) for p in rec.cfg.processes() if p.kind != "recorder"] if "all" in processes else processes
+        results = [replay(rec, p) for p in names]
+    except (RecordingError, ReplayError) as exc:
+        print(f"arena replay: error: {exc}", file=sys.stderr)
+        return 2
+    ok = all(r.match for r in results)
+    if as_json:
+        out = results[0].to_dict() if len(results) == 1 else {"match": ok, "results": [r.to_dict() for r in results]}
+        print(json.dumps(out, indent=2))
+    else:
+        for r in results:
+            print(_describe(r))
+            if r.note:
+                print(f"  ({r.note})")
+    return 0 if ok else 1

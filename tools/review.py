@@ -1,0 +1,387 @@
+"""`arena review FILE.mcap`: what happened in a recorded match.
+
+Everything comes from the recording itself (tools/recording.py):
+
+* teams, strategies, seed: the `arena` metadata (the match configuration);
+* score, goal timeline, restarts by type: the `referee` frames;
+* possession and the trajectories: the ground-truth `world` frames. A frame
+  counts for the team whose robot holds the ball on its dribbler, else for the
+  team of the robot nearest the ball if it is within `POSSESSION_RADIUS`, else
+  for nobody (a loose ball);
+* distance per robot: the engine's Summary (physics at 250 Hz, the number
+  `arena match` reports), or the world frames when the file has no summary;
+* applied link statistics and per-process tick timing: the processes'
+  Summaries, which the recorder stores as metadata at the end of the match.
+
+A truncated recording (the recorder was killed) is reviewed up to where it
+ends, and the report says so. `--plots DIR` adds PNG charts and an animated
+GIF (matplotlib, Agg backend, PillowWriter).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from arena.schemas.messages import Referee, World
+from arena.tools.recording import Recording, RecordingError, load
+
+POSSESSION_RADIUS = 0.5  # [m] robot centre to ball centre: within this the nearest robot's team has the ball
+RESTARTS = ("KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL")  # MSL RefBox
+JUMP = 0.5  # [m] a move longer than this between two world frames is a placement, not driving
+GIF_FRAMES = 100  # [-] at most this many frames in the animation (Pillow encodes ~30 ms each)
+GIF_FPS = 10  # [1/s]
+TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in the Foxglove scene
+NEEDED = frozenset({"world", "referee"})
+
+
+def _percentiles(values: list[float]) -> dict[str, float]:
+    if not values:
+        return {"p50": 0.0, "p95": 0.0, "p99": 0.0, "max": 0.0}
+    a = np.asarray(values, dtype=float)
+    return {
+        "p50": round(float(np.percentile(a, 50)), 3),
+        "p95": round(float(np.percentile(a, 95)), 3),
+        "p99": round(float(np.percentile(a, 99)), 3),
+        "max": round(float(a.max()), 3),
+    }
+
+
+def _link_stats(rec: Recording) -> dict[str, dict]:
+    """Per link class and per (receiving process, class): frames, drops, delay percentiles."""
+    per_class: dict[str, dict] = {}
+    per_process: dict[str, dict] = {}
+    for name, s in rec.summaries.items():
+        for cls, agg in s.links.items():
+            frames, dropped = int(agg.get("frames", 0)), int(agg.get("dropped", 0))
+            delays = s.delays_ms.get(cls, [])
+            acc = per_class.setdefault(cls, {"frames": 0, "dropped": 0, "_d": []})
+            acc["frames"] += frames
+            acc["dropped"] += dropped
+            acc["_d"].extend(delays)
+            per_process.setdefault(name, {})[cls] = {
+                "frames": frames,
+                "dropped": dropped,
+                "drop_percent": round(100.0 * dropped / frames, 3) if frames else 0.0,
+                "delay_ms": _percentiles(delays),
+            }
+    for acc in per_class.values():
+        d = acc.pop("_d")
+        acc["drop_percent"] = round(100.0 * acc["dropped"] / acc["frames"], 3) if acc["frames"] else 0.0
+        acc["delay_ms"] = _percentiles(d)
+    return {"by_class": dict(sorted(per_class.items())), "by_process": per_process}
+
+
+def analyse(rec: Recording) -> dict:
+    """The review as one JSON-able dict."""
+    cfg = rec.cfg
+    dt = cfg.timing.dt
+    refs: list[Referee] = rec.decoded("referee", Referee)
+    worlds: list[World] = rec.decoded("world", World)
+    score = [refs[-1].score_a, refs[-1].score_b] if refs else [0, 0]
+    goals, restarts, commands = [], Counter(), Counter()
+    for r in refs:
+        for c in r.commands:
+            commands[c.name] += 1
+            if c.name in RESTARTS:
+                restarts[f"{c.name} {c.team}".strip()] += 1
+            if c.name == "GOAL":
+                goals.append({"tick": c.tick, "t": round(c.tick * dt, 2), "team": c.team, "score": [r.score_a, r.score_b]})
+    # possession and distance from the ground truth
+    holds = Counter()
+    dist: dict[str, float] = {}
+    last: dict[str, tuple[float, float]] = {}
+    for w in worlds:
+        holder = ""
+        best = POSSESSION_RADIUS
+        for rb in w.robots:
+            name = f"{rb.team}/{rb.robot}"
+            if name in last:
+                px, py = last[name]
+                step = math.hypot(rb.x - px, rb.y - py)
+                dist[name] = dist.get(name, 0.0) + (step if step <= JUMP else 0.0)
+            last[name] = (rb.x, rb.y)
+            if rb.has_ball:
+                holder, best = rb.team, -1.0
+            d = math.hypot(rb.x - w.ball_x, rb.y - w.ball_y)
+            if d < best:
+                holder, best = rb.team, d
+        holds[holder or "loose"] += 1
+    held = holds["a"] + holds["b"]
+    possession = {
+        "a": round(100.0 * holds["a"] / held, 1) if held else 0.0,
+        "b": round(100.0 * holds["b"] / held, 1) if held else 0.0,
+        "loose_percent_of_time": round(100.0 * holds["loose"] / len(worlds), 1) if worlds else 0.0,
+    }
+    engine = rec.summaries.get("engine")
+    if engine is not None and engine.extra.get("distance_m"):
+        distance, source = dict(engine.extra["distance_m"]), "engine summary"
+    else:
+        distance, source = {k: round(v, 3) for k, v in sorted(dist.items())}, "world frames"
+    timing = {}
+    for name in [str(p) for p in cfg.processes()]:
+        s = rec.summaries.get(name)
+        if s is None:
+            continue
+        timing[name] = {
+            "tick_us_median": round(s.tick_us[0], 1) if s.tick_us else None,
+            "tick_us_p95": round(s.tick_us[1], 1) if s.tick_us else None,
+            "wall_s": round(s.wall_s, 3),
+            "cpu_s": round(sum(s.cpu_s), 3) if s.cpu_s else None,
+        }
+    last_tick = worlds[-1].tick if worlds else 0
+    return {
+        "file": rec.path,
+        "truncated": rec.truncated,
+        "truncation": rec.problem,
+        "complete": rec.complete,
+        "home": cfg.home,
+        "away": cfg.away,
+        "seed": cfg.seed,
+        "robots": cfg.robots,
+        "link": cfg.link,
+        "git_revision": rec.meta.get("arena", {}).get("git_revision", "unknown"),
+        "score": score,
+        "ticks": last_tick,
+        "sim_seconds": round(last_tick * dt, 3),
+        "planned_ticks": cfg.total_ticks,
+        "planned_sim_seconds": round(cfg.total_ticks * dt, 3),
+        "goals": goals,
+        "restarts": dict(sorted(restarts.items())),
+        "commands": dict(sorted(commands.items())),
+        "possession_percent": possession,
+        "distance_m": distance,
+        "distance_source": source,
+        "links": _link_stats(rec),
+        "timing": timing,
+        "summaries": sorted(rec.summaries),
+        "messages": dict(sorted(rec.counts.items())),
+    }
+
+
+# ------------------------------------------------------------------ output
+def print_review(r: dict, console: Console | None = None) -> None:
+    console = console or Console()
+    a, b = r["score"]
+    console.print(f"[bold]{r['home']}[/] (a) [bold]{a} : {b}[/] [bold]{r['away']}[/] (b)   seed {r['seed']}, link {r['link']}")
+    console.print(f"{r['sim_seconds']:.1f} s of {r['planned_sim_seconds']:.1f} s recorded; git {r['git_revision'][:12]}")
+    if r["truncated"]:
+        console.print(f"[yellow]truncated recording: {r['truncation']}; reviewed up to {r['sim_seconds']:.1f} s[/]")
+    elif not r["complete"]:
+        console.print("[yellow]incomplete recording: the recorder missed some process's last batch[/]")
+    if r["goals"]:
+        console.print("goals: " + ", ".join(f"{g['t']:.1f} s {g['team']} ({g['score'][0]}:{g['score'][1]})" for g in r["goals"]))
+    else:
+        console.print("goals: none")
+    console.print("restarts: " + (", ".join(f"{k} {v}" for k, v in r["restarts"].items()) or "none"))
+    p = r["possession_percent"]
+    console.print(f"possession: a {p['a']:.1f} %, b {p['b']:.1f} % (ball loose {p['loose_percent_of_time']:.1f} % of the time)")
+    d = Table(title="distance per robot", caption=f"from the {r['distance_source']}")
+    d.add_column("robot")
+    d.add_column("[m]", justify="right")
+    for name, m in r["distance_m"].items():
+        d.add_row(name, f"{m:.1f}")
+    console.print(d)
+    links = r["links"]["by_class"]
+    if links:
+        t = Table(title="links (applied by the receivers)")
+        for col in ("class", "frames", "dropped", "drop %", "delay p50 ms", "p95 ms", "p99 ms"):
+            t.add_column(col, justify="right")
+        for cls, s in links.items():
+            dm = s["delay_ms"]
+            t.add_row(cls, str(s["frames"]), str(s["dropped"]), f"{s['drop_percent']:.2f}", f"{dm['p50']:.2f}", f"{dm['p95']:.2f}", f"{dm['p99']:.2f}")
+        console.print(t)
+    else:
+        console.print("[yellow]links: no process summaries in the file[/]")
+    if r["timing"]:
+        t = Table(title="per-process tick timing (own work)")
+        for col in ("process", "median us", "p95 us", "wall s", "cpu s"):
+            t.add_column(col, justify="right")
+        for name, s in r["timing"].items():
+            t.add_row(
+                name,
+                f"{s['tick_us_median']:.0f}" if s["tick_us_median"] is not None else "-",
+                f"{s['tick_us_p95']:.0f}" if s["tick_us_p95"] is not None else "-",
+                f"{s['wall_s']:.2f}",
+                f"{s['cpu_s']:.2f}" if s["cpu_s"] is not None else "-",
+            )
+        console.print(t)
+
+
+# ------------------------------------------------------------------- plots
+def _draw_field(ax, cfg, grass: bool = True) -> None:
+    from matplotlib.patches import Arc, Circle, Rectangle
+
+    f = cfg.field
+    hl, hw = f.length / 2, f.width / 2
+    if grass:
+        ax.set_facecolor("#2e7d32")
+    ax.add_patch(Rectangle((-hl, -hw), f.length, f.width, fill=False, ec="white", lw=1.5))
+    ax.plot([0, 0], [-hw, hw], color="white", lw=1)
+    ax.add_patch(Circle((0, 0), f.center_circle_radius, fill=False, ec="white", lw=1))
+    for side in (-1, 1):
+        gx = side * hl
+        for depth, width in ((f.penalty_area_depth, f.penalty_area_width), (f.goal_area_depth, f.goal_area_width)):
+            x0 = gx if side < 0 else gx - depth
+            ax.add_patch(Rectangle((x0, -width / 2), depth, width, fill=False, ec="white", lw=1))
+        x0 = gx if side > 0 else gx - f.goal_depth
+        ax.add_patch(Rectangle((x0, -f.goal_width / 2), f.goal_depth, f.goal_width, fc="white", alpha=0.5, ec="white"))
+        for cy in (-hw, hw):
+            # the quarter of the corner circle that lies inside the field
+            start = {(1, -1): 90, (1, 1): 180, (-1, 1): 270, (-1, -1): 0}[(side, 1 if cy > 0 else -1)]
+            ax.add_patch(
+                Arc((gx, cy), 2 * f.corner_arc_radius, 2 * f.corner_arc_radius, theta1=start, theta2=start + 90, color="white", lw=1)
+            )
+    ax.set_xlim(-hl - f.runoff, hl + f.runoff)
+    ax.set_ylim(-hw - f.runoff, hw + f.runoff)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+
+
+def write_plots(rec: Recording, review: dict, out_dir: str) -> list[str]:
+    """PNG charts and an animated GIF of the match; returns the paths written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = rec.cfg
+    worlds: list[World] = rec.decoded("world", World)
+    written = []
+    names = sorted({f"{r.team}/{r.robot}" for w in worlds for r in w.robots})
+    tracks = {n: ([], []) for n in names}
+    ball = ([], [])
+    for w in worlds:
+        _extend(ball, w.ball_x, w.ball_y)
+        for r in w.robots:
+            _extend(tracks[f"{r.team}/{r.robot}"], r.x, r.y)
+
+    fig, ax = plt.subplots(figsize=(10, 7))
+    _draw_field(ax, cfg)
+    for n, (xs, ys) in tracks.items():
+        ax.plot(xs, ys, color=TEAM_COLOURS[n[0]], lw=0.8, alpha=0.7, label=n)
+    ax.plot(ball[0], ball[1], color="orange", lw=0.8, alpha=0.9, label="ball")
+    ax.legend(loc="upper right", fontsize=7, ncol=2)
+    ax.set_title(f"trajectories: {cfg.home} (a) vs {cfg.away} (b), seed {cfg.seed}")
+    written.append(_save(fig, out / "trajectories.png"))
+
+    fig, axes = plt.subplots(1, 3, figsize=(18, 5))
+    f = cfg.field
+    extent = [[-f.length / 2 - f.runoff, f.length / 2 + f.runoff], [-f.width / 2 - f.runoff, f.width / 2 + f.runoff]]
+    for ax, (title, xs, ys) in zip(
+        axes,
+        [
+            ("ball", ball[0], ball[1]),
+            *(
+                (
+                    f"team {team}",
+                    [x for n in names if n[0] == team for x in tracks[n][0]],
+                    [y for n in names if n[0] == team for y in tracks[n][1]],
+                )
+                for team in "ab"
+            ),
+        ],
+    ):
+        ok = ~np.isnan(np.asarray(xs, dtype=float))
+        h, xe, ye = np.histogram2d(np.asarray(xs)[ok], np.asarray(ys)[ok], bins=[28, 20], range=extent)
+        ax.imshow(h.T, origin="lower", extent=[xe[0], xe[-1], ye[0], ye[-1]], cmap="magma", aspect="equal")
+        _draw_field(ax, cfg, grass=False)
+        ax.set_title(f"heatmap: {title}")
+        ax.set_xlabel("x [m]")
+    written.append(_save(fig, out / "heatmap.png"))
+
+    fig, ax = plt.subplots(figsize=(9, 4))
+    end = review["sim_seconds"]
+    for i, team in enumerate("ab"):
+        times = [0.0] + [g["t"] for g in review["goals"]] + [end]
+        scores = [0] + [g["score"][i] for g in review["goals"]] + [review["score"][i]]
+        ax.step(
+            times, scores, where="post", color=TEAM_COLOURS[team], ls="-" if team == "a" else "--", lw=2,
+            label=f"{team}: {review['home' if team == 'a' else 'away']}",
+        )
+    ax.axvline(cfg.half_time, color="grey", ls=":", lw=0.8)
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_ylim(-0.1, max(1, *review["score"]) + 0.5)
+    ax.set_xlabel("simulated time [s]")
+    ax.set_ylabel("goals")
+    ax.set_title("score")
+    ax.legend()
+    written.append(_save(fig, out / "score.png"))
+
+    if worlds:
+        written.append(_animate(worlds, cfg, out / "match.gif"))
+    return written
+
+
+def _extend(track: tuple[list[float], list[float]], x: float, y: float) -> None:
+    """Append a point; a jump (a restart placement) breaks the line instead of drawing it."""
+    xs, ys = track
+    if xs and not math.isnan(xs[-1]) and math.hypot(x - xs[-1], y - ys[-1]) > JUMP:
+        xs.append(math.nan)
+        ys.append(math.nan)
+    xs.append(x)
+    ys.append(y)
+
+
+def _save(fig, path: Path) -> str:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return str(path)
+
+
+def _animate(worlds: list[World], cfg, path: Path) -> str:
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    step = max(1, math.ceil(len(worlds) / GIF_FRAMES))
+    frames = worlds[::step]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    _draw_field(ax, cfg)
+    ax.set_axis_off()  # axes and ticks would cost most of the drawing time of every frame
+    teams = [r.team for r in frames[0].robots]
+    robots = ax.scatter([0] * len(teams), [0] * len(teams), s=80, c=[TEAM_COLOURS[t] for t in teams], marker="s", edgecolors="black")
+    ball = ax.scatter([0], [0], s=30, c="orange", edgecolors="black", zorder=3)
+    title = ax.set_title("")
+
+    def draw(w: World):
+        robots.set_offsets([[r.x, r.y] for r in w.robots])
+        ball.set_offsets([[w.ball_x, w.ball_y]])
+        title.set_text(f"t = {w.t:.1f} s")
+        return robots, ball, title
+
+    anim = FuncAnimation(fig, draw, frames=frames, blit=False)
+    anim.save(path, writer=PillowWriter(fps=GIF_FPS), dpi=60)
+    plt.close(fig)
+    return str(path)
+
+
+def main(path: str, plots: str | None = None, as_json: bool = False) -> int:
+    try:
+        rec = load(path, keep=NEEDED)
+    except RecordingError as exc:
+        print(f"arena review: error: {exc}", file=sys.stderr)
+        return 2
+    review = analyse(rec)
+    if plots:
+        review["plots"] = write_plots(rec, review, plots)
+    if as_json:
+        print(json.dumps(review, indent=2))
+    else:
+        print_review(review)
+        for p in review.get("plots", []):
+            print(f"wrote {p}")
+    return 0
