@@ -20,12 +20,15 @@ EXAMPLES = {
   arena match --home BS --away BS --half-time 30 --seed 7 --json
   arena match --home AD --away BS --link congested-wifi --link-param wifi.latency_ms=30
   arena match --home BS --away BS --external a/1      # start robot a/1 by hand (HIL)
-  arena match --home BS --away BS --realtime --half-time 5""",
+  arena match --home BS --away BS --realtime --half-time 5
+  arena match --home BS --away AD --half-time 60 --record match.mcap   # then: arena review match.mcap""",
     "run": """examples:
   # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
   arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
-  arena run router --match demo --listen tcp/0.0.0.0:7447""",
+  arena run router --match demo --listen tcp/0.0.0.0:7447
+  # a recorder on another machine (the match was started with --record ... --external recorder)
+  arena run recorder --match demo --connect tcp/192.168.1.10:7447 --record out.mcap""",
     "up": """examples:
   arena up compose.yaml            # the services of compose.yaml as local processes
   arena up compose.yaml --json""",
@@ -36,7 +39,17 @@ EXAMPLES = {
   arena tournament --link congested-wifi --jobs 2 --json""",
     "bench": """examples:
   arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
-  arena bench match --runs 5 --half-time 120 --link wifi""",
+  arena bench match --runs 5 --half-time 120 --link wifi
+  arena bench record               # median rtf with and without --record, and the ratio
+  arena bench robot                # median us per robot control step and per F-SFM step""",
+    "review": """examples:
+  arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
+  arena review match.mcap --json
+  arena review match.mcap --plots plots/     # PNG charts and an animated GIF of the match""",
+    "replay": """examples:
+  arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
+  arena replay match.mcap --process basestation/b --json
+  arena replay match.mcap --process all                # every process of the match""",
     "schemas": """examples:
   arena schemas --check            # is schemas/README.md up to date with schemas/messages.py?
   arena schemas --write""",
@@ -92,6 +105,7 @@ def build_parser() -> Parser:
     m.add_argument("--logs", metavar="DIR", help="keep every process's log in DIR")
     m.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     m.add_argument("--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up")
+    m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
 
     r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
     r.add_argument("kind", choices=[*KINDS, "router"], help="process kind")
@@ -107,6 +121,11 @@ def build_parser() -> Parser:
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
     r.add_argument("--startup-timeout", type=float, default=60.0, metavar="S", help="wait for the match (60)")
     r.add_argument("--log-level", default="WARNING", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
+    r.add_argument(
+        "--record",
+        metavar="PATH",
+        help="recorder: write the MCAP file here; engine without --config: the match records",
+    )
     eng = r.add_argument_group("engine only: the match it hosts when no --config is given")
     _add_match_flags(eng, required=False, seed=False)
 
@@ -129,12 +148,32 @@ def build_parser() -> Parser:
     t.add_argument("--json", action="store_true", help="print one JSON object")
 
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
-    b.add_argument("what", choices=["match"], help="what to measure")
+    b.add_argument(
+        "what", choices=["match", "record", "robot"],
+        help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step",
+    )
+    b.add_argument("--strategy", default="advance-dynamic", metavar="NAME", help="robot: strategy to time (AD)")
     b.add_argument("--runs", type=int, default=3, metavar="N", help="runs (3)")
     b.add_argument("--half-time", type=float, default=60.0, metavar="SECONDS", help="half length (60)")
     b.add_argument("--robots", type=int, default=3, metavar="N")
     b.add_argument("--link", default="ideal", metavar="PRESET")
     b.add_argument("--json", action="store_true")
+
+    v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
+    v.add_argument("file", help="an MCAP file written by arena match --record")
+    v.add_argument("--plots", metavar="DIR", help="also write PNG charts and an animated GIF into DIR")
+    v.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
+
+    y = add("replay", "re-run one process against its recorded inputs and compare its outputs")
+    y.add_argument("file", help="an MCAP file written by arena match --record (lockstep)")
+    y.add_argument(
+        "--process",
+        action="append",
+        required=True,
+        metavar="PROC",
+        help="robot/a/1 (or a/1), basestation/b, engine, referee, or all (repeatable)",
+    )
+    y.add_argument("--json", action="store_true", help="print JSON instead of text")
 
     s = add("schemas", "the wire contract: check or rewrite schemas/README.md from schemas/messages.py")
     g = s.add_mutually_exclusive_group()
@@ -143,7 +182,7 @@ def build_parser() -> Parser:
     return top
 
 
-def match_config(args: argparse.Namespace, realtime: bool = False, external=()) -> MatchConfig:
+def match_config(args: argparse.Namespace, realtime: bool = False, external=(), record: str = "") -> MatchConfig:
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
 
@@ -163,6 +202,7 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=()) 
         link=args.link,
         link_overrides=overrides,
         realtime=realtime,
+        record=record,
         external=tuple(ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e)) for e in external),
     )
     cfg.validate()
@@ -172,7 +212,8 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=()) 
 def cmd_match(args: argparse.Namespace) -> int:
     from arena.tools import launcher, report
 
-    cfg = match_config(args, realtime=args.realtime, external=args.external)
+    record = record_path(args.record) if args.record else ""
+    cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
     if args.match:
         from arena.runtime.keys import check_match_id
 
@@ -206,6 +247,18 @@ def cmd_match(args: argparse.Namespace) -> int:
     return 0
 
 
+def record_path(text: str) -> str:
+    """An absolute path for a new MCAP file whose directory exists (children may run elsewhere)."""
+    from pathlib import Path
+
+    path = Path(text).expanduser().resolve()
+    if not path.parent.is_dir():
+        raise ConfigError(f"--record {text}: directory {path.parent} does not exist")
+    if path.is_dir():
+        raise ConfigError(f"--record {text} is a directory")
+    return str(path)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from arena.runtime.session import NetConfig
     from arena.tools import run as runner
@@ -224,7 +277,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.config:
             cfg = runner.load_config(args.config)
         elif args.kind == "engine":
-            cfg = match_config(args, realtime=args.realtime)
+            cfg = match_config(args, realtime=args.realtime, record=record_path(args.record) if args.record else "")
+        if args.record and args.kind not in ("engine", "recorder"):
+            raise ConfigError(f"--record does not apply to {args.kind}")
+        record = record_path(args.record) if args.record and args.kind == "recorder" else None
         from arena.runtime.keys import check_match_id
 
         check_match_id(args.match)
@@ -232,7 +288,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"arena run: error: {exc}", file=sys.stderr)
         return 2
     return runner.main_guarded(
-        runner.run, pid, args.match, net, cfg, args.seed, args.realtime, args.startup_timeout
+        runner.run, pid, args.match, net, cfg, args.seed, args.realtime, args.startup_timeout, record
     )
 
 
@@ -281,7 +337,23 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from arena.tools import bench
 
+    if args.what == "record":
+        return bench.bench_record(args)
+    if args.what == "robot":
+        return bench.bench_robot(args)
     return bench.bench_match(args)
+
+
+def cmd_review(args: argparse.Namespace) -> int:
+    from arena.tools import review
+
+    return review.main(args.file, plots=args.plots, as_json=args.json)
+
+
+def cmd_replay(args: argparse.Namespace) -> int:
+    from arena.tools import replay
+
+    return replay.main(args.file, args.process, as_json=args.json)
 
 
 def cmd_schemas(args: argparse.Namespace) -> int:
@@ -294,7 +366,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handlers = {"match": cmd_match, "run": cmd_run, "up": cmd_up, "bench": cmd_bench, "schemas": cmd_schemas,
-                "tournament": cmd_tournament}
+                "tournament": cmd_tournament, "review": cmd_review, "replay": cmd_replay}
     try:
         return handlers[args.command](args)
     except ConfigError as exc:

@@ -1,14 +1,17 @@
 """Base station process: the team's fused world model, strategy and roles.
 
 Inputs: every robot's `report` (Wi-Fi, every comm period, phase 0, lag 1) and
-the `referee` frames (wired, lag 1). Every comm period (phase 1) it runs the
-strategy's team brain and sends one `order` per robot over Wi-Fi.
+the `referee` frames (wired, lag 1; a frame with a command that is not an MSL
+RefBox command, or aimed at a team that does not exist, is rejected by
+`check_referee`). Every comm period (phase 1) it runs the strategy's team
+brain and sends one `order` per robot over Wi-Fi.
 """
 
 from __future__ import annotations
 
 import time
 
+from arena.processes.referee_box import check_referee
 from arena.runtime.lockstep import Schedule
 from arena.runtime.node import Node
 from arena.strategies import registry
@@ -26,18 +29,17 @@ class BaseStationNode(Node):
             n: self.inp("report", team, n, schedule=Schedule(comm, 0), lag=1, sender=f"robot/{team}/{n}")
             for n in range(cfg.robots)
         }
-        self.ref_in = self.inp("referee", schedule=Schedule(cfg.timing.referee_period, 0), lag=1, sender="referee")
+        self.ref_in = self.inp(
+            "referee", schedule=Schedule(cfg.timing.referee_period, 0), lag=1, sender="referee", check=check_referee
+        )
         self.order_out = {n: self.out("order", team, n) for n in range(cfg.robots)}
         strategy = registry.get(cfg.strategy_of(team))
         self.brain = strategy.make_team(TeamContext(cfg=cfg, team=team, rng=self.rng("strategy")))
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
-        reports = {}
-        for n, ib in self.report_in.items():
-            frames = ib.take(k)
-            if frames:
-                reports[n] = frames[-1]
+        # Each robot's newest report, if a new one arrived since the last order.
+        reports = {n: ib.latest for n, ib in self.report_in.items() if ib.take(k)}
         referee = self.ref_in.latest_by(k)
         orders = self.brain.step(k, reports, referee)
         for n, out in self.order_out.items():

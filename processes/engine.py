@@ -2,8 +2,12 @@
 
 Per tick k (lockstep):
 
-1. apply the referee frames delivered by k (KICKOFF and DROP_BALL placements,
-   the side switch);
+1. apply the referee frames delivered by k (`apply_command`): the side
+   switch; STOP and every set-piece command stop play, and a set piece puts
+   the ball on its spot and pins it there (KICKOFF also places every robot);
+   START first moves every robot that is still too close to the ball spot to
+   the nearest legal place (`setpieces.py`, docs/rules.md), then frees the
+   ball;
 2. publish every robot's `sense` for tick k, `world` (G_V), and every referee
    period the ball `events` (G_Re) gathered since the previous frame;
 3. step the physics from k to k+1 with the commands delivered by k, i.e. the
@@ -13,6 +17,11 @@ Per tick k (lockstep):
 In real-time mode the engine paces ticks to the wall clock and never waits for
 a command: a robot without a fresh command keeps its last setpoint until
 `cmd_timeout`, then stops.
+
+Inputs are validated on the way in: a `cmd` with non-finite numbers or the
+wrong number of wheel speeds for the robot model, and a `referee` frame with
+an unknown command or team (`check_referee`), are rejected, counted and
+logged, and the match goes on.
 """
 
 from __future__ import annotations
@@ -22,25 +31,78 @@ import time
 
 import numpy as np
 
+from arena.processes import setpieces
+from arena.processes.drive import Drive
 from arena.processes.physics import Physics
+from arena.processes.referee_box import check_referee
 from arena.processes.sensors import sense
 from arena.runtime import seeds
-from arena.runtime.config import TEAMS
+from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import EVERY_TICK, Schedule
 from arena.runtime.node import Node
-from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee
+from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
 
 
-def check_cmd(cmd: Cmd) -> str | None:
-    """Reject commands no robot could mean: non-finite numbers, odd wheel counts."""
+def check_cmd(cmd: Cmd, wheels: int) -> str | None:
+    """Reject commands no robot could mean: non-finite numbers, a wheel count the model has not."""
     for name in ("vx", "vy", "omega", "kick_speed"):
         if not math.isfinite(getattr(cmd, name)):
             return f"{name} is not finite"
-    if cmd.mode == "wheels" and len(cmd.wheels) not in (3, 4):
-        return f"{len(cmd.wheels)} wheel speeds (expected 3 or 4)"
+    if cmd.mode == "wheels" and len(cmd.wheels) != wheels:
+        return f"{len(cmd.wheels)} wheel speeds (this robot has {wheels})"
     if not all(math.isfinite(w) for w in cmd.wheels):
         return "a wheel speed is not finite"
     return None
+
+
+class Restarts:
+    """Applies referee commands to the physics: stoppages, ball spots, legal positions.
+
+    Shared by the engine process and in-process rule tests. `placed` lists
+    every robot moved at a START as (tick, team, n, x, y).
+    """
+
+    def __init__(self, cfg: MatchConfig, physics: Physics):
+        self.cfg = cfg
+        self.physics = physics
+        self.pending: RefCommand | None = None  # the set piece waiting for its START
+        self.placed: list[tuple[int, str, int, float, float]] = []
+
+    def apply_frame(self, frame: Referee) -> None:
+        self.physics.attack_dir_a = frame.attack_dir_a
+        for c in frame.commands:
+            self.apply_command(c)
+
+    def apply_command(self, c: RefCommand) -> None:
+        ph = self.physics
+        if c.name in setpieces.SET_PIECES:
+            ph.stop_play()
+            if c.name == "KICKOFF":
+                ph.kickoff_positions(c.team)
+            ph.pin_ball(c.x, c.y)
+            self.pending = c
+        elif c.name == "START":
+            if self.pending is not None:
+                self.enforce_distance(self.pending)
+            self.pending = None
+            ph.start_play()
+        elif c.name in ("STOP", "HALF_TIME", "END_GAME", "PARK"):
+            ph.stop_play()
+
+    def enforce_distance(self, c: RefCommand) -> None:
+        """Move every robot too close to the ball spot of `c` to the nearest legal place."""
+        ph = self.physics
+        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states()}
+        spot = (c.x, c.y)
+        rule = setpieces.keep_away(c.name, c.team, self.cfg)
+        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
+        for t, n in setpieces.too_close(robots, c.name, c.team, spot, ph.attack_dir_a, self.cfg):
+            x, y, th = poses[(t, n)]
+            others = [(ox, oy) for r, (ox, oy, _) in poses.items() if r != (t, n)]
+            nx, ny = setpieces.legal_spot(x, y, spot, rule.distance, others, self.cfg)
+            ph.place_robot(t, n, nx, ny, th)
+            poses[(t, n)] = (nx, ny, th)
+            self.placed.append((ph.tick, t, n, nx, ny))
 
 
 class EngineNode(Node):
@@ -51,17 +113,20 @@ class EngineNode(Node):
         self.physics = Physics(cfg)
         self.physics.attack_dir_a = 1
         self.physics.kickoff_positions("a")
+        self.physics.stop_play()
+        self.restarts = Restarts(cfg, self.physics)
+        self.wheels = Drive(cfg.robot).wheels  # wheel speeds a `cmd` in mode "wheels" must carry
         self.sensor_rng = {
             r: np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r)) for r in self.robots
         }
         self.cmd_in = {
             (team, n): self.inp(
-                "cmd", team, n, schedule=EVERY_TICK, lag=1, sender=f"robot/{team}/{n}", check=check_cmd
+                "cmd", team, n, schedule=EVERY_TICK, lag=1, sender=f"robot/{team}/{n}", check=self.check_cmd
             )
             for team, n in self.robots
         }
         p = cfg.timing.referee_period
-        self.ref_in = self.inp("referee", schedule=Schedule(p, 0), lag=1, sender="referee")
+        self.ref_in = self.inp("referee", schedule=Schedule(p, 0), lag=1, sender="referee", check=check_referee)
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
         self.world_out = self.out("world", viewers_only=True)
         self.events_out = self.out("events")
@@ -70,6 +135,9 @@ class EngineNode(Node):
         self.world_schedule = Schedule(cfg.timing.world_period, 0)
         self.pending_events: list = []
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
+
+    def check_cmd(self, cmd: Cmd) -> str | None:
+        return check_cmd(cmd, self.wheels)
 
     def on_peer_dead(self, peer: str) -> None:
         """Tell the referee (G_Re) that a robot is gone; its wheels are stopped in the loop."""
@@ -81,14 +149,12 @@ class EngineNode(Node):
 
     # -------------------------------------------------------------- per tick
     def apply_referee(self, frames: list[Referee]) -> None:
-        ph = self.physics
         for frame in frames:
-            ph.attack_dir_a = frame.attack_dir_a
-            for c in frame.commands:
-                if c.name == "KICKOFF" and c.team in TEAMS:
-                    ph.kickoff_positions(c.team)
-                elif c.name == "DROP_BALL":
-                    ph.place_ball(c.x, c.y)
+            n = len(self.restarts.placed)
+            self.restarts.apply_frame(frame)
+            for tick, team, robot, x, y in self.restarts.placed[n:]:
+                self.log.info("tick %d: robot %s/%d too close to the ball at START, placed at (%.2f, %.2f)",
+                              tick, team, robot, x, y)
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor
@@ -183,4 +249,5 @@ class EngineNode(Node):
         return {
             "distance_m": {f"{t}/{n}": round(d, 3) for (t, n), d in sorted(self.physics.distance.items())},
             "ticks": self.last_tick,
+            "placed": len(self.restarts.placed),
         }

@@ -73,6 +73,7 @@ SUMMARY = "summary"  # arena/<m>/summary/<process id>: one Summary per process a
 CONFIG = "config"  # queryable: the match configuration as JSON
 ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
 COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
+TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
 
 
 class Keys:
@@ -100,6 +101,12 @@ class Keys:
 
     def summary_all(self) -> str:
         return f"{self.prefix}{SUMMARY}/**"
+
+    def tap(self, process: str) -> str:
+        return f"{self.prefix}{TAP}/{process}"
+
+    def tap_all(self) -> str:
+        return f"{self.prefix}{TAP}/**"
 
     def ack(self, process: str) -> str:
         return f"{self.prefix}{ACK}/{process}"

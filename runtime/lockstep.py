@@ -151,7 +151,8 @@ class Outbound(Generic[M]):
         self._encode = msgspec.msgpack.Encoder().encode
         self.sent = 0
 
-    def send(self, msg: M) -> None:
+    def send(self, msg: M) -> bytes:
+        """Encode, digest and put `msg`; returns the payload (for a tap, runtime/tap.py)."""
         payload = self._encode(msg)
         d = self._digest
         d.update(self.rel)
@@ -159,6 +160,7 @@ class Outbound(Generic[M]):
         d.update(payload)
         self.sent += 1
         self._put(payload)
+        return payload
 
 
 class Inbound(Generic[M]):
@@ -294,13 +296,18 @@ class Inbound(Generic[M]):
 
     # ---------------------------------------------------------------- delivery
     def take(self, k: int) -> list[M]:
-        """Frames delivered by tick k, in delivery order; also updates `latest`."""
+        """Frames delivered by tick k, in delivery order; also updates `latest`.
+
+        Jitter can reorder frames, as on a real network; `latest` is the newest
+        by send tick, so a late old frame never replaces fresher news.
+        """
         out: list[M] = []
         pending = self._pending
         while pending and pending[0][0] <= k:
             out.append(heapq.heappop(pending)[2])
-        if out:
-            self.latest = out[-1]
+        for msg in out:
+            if self.latest is None or msg.tick > self.latest.tick:
+                self.latest = msg
         return out
 
     def latest_by(self, k: int) -> M | None:

@@ -28,6 +28,7 @@ from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.keys import KEY_BY_NAME, Keys
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
 from arena.runtime.lockstep import Inbound, Outbound, Rejections, Schedule, Watchdog
+from arena.runtime.tap import Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
 
@@ -60,6 +61,11 @@ class Node:
         self.last_tick = 0
         self._wall_s = 0.0
         self._collector = False
+        # A recorded match: everything this process sends also goes to its tap
+        # (runtime/tap.py), which the recorder collects.
+        self.tap: Tap | None = None
+        if cfg.record and pid.kind != "recorder":
+            self.tap = Tap(self.name, transport.publisher(keys.tap(self.name)))
 
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
@@ -67,7 +73,10 @@ class Node:
         is not put on the wire while nobody listens (it still counts in the digest)."""
         key = self.keys.key(name, team, n)
         put = self.transport.publisher(key, when_matched=viewers_only)
-        ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
+        if self.tap is None:
+            ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
+        else:
+            ob = TappedOutbound(key, self.keys.rel(key), put, self.digest, self.tap)
         self.outbound.append(ob)
         return ob
 
@@ -181,6 +190,8 @@ class Node:
             self._wall_s = time.perf_counter() - t0
         finally:
             self.watchdog.stop()
+        if self.tap is not None:
+            self.tap.close(self.last_tick)
         summary = self.summary()
         self.deliver_summary(msgs.encode(summary))
         return summary
@@ -241,4 +252,5 @@ class Node:
             wall_s=self._wall_s,
             cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
             extra=self.summary_extra(),
+            sent_by_key={o.rel.decode(): o.sent for o in self.outbound},
         )

@@ -69,6 +69,8 @@ class ZenohTransport:
     def __init__(self, session: zenoh.Session):
         self.session = session
         self._keep: list[object] = []  # declared entities live as long as the transport
+        self._wakers: dict[str, zenoh.Publisher] = {}
+        self._wake_lock = threading.Lock()
 
     def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
         pub = self.session.declare_publisher(
@@ -97,10 +99,18 @@ class ZenohTransport:
     def subscribe(self, key: str) -> Channel:
         sub = self.session.declare_subscriber(key, zenoh.handlers.FifoChannel(self.FIFO))
         self._keep.append(sub)
+        # The wake-up for this subscription goes through a publisher of its own,
+        # declared now on the main thread: `wake` runs on other threads (watchdog,
+        # liveliness callback), and a session call there can collide with the
+        # main thread's ("Already mutably borrowed").
+        self._wakers[key] = self.session.declare_publisher(key, allowed_destination=zenoh.Locality.SESSION_LOCAL)
         return _ZenohChannel(sub)
 
     def wake(self, key: str) -> None:
-        self.session.put(key, WAKE, allowed_destination=zenoh.Locality.SESSION_LOCAL)
+        waker = self._wakers.get(key)
+        if waker is not None:
+            with self._wake_lock:
+                waker.put(WAKE)
 
     def declare_alive(self, key: str) -> None:
         self._keep.append(self.session.liveliness().declare_token(key))
@@ -124,6 +134,10 @@ class ZenohTransport:
         return None
 
     def close(self) -> None:
+        with self._wake_lock:
+            for waker in self._wakers.values():
+                waker.undeclare()
+            self._wakers.clear()
         for entity in reversed(self._keep):
             undeclare = getattr(entity, "undeclare", None)
             if undeclare is not None:

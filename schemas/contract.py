@@ -14,7 +14,8 @@ from pathlib import Path
 import msgspec
 from msgspec import inspect as mi
 
-from arena.runtime.keys import ACK, ALIVE, COLLECTOR, CONFIG, KEYS, SUMMARY
+from arena.runtime.keys import ACK, ALIVE, COLLECTOR, CONFIG, KEYS, SUMMARY, TAP
+from arena.runtime.tap import TAP_PERIOD
 from arena.schemas import messages as m
 
 README = Path(__file__).with_name("README.md")
@@ -79,6 +80,7 @@ Infrastructure keys (not data pairs):
 | `arena/<match>/{SUMMARY}/<process>` | `Summary`, once per process at the end of the match |
 | `arena/<match>/{COLLECTOR}` | liveliness token of a summary collector (`arena match`, `arena up`); while present, a process repeats its summary until acknowledged |
 | `arena/<match>/{ACK}/<process>` | the collector's acknowledgement of a summary (payload `ack`) |
+| `arena/<match>/{TAP}/<process>` | `TapBatch`, only in a recorded match: every frame the process sent, batched every {TAP_PERIOD} ticks, for the recorder (docs/recording.md) |
 
 """
 

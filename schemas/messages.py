@@ -127,6 +127,7 @@ class TeamPose(Base):
     y: Meters
     theta: Radians = 0.0
     age: Annotated[int, Meta(description="[ticks] since last seen")] = 0
+    role: Annotated[str, Meta(description="own robots: the role the base station gave it, '' otherwise")] = ""
 
 
 class Order(Base):
@@ -177,15 +178,25 @@ class Referee(Base):
 
 # ----------------------------------------------------------------------- G_Re
 class BallEvent(Base):
+    """One ball-status event; docs/rules.md says what the referee makes of each kind."""
+
     kind: Annotated[
         str,
-        Meta(description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, ROBOT_DEAD"),
+        Meta(
+            description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, FOUL_PUSHING, FOUL_DRIBBLING, ROBOT_DEAD"
+        ),
     ]
     tick: Annotated[int, Meta(description="tick at which it happened")]
-    team: Annotated[TeamOrNone, Meta(description="GOAL: scoring team; TOUCH: toucher's team")] = ""
-    robot: Annotated[int, Meta(description="robot involved, -1 if none")] = -1
-    x: Annotated[float, Meta(description="[m] ball position, field frame")] = 0.0
-    y: Annotated[float, Meta(description="[m] ball position, field frame")] = 0.0
+    team: Annotated[
+        TeamOrNone,
+        Meta(
+            description="GOAL: scoring team; GOAL_LINE: the team defending that goal line; "
+            "TOUCH: toucher's team; FOUL_*: offender's team; ROBOT_DEAD: the robot's team"
+        ),
+    ] = ""
+    robot: Annotated[int, Meta(description="robot involved (toucher, offender, dead robot), -1 if none")] = -1
+    x: Annotated[float, Meta(description="[m] ball position, field frame; FOUL_PUSHING: contact point")] = 0.0
+    y: Annotated[float, Meta(description="[m] ball position, field frame; FOUL_PUSHING: contact point")] = 0.0
     last_team: Annotated[TeamOrNone, Meta(description="team of the last robot to touch the ball")] = ""
     last_robot: Annotated[int, Meta(description="last robot to touch the ball, -1 if none")] = -1
 
@@ -247,9 +258,37 @@ class Summary(Base):
     wall_s: Annotated[float, Meta(description="[s] wall time from the start barrier to the last tick")] = 0.0
     cpu_s: Annotated[list[float], Meta(description="[s] user and system CPU time of the whole process")] = []
     extra: Annotated[dict[str, object], Meta(description="kind-specific results (score, events, distances)")] = {}
+    sent_by_key: Annotated[
+        dict[str, int], Meta(description="frames sent per key, the key without the `arena/<match>/` prefix")
+    ] = {}
 
 
-MESSAGE_TYPES: tuple[type[Base], ...] = (FieldSpec, Sense, Cmd, Report, Order, Referee, EngineEvents, World, Summary)
+class TapFrame(Base):
+    """One frame a process sent, as it went on the wire (for the recorder)."""
+
+    key: Annotated[str, Meta(description="the key without the `arena/<match>/` prefix, e.g. robot/a/1/cmd")]
+    tick: Annotated[int, Meta(ge=0, description="the frame's own tick")]
+    payload: Annotated[bytes, Meta(description="the msgpack payload, byte for byte (msgpack bin)")]
+
+
+class TapBatch(Base):
+    """A recorded match only: the frames one process sent, batched every tap period.
+
+    Every frame the process sent with a tick below `tick` is in this batch or
+    an earlier one, in send order. The last batch has `final` set and comes
+    before the process's `Summary`.
+    """
+
+    tick: Annotated[int, Meta(ge=0, description="watermark: no later frame of this process has a lower tick")]
+    process: Annotated[str, Meta(description="sender, e.g. robot/a/1")]
+    seq: Annotated[int, Meta(ge=0, description="batch number of this process: 0, 1, 2, ...")]
+    final: Annotated[bool, Meta(description="the process's last batch")] = False
+    frames: list[TapFrame] = []
+
+
+MESSAGE_TYPES: tuple[type[Base], ...] = (
+    FieldSpec, Sense, Cmd, Report, Order, Referee, EngineEvents, World, Summary, TapBatch
+)
 
 _ENCODER = msgspec.msgpack.Encoder()
 

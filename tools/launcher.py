@@ -66,12 +66,14 @@ def new_match_id(seed: int) -> str:
     return f"m{seed}-{os.getpid()}-{os.urandom(3).hex()}"
 
 
-def run_argv(pid: ProcessId, match: str, connect: str, config_path: str | None = None) -> list[str]:
+def run_argv(pid: ProcessId, match: str, connect: str, config_path: str | None = None, record: str = "") -> list[str]:
     argv = [sys.executable, "-m", "arena", "run", pid.kind, "--match", match, "--connect", connect]
     if pid.team:
         argv += ["--team", pid.team]
     if pid.kind == "robot":
         argv += ["--robot", str(pid.robot)]
+    if pid.kind == "recorder" and record:
+        argv += ["--record", record]
     if config_path:
         argv += ["--config", config_path]
     return argv
@@ -232,7 +234,8 @@ def percentile(sorted_values: list[float], q: float) -> float:
 
 def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
     """The match result (what `arena match --json` prints)."""
-    order = [str(p) for p in cfg.processes()]
+    # The recorder sends no data: the digests are the same with or without it.
+    order = [str(p) for p in cfg.processes() if p.kind != "recorder"]
     sums = got.summaries
     combined = hashlib.blake2b(digest_size=16)
     for name in order:
@@ -276,6 +279,12 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
             }
         )
     score = list(referee.extra.get("score", [0, 0])) if referee else [0, 0]
+    sent_by_key: dict[str, int] = {}
+    for name in order:
+        if name in sums:
+            for key, n in sums[name].sent_by_key.items():
+                sent_by_key[key] = sent_by_key.get(key, 0) + n
+    recorder = sums.get("recorder")
     ticks = engine.tick if engine else 0
     sim_seconds = ticks * cfg.timing.dt
     # Simulation speed is measured by the engine from its start barrier to its
@@ -304,6 +313,8 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "rejected": sum(rejected.values()),
         "rejected_reasons": dict(rejected),
         "dead": sorted({d for s in sums.values() for d in s.dead}),
+        "sent_by_key": dict(sorted(sent_by_key.items())),
+        "recording": recorder.extra if recorder else None,
         "referee_log": referee.extra.get("log", []) if referee else [],
     }
 
@@ -342,11 +353,11 @@ def play_match(
             for p in cfg.processes():
                 if p in external:
                     continue
-                children.append(spawn(str(p), p, run_argv(p, match, connect, str(cfg_path)), logs))
+                children.append(spawn(str(p), p, run_argv(p, match, connect, str(cfg_path), cfg.record), logs))
             if external and announce is not None:
                 lines = [f"waiting for {len(external)} external process(es); start each with:"]
                 for p in sorted(external):
-                    argv = run_argv(p, match, connect)[2:]
+                    argv = run_argv(p, match, connect, record=cfg.record)[2:]
                     lines.append("  arena " + " ".join(argv[1:]))
                 announce("\n".join(lines))
             try:

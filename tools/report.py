@@ -40,3 +40,7 @@ def print_match(result: dict, console: Console | None = None) -> None:
         console.print(f"[yellow]rejected inputs: {result['rejected']} {result['rejected_reasons']}[/]")
     if result["dead"]:
         console.print(f"[red]treated as dead: {', '.join(result['dead'])}[/]")
+    rec = result.get("recording")
+    if rec:
+        state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"
+        console.print(f"recorded {sum(rec['messages'].values())} messages to {rec['path']} ({state}): arena review {rec['path']}")

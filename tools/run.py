@@ -78,8 +78,13 @@ def run(
     seed: int | None,
     realtime: bool,
     startup_timeout: float,
+    record: str | None = None,
 ) -> int:
-    """Run one process to the end of its match. Returns the exit code."""
+    """Run one process to the end of its match. Returns the exit code.
+
+    `record`: the recorder's output path; it overrides the configuration's
+    (which names the path on the machine that started the match).
+    """
     signal.signal(signal.SIGTERM, _sigterm)
     keys = Keys(match)
     log = logging.getLogger(f"arena.{pid}")
@@ -92,7 +97,12 @@ def run(
                 raise ConfigError(f"--seed {seed} differs from the match's seed {cfg.seed}")
             if realtime and not cfg.realtime:
                 raise ConfigError("--realtime given, but the match runs in lockstep")
-            if pid not in cfg.processes() and not (pid.kind == "recorder"):
+            if pid.kind == "recorder":
+                if not cfg.record:
+                    raise ConfigError(f"match {match!r} does not record: start it with --record FILE.mcap")
+                if record:
+                    cfg = cfg.replace(record=record)
+            if pid not in cfg.processes():
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
             node = node_class(pid.kind)(pid, cfg, transport, keys)
             node.run()

@@ -27,6 +27,11 @@ def arena(*args: str) -> subprocess.CompletedProcess:
         (["run", "robot", "--match", "m/x", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"], "bad match id"),
         (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read --config"),
         (["up", "/nonexistent/compose.yaml"], "cannot read"),
+        (["match", "--home", "BS", "--away", "BS", "--record", "/nonexistent/dir/m.mcap"], "does not exist"),
+        (["review", "/nonexistent.mcap"], "cannot read"),
+        (["replay", "/nonexistent.mcap", "--process", "a/1"], "cannot read"),
+        (["replay", "/nonexistent.mcap"], "required: --process"),
+        (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1", "--record", "x.mcap"], "--record does not apply"),
         (["frobnicate"], "invalid choice"),
     ],
 )
@@ -39,6 +44,6 @@ def test_bad_input_is_one_line_and_exit_2(args, needle):
 
 
 def test_help_texts_show_examples():
-    for cmd in ("match", "run", "up", "bench"):
+    for cmd in ("match", "run", "up", "bench", "review", "replay"):
         r = arena(cmd, "--help")
         assert r.returncode == 0 and "examples:" in r.stdout

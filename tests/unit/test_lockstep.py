@@ -27,8 +27,22 @@ def test_schedule(period, phase, k, last, due):
     assert s.first_after(s.last_at_or_before(k)) > k or s.last_at_or_before(k) == -1
 
 
+class ScriptedLink(LinkEmulator):
+    """A link whose delays are given in advance."""
+
+    __slots__ = ("script",)
+
+    def __init__(self, delays_ms):
+        super().__init__(LinkModel(latency_ms=1.0), random.Random(0))
+        self.script = iter(delays_ms)
+
+    def decide(self):
+        self.frames += 1
+        return next(self.script)
+
+
 class Harness:
-    def __init__(self, model=LinkModel(), schedule=EVERY_TICK, lag=1, timeout=5.0):
+    def __init__(self, model=LinkModel(), schedule=EVERY_TICK, lag=1, timeout=5.0, emulator=None):
         self.bus = MemoryBus()
         self.rx = MemoryTransport(self.bus)
         self.tx = MemoryTransport(self.bus)
@@ -38,7 +52,7 @@ class Harness:
         self.wd = Watchdog(self.rx, timeout)
         self.inbound = Inbound(
             key=KEY, msg_type=Cmd, channel=self.rx.subscribe(KEY), schedule=schedule, lag=lag,
-            link_class="sensor", sender="robot/a/1", emulator=LinkEmulator(model, random.Random(1)),
+            link_class="sensor", sender="robot/a/1", emulator=emulator or LinkEmulator(model, random.Random(1)),
             dt=0.02, rejections=self.rej, watchdog=self.wd, is_dead=self.gone.__contains__,
             on_dead=self.dead.__setitem__,
         )
@@ -128,3 +142,16 @@ def test_outbound_digest_covers_key_and_payload():
     Outbound(KEY, "robot/a/1/cmd", sent.append, d1).send(Cmd(tick=0))
     Outbound(KEY, "robot/a/2/cmd", sent.append, d2).send(Cmd(tick=0))
     assert sent[0] == sent[1] and d1.digest() != d2.digest()
+
+
+def test_a_late_old_frame_never_replaces_fresher_news():
+    harness = Harness(emulator=ScriptedLink([65.0, 0.0]))  # tick 0 arrives 4 ticks late, tick 1 on time
+    try:
+        harness.put(encode(Cmd(tick=0, vx=0.0)))
+        harness.put(encode(Cmd(tick=1, vx=1.0)))
+        harness.inbound.sync(2)
+        assert [c.tick for c in harness.inbound.take(2)] == [1]
+        assert [c.tick for c in harness.inbound.take(4)] == [0]
+        assert harness.inbound.latest.tick == 1
+    finally:
+        harness.close()
