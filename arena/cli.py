@@ -209,8 +209,20 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=(), 
     return cfg
 
 
+def emit_match(result: dict, as_json: bool) -> int:
+    """Print a match result (arena match, arena up): one JSON object, or the tables."""
+    from arena.tools import report
+
+    if as_json:
+        result.pop("referee_log", None)
+        print(json.dumps(result, indent=2))
+    else:
+        report.print_match(result)
+    return 0
+
+
 def cmd_match(args: argparse.Namespace) -> int:
-    from arena.tools import launcher, report
+    from arena.tools import launcher
 
     record = record_path(args.record) if args.record else ""
     cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
@@ -239,12 +251,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     except launcher.MatchError as exc:
         print(f"arena match: error: {exc}", file=sys.stderr)
         return 1
-    if args.json:
-        result.pop("referee_log", None)
-        print(json.dumps(result, indent=2))
-    else:
-        report.print_match(result)
-    return 0
+    return emit_match(result, args.json)
 
 
 def record_path(text: str) -> str:
@@ -293,19 +300,14 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_up(args: argparse.Namespace) -> int:
-    from arena.tools import compose, report
+    from arena.tools import compose
 
     try:
         result = compose.up(args.file, timeout=args.timeout)
     except compose.ComposeError as exc:
         print(f"arena up: error: {exc}", file=sys.stderr)
         return 2 if exc.bad_input else 1
-    if args.json:
-        result.pop("referee_log", None)
-        print(json.dumps(result, indent=2))
-    else:
-        report.print_match(result)
-    return 0
+    return emit_match(result, args.json)
 
 
 def cmd_tournament(args: argparse.Namespace) -> int:
