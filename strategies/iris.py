@@ -101,12 +101,6 @@ class IrisParams:
         return type(defaults)(**{**{f: getattr(defaults, f) for f in defaults.__dataclass_fields__}, "max_speed": self.cruise})
 
 
-def _attack_dir(team: str, referee: Referee | None) -> int:
-    if referee is None:
-        return 1 if team == "a" else -1
-    return referee.attack_dir_a if team == "a" else -referee.attack_dir_a
-
-
 class IrisTeam:
     """Base station brain: eq. 5 fusion, S1/S2/S3, Fig. 6 roles with the areas of eq. 6."""
 
@@ -133,12 +127,8 @@ class IrisTeam:
 
     def step(self, tick: int, reports: dict[int, Report], referee: Referee | None) -> dict[int, Order]:
         self.model.update(tick, reports)
-        attack_dir = _attack_dir(self.team, referee)
-        command, cteam, sx, sy, strategy = "STOP", "", 0.0, 0.0, R.S_LEVEL
-        if referee is not None:
-            command, cteam, sx, sy = referee.command, referee.command_team, referee.spot_x, referee.spot_y
-            own, opp = (referee.score_a, referee.score_b) if self.team == "a" else (referee.score_b, referee.score_a)
-            strategy = R.choose_strategy(own, opp)
+        c = R.referee_fields(self.team, referee, default_attack_dir=1 if self.team == "a" else -1)
+        command, cteam, attack_dir = c["command"], c["command_team"], c["attack_dir"]
         possession, holder = self.possession(tick)
         if command == PLAY:
             xy = {n: (v[0], v[1]) for n, v in self.model.own.items()}
@@ -159,12 +149,7 @@ class IrisTeam:
             n: Order(
                 tick=tick,
                 robot=n,
-                command=command,
-                command_team=cteam,
-                spot_x=sx,
-                spot_y=sy,
-                attack_dir=attack_dir,
-                strategy=strategy,
+                **c,
                 role=role_of.get(n, "defender"),
                 role_state=self.roles.state.get(n, 0),
                 own=own_poses,

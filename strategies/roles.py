@@ -71,6 +71,26 @@ def role_name(state: int) -> str:
     return "attacker" if is_attacker(state) else "defender"
 
 
+def referee_fields(team: str, referee, default_attack_dir: int) -> dict:
+    """Eq. 5's C and S for `team` from the referee's latest frame, as Order fields.
+
+    Before the first frame: STOP, no spot, S1, and `default_attack_dir`.
+    """
+    if referee is None:
+        return {"command": "STOP", "command_team": "", "spot_x": 0.0, "spot_y": 0.0,
+                "attack_dir": default_attack_dir, "strategy": S_LEVEL}
+    a = team == "a"
+    own, opp = (referee.score_a, referee.score_b) if a else (referee.score_b, referee.score_a)
+    return {
+        "command": referee.command,
+        "command_team": referee.command_team,
+        "spot_x": referee.spot_x,
+        "spot_y": referee.spot_y,
+        "attack_dir": referee.attack_dir_a if a else -referee.attack_dir_a,
+        "strategy": choose_strategy(own, opp),
+    }
+
+
 def choose_strategy(own_score: int, opponent_score: int) -> int:
     """Eq. 5's S: 1 level, 2 offensive (losing), 3 defensive (winning)."""
     if own_score == opponent_score:

@@ -36,6 +36,7 @@ from arena.processes import setpieces
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.strategies.base import RobotContext, Strategy, TeamContext
+from arena.strategies.roles import referee_fields
 
 PLAY_COMMANDS = frozenset({"START"})
 SETUP_COMMANDS = setpieces.SET_PIECES - {"KICKOFF"}  # robots position themselves for these
@@ -81,14 +82,7 @@ class SimpleTeam:
             self.poses[n] = (rep.pose.x, rep.pose.y, rep.pose.theta, rep.tick)
             if rep.ball.visible and (self.ball is None or rep.tick >= self.ball[2]):
                 self.ball = (rep.ball.x, rep.ball.y, rep.tick)
-        command, cteam, sx, sy, attack_dir, strategy = "STOP", "", 0.0, 0.0, 1, 1
-        if referee is not None:
-            command, cteam, sx, sy = referee.command, referee.command_team, referee.spot_x, referee.spot_y
-            attack_dir = referee.attack_dir_a if self.team == "a" else -referee.attack_dir_a
-            own, opp = (
-                (referee.score_a, referee.score_b) if self.team == "a" else (referee.score_b, referee.score_a)
-            )
-            strategy = 1 if own == opp else (2 if own < opp else 3)
+        c = referee_fields(self.team, referee, default_attack_dir=1)
         roles = self._roles()
         own_poses = [TeamPose(robot=n, x=p[0], y=p[1], theta=p[2], age=tick - p[3]) for n, p in sorted(self.poses.items())]
         bx, by, bt = self.ball if self.ball is not None else (0.0, 0.0, -1)
@@ -96,12 +90,7 @@ class SimpleTeam:
             n: Order(
                 tick=tick,
                 robot=n,
-                command=command,
-                command_team=cteam,
-                spot_x=sx,
-                spot_y=sy,
-                attack_dir=attack_dir,
-                strategy=strategy,
+                **c,
                 role=roles[n],
                 own=own_poses,
                 ball_valid=self.ball is not None,
