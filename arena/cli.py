@@ -41,7 +41,10 @@ EXAMPLES = {
   arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
   arena bench match --runs 5 --half-time 120 --link wifi
   arena bench record               # median rtf with and without --record, and the ratio
-  arena bench robot                # median us per robot control step and per F-SFM step""",
+  arena bench robot                # median us per robot control step and per F-SFM step
+  arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
+  arena bench nav --trials 3 --only static,SAROG --plots navplots/
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench.toml)""",
     "review": """examples:
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
@@ -149,8 +152,9 @@ def build_parser() -> Parser:
 
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument(
-        "what", choices=["match", "record", "robot"],
-        help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step",
+        "what", choices=["match", "record", "robot", "nav"],
+        help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
+        "nav: the navigators in their papers' scenarios",
     )
     b.add_argument("--strategy", default="advance-dynamic", metavar="NAME", help="robot: strategy to time (AD)")
     b.add_argument("--runs", type=int, default=3, metavar="N", help="runs (3)")
@@ -158,6 +162,11 @@ def build_parser() -> Parser:
     b.add_argument("--robots", type=int, default=3, metavar="N")
     b.add_argument("--link", default="ideal", metavar="PRESET")
     b.add_argument("--json", action="store_true")
+    b.add_argument("--trials", type=int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)")
+    b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
+    b.add_argument("--scenarios", metavar="FILE", help="nav: scenario file (default: the built-in tools/navbench.toml)")
+    b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
+    b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
 
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
     v.add_argument("file", help="an MCAP file written by arena match --record")
@@ -343,6 +352,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return bench.bench_record(args)
     if args.what == "robot":
         return bench.bench_robot(args)
+    if args.what == "nav":
+        from arena.tools import navbench
+
+        return navbench.main(args)
     return bench.bench_match(args)
 
 

@@ -10,6 +10,12 @@ one angular speed [rad/s] per wheel). Both go through the same wheels:
 * **omni3**, the Festo Robotino: paper 1 eq. 1-2 (`navigation/omni3.py`),
   three wheels at 180, 60 and -60 degrees, L = `wheel_base`,
   R = `wheel_radius`; forward kinematics is the exact inverse of eq. 2.
+* **diff**, a differential drive such as the E-puck: paper 3 eq. 13
+  (`navigation/diffdrive.py`), two wheels on one axle, R = `wheel_radius`,
+  axle length L = 2 `wheel_base` (`wheel_base` is wheel to robot centre, as
+  for the omni models); forward kinematics is eq. 13's exact inverse. The
+  wheels cannot move the body sideways: a body command's vy is dropped
+  (which is what forward(inverse(twist)) gives).
 
 Wheel speeds are saturated at `max_wheel_speed` by scaling the whole wheel
 vector (`navigation/saturation.py`), so the robot keeps its direction of
@@ -31,7 +37,7 @@ from __future__ import annotations
 
 import math
 
-from arena.navigation import omni3, omni4
+from arena.navigation import diffdrive, omni3, omni4
 from arena.navigation.saturation import saturation_scale
 from arena.runtime.config import RobotParams
 from arena.schemas.messages import Cmd
@@ -41,6 +47,19 @@ Matrix = tuple[tuple[float, ...], ...]
 
 def _rows(m) -> Matrix:
     return tuple(tuple(float(v) for v in row) for row in m)
+
+
+def _diff_matrices(p: diffdrive.DiffDriveParams) -> tuple[Matrix, Matrix]:
+    """Paper 3 eq. 13 as matrices: twist (vx, vy, omega) -> (phidot_r, phidot_l), and its inverse.
+
+    Built column by column from `diffdrive.wheel_speeds` and `diffdrive.body_velocity`,
+    so that the engine and the navigation library share one formula.
+    """
+    (rv, lv), (rw, lw) = diffdrive.wheel_speeds(1.0, 0.0, p), diffdrive.wheel_speeds(0.0, 1.0, p)
+    inv = ((rv, 0.0, rw), (lv, 0.0, lw))  # vy moves no wheel
+    (vr, wr), (vl, wl) = diffdrive.body_velocity(1.0, 0.0, p), diffdrive.body_velocity(0.0, 1.0, p)
+    fwd = ((vr, vl), (0.0, 0.0), (wr, wl))  # the wheels give no vy
+    return inv, fwd
 
 
 class Drive:
@@ -53,8 +72,12 @@ class Drive:
         elif rp.model == "omni4":
             p4 = omni4.Omni4Params(wheel_distance=rp.wheel_base, wheel_radii=(rp.wheel_radius,) * 4)
             inv, fwd = omni4.inverse_matrix(p4), omni4.forward_matrix(p4)
+        elif rp.model == "diff":
+            pd = diffdrive.DiffDriveParams(wheel_radius=rp.wheel_radius, axle_length=2.0 * rp.wheel_base)
+            inv, fwd = _diff_matrices(pd)
         else:
-            raise ValueError(f"unknown robot model {rp.model!r} (omni4 or omni3)")
+            raise ValueError(f"unknown robot model {rp.model!r} (omni4, omni3 or diff)")
+        self.holonomic = rp.model != "diff"  # False: the wheels give no sideways velocity
         self.inverse_rows: Matrix = _rows(inv)  # twist -> wheel speeds [rad/s]
         self.forward_rows: Matrix = _rows(fwd)  # wheel speeds -> twist
         self.wheels = len(self.inverse_rows)
@@ -84,6 +107,6 @@ class Drive:
                 return 0.0, 0.0, 0.0
             s = saturation_scale(cmd.wheels, self.max_wheel_speed)
             return self._cap(*self.body_twist([w * s for w in cmd.wheels]))
-        vx, vy, w = self._cap(cmd.vx, cmd.vy, cmd.omega)
+        vx, vy, w = self._cap(cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega)
         s = saturation_scale(self.wheel_speeds(vx, vy, w), self.max_wheel_speed)
         return vx * s, vy * s, w * s

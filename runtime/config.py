@@ -79,6 +79,24 @@ ROBOTINO = RobotParams(
 )
 """The Robotino of paper 1 as a drop-in `MatchConfig.robot`; numbers the paper lacks are Festo's or assumed."""
 
+EPUCK = RobotParams(
+    model="diff",  # differential drive, paper 3 eq. 8 and 13 (navigation/diffdrive.py)
+    size=0.074,  # [m] footprint: the E-puck is round, radius 37 mm (paper 3 sec. II-C), boxed
+    height=0.05,  # [m]
+    mass=0.15,  # [kg] assumed; not in paper 3
+    max_speed=0.13,  # [m/s] just above the rim speed of max_wheel_speed (0.129 m/s), so the wheels limit
+    max_accel=1.0,  # [m/s^2] assumed; high, so that the body follows eq. 8's kinematic model closely
+    max_omega=5.0,  # [rad/s] just above 2 R max_wheel_speed / L (4.95 rad/s), so the wheels limit
+    max_alpha=40.0,  # [rad/s^2] assumed, as max_accel
+    wheel_radius=0.0205,  # [m] R, E-puck wheel (navigation/diffdrive.py)
+    wheel_base=0.026,  # [m] wheel to robot centre: half the 52 mm axle length L
+    max_wheel_speed=6.28,  # [rad/s] the E-puck motor limit (Webots' MAX_SPEED)
+    kick_max_speed=0.0,  # [m/s] no kicker
+)
+"""The E-puck of paper 3 (`arena bench nav`). Its model "diff" is the engine's
+differential drive (`processes/drive.py`); `MatchConfig.validate` still
+accepts only the soccer robots omni4 and omni3 for matches."""
+
 
 @dataclass(frozen=True)
 class BallParams:
