@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 
 from arena.processes.referee_box import check_referee
-from arena.runtime.lockstep import Schedule
+from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
 from arena.strategies import registry
 from arena.strategies.base import TeamContext
@@ -47,22 +47,22 @@ class BaseStationNode(Node):
         self.last_tick = k
         self.timed(t0)
 
-    def loop(self) -> None:
+    def lockstep(self) -> Waits:
+        for k in self.schedule.ticks(self.cfg.total_ticks):
+            for ib in self.report_in.values():
+                yield ib, k
+            yield self.ref_in, k
+            self.act(k)
+
+    def loop_realtime(self) -> None:
         last = self.cfg.total_ticks
-        if self.cfg.realtime:
-            while True:
-                r = self.ref_in.recv_clock()
-                if r is None:
-                    return
-                k = self.schedule.first_after(r)
-                if k > last:
-                    return
-                for ib in self.report_in.values():
-                    ib.poll(k)
-                self.act(k)
-        else:
-            for k in self.schedule.ticks(last):
-                for ib in self.report_in.values():
-                    ib.sync(k)
-                self.ref_in.sync(k)
-                self.act(k)
+        while True:
+            r = self.ref_in.recv_clock()
+            if r is None:
+                return
+            k = self.schedule.first_after(r)
+            if k > last:
+                return
+            for ib in self.report_in.values():
+                ib.poll(k)
+            self.act(k)

@@ -38,7 +38,7 @@ from arena.processes.referee_box import check_referee
 from arena.processes.sensors import sense
 from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
-from arena.runtime.lockstep import EVERY_TICK, Schedule
+from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
 from arena.runtime.node import Node
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
 
@@ -190,13 +190,13 @@ class EngineNode(Node):
 
     def loop(self) -> None:
         self.field_out.send(self.field_spec())
-        if self.cfg.realtime:
-            self._loop_realtime()
-            return
+        super().loop()
+
+    def lockstep(self) -> Waits:
         last = self.cfg.total_ticks
         ph = self.physics
         for k in range(last + 1):
-            self.ref_in.sync(k)
+            yield self.ref_in, k
             t0 = time.perf_counter()
             self.apply_referee(self.ref_in.take(k))
             self.publish(k)
@@ -206,7 +206,7 @@ class EngineNode(Node):
                 break
             work = time.perf_counter() - t0
             for r, ib in self.cmd_in.items():
-                ib.sync(k)
+                yield ib, k
                 frames = ib.take(k)
                 if frames:
                     ph.set_command(r[0], r[1], frames[-1])
@@ -216,7 +216,7 @@ class EngineNode(Node):
             self.pending_events.extend(ph.step())
             self._work_s.append(work + time.perf_counter() - t1)
 
-    def _loop_realtime(self) -> None:
+    def loop_realtime(self) -> None:
         last = self.cfg.total_ticks
         dt = self.cfg.timing.dt
         timeout_ticks = max(1, int(round(self.cfg.robot.cmd_timeout / dt)))

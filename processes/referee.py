@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 
 from arena.processes.referee_box import RefereeBox
-from arena.runtime.lockstep import Schedule
+from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
 
 
@@ -30,22 +30,22 @@ class RefereeNode(Node):
         self.last_tick = k
         self.timed(t0)
 
-    def loop(self) -> None:
+    def lockstep(self) -> Waits:
+        for k in self.schedule.ticks(self.cfg.total_ticks):
+            yield self.events_in, k
+            self.act(k)
+
+    def loop_realtime(self) -> None:
         last = self.cfg.total_ticks
-        if self.cfg.realtime:
-            self.act(0)
-            while True:
-                e = self.events_in.recv_clock()
-                if e is None:
-                    return
-                k = self.schedule.first_after(e)
-                self.act(min(k, last))
-                if k >= last:
-                    return
-        else:
-            for k in self.schedule.ticks(last):
-                self.events_in.sync(k)
-                self.act(k)
+        self.act(0)
+        while True:
+            e = self.events_in.recv_clock()
+            if e is None:
+                return
+            k = self.schedule.first_after(e)
+            self.act(min(k, last))
+            if k >= last:
+                return
 
     def summary_extra(self) -> dict[str, object]:
         return self.box.summary()

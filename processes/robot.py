@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 
-from arena.runtime.lockstep import EVERY_TICK, Schedule
+from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
 from arena.runtime.node import Node
 from arena.strategies import registry
 from arena.strategies.base import RobotContext
@@ -42,19 +42,19 @@ class RobotNode(Node):
         self.last_tick = k
         self.timed(t0)
 
-    def loop(self) -> None:
+    def lockstep(self) -> Waits:
+        for k in range(self.cfg.total_ticks + 1):
+            yield self.sense_in, k
+            yield self.order_in, k
+            self.act(k)
+
+    def loop_realtime(self) -> None:
         last = self.cfg.total_ticks
-        if self.cfg.realtime:
-            while True:
-                k = self.sense_in.recv_clock()
-                if k is None:
-                    return
-                self.order_in.poll(k)
-                self.act(k)
-                if k >= last:
-                    return
-        else:
-            for k in range(last + 1):
-                self.sense_in.sync(k)
-                self.order_in.sync(k)
-                self.act(k)
+        while True:
+            k = self.sense_in.recv_clock()
+            if k is None:
+                return
+            self.order_in.poll(k)
+            self.act(k)
+            if k >= last:
+                return

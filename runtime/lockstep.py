@@ -39,9 +39,9 @@ import math
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from dataclasses import dataclass
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 import msgspec
 
@@ -163,6 +163,87 @@ class Outbound(Generic[M]):
         return payload
 
 
+# A lockstep loop is a generator that yields (inbound, k) where it needs every
+# frame of that link due at tick k; the driver resumes it once they are in.
+Waits = Generator[tuple["Inbound[Any]", int], None, None]
+
+
+def pull(steps: Waits) -> None:
+    """Drive a lockstep loop from this thread, blocking in each link's `sync`."""
+    for ib, k in steps:
+        ib.sync(k)
+
+
+class Reactor:
+    """Drive a lockstep loop from the transport's receive callbacks.
+
+    The loop runs on the thread that delivers the frame it was waiting for,
+    so a frame in and the frames it causes out take no thread hand-over: on
+    the 2-core machine a hand-over (futex wake-up, context switch) costs
+    about as much CPU as the message itself. The main thread only waits for
+    the end and bounds every wait: a link silent for `timeout` seconds of
+    wall time is given up (wall time detects failures only, never behaviour).
+    """
+
+    def __init__(self, timeout: float):
+        self.timeout = timeout
+        self.lock = threading.Lock()
+        self.done = threading.Event()
+        self._steps: Waits | None = None
+        self._waiting: tuple[Inbound[Any], int] | None = None
+        self._since = 0.0
+        self.error: BaseException | None = None
+
+    def on_frame(self, ib: Inbound[Any], raw: bytes) -> None:
+        with self.lock:
+            ib.feed(raw)
+            if self._steps is not None:
+                self._advance()
+
+    def _advance(self) -> None:
+        try:
+            while True:
+                if self._waiting is not None:
+                    ib, k = self._waiting
+                    if not ib.ready(k):
+                        # As in `Inbound.sync`: a wake-up while we wait for a gone sender.
+                        if ib.woken and ib._is_dead(ib.sender):
+                            ib._give_up("its liveliness token vanished")
+                            continue
+                        ib.woken = False
+                        return
+                self._waiting = next(self._steps)  # type: ignore[arg-type]
+                self._since = time.monotonic()  # the start of this wait (failure detection only)
+        except StopIteration:
+            self._finish()
+        except BaseException as exc:  # raised again on the main thread by `run`
+            self.error = exc
+            self._finish()
+
+    def _finish(self) -> None:
+        self._steps = None
+        self._waiting = None
+        self.done.set()
+
+    def run(self, steps: Waits) -> None:
+        """Start the loop here, then wait for it to end on the callbacks' thread."""
+        with self.lock:
+            self._steps = steps
+            self._advance()
+        while not self.done.wait(0.1):
+            with self.lock:
+                if self._waiting is None:
+                    continue
+                ib, k = self._waiting
+                if time.monotonic() - self._since >= self.timeout:
+                    ib._give_up(f"silent for {self.timeout:g} s waiting for tick {k}")
+                else:
+                    continue
+                self._advance()
+        if self.error is not None:
+            raise self.error
+
+
 class Inbound(Generic[M]):
     """One inbound link, in lockstep: schedule, lag, link emulation, validation."""
 
@@ -171,7 +252,7 @@ class Inbound(Generic[M]):
         *,
         key: str,
         msg_type: type[M],
-        channel: Channel,
+        channel: Channel | None,
         schedule: Schedule,
         lag: int,
         link_class: str,
@@ -202,6 +283,7 @@ class Inbound(Generic[M]):
         self.strict = True  # lockstep; False in real-time mode
         self.last_seen = -1  # tick of the last accepted frame
         self.dead = False
+        self.woken = False  # reactive mode: a WAKE came (a peer's token vanished)
         self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
         self.latest: M | None = None  # the last delivered message
 
@@ -237,6 +319,17 @@ class Inbound(Generic[M]):
         hold = max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
         heapq.heappush(self._pending, (base + hold, tick, msg))
         return True
+
+    def ready(self, k: int) -> bool:
+        """Every frame sent at or before k - lag is in (or the sender is dead)."""
+        return self.dead or self.last_seen >= self.schedule.last_at_or_before(k - self.lag)
+
+    def feed(self, raw: bytes) -> None:
+        """Reactive lockstep: one frame from the transport's callback (see `Reactor`)."""
+        if raw == WAKE:
+            self.woken = True  # looked at by the Reactor only when it waits on this link
+            return
+        self._accept(raw, None)
 
     def sync(self, k: int) -> None:
         """Block until every frame sent at or before k - lag is in (lockstep)."""

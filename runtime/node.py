@@ -12,6 +12,7 @@ A process kind subclasses `Node`, declares its links in `__init__` with
 
 from __future__ import annotations
 
+import functools
 import gc
 import hashlib
 import logging
@@ -27,8 +28,8 @@ from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.keys import KEY_BY_NAME, Keys
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
-from arena.runtime.lockstep import Inbound, Outbound, Rejections, Schedule, Watchdog
-from arena.runtime.tap import Tap, TappedOutbound
+from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
+from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
 
@@ -51,6 +52,10 @@ class Node:
         self.digest = hashlib.blake2b(digest_size=16)
         self.rejections = Rejections(self.log)
         self.watchdog = Watchdog(transport, cfg.timing.wait_timeout)
+        # Lockstep over zenoh runs the loop in the receive callbacks (`Reactor`);
+        # real time, and the memory transport of in-process runs, pull instead.
+        self.reactive = not cfg.realtime and getattr(transport, "callbacks", False)
+        self.reactor = Reactor(cfg.timing.wait_timeout) if self.reactive else None
         self.outbound: list[Outbound[Any]] = []
         self.inbound: list[Inbound[Any]] = []
         self.gone: set[str] = set()  # peers whose liveliness token vanished
@@ -64,8 +69,11 @@ class Node:
         # A recorded match: everything this process sends also goes to its tap
         # (runtime/tap.py), which the recorder collects.
         self.tap: Tap | None = None
+        self._tap_handoff: Handoff | None = None
         if cfg.record and pid.kind != "recorder":
-            self.tap = Tap(self.name, transport.publisher(keys.tap(self.name)))
+            put = transport.publisher(keys.tap(self.name))
+            self._tap_handoff = Handoff(put) if self.reactive else None
+            self.tap = Tap(self.name, self._tap_handoff or put)
 
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
@@ -98,7 +106,7 @@ class Node:
         ib: Inbound[Any] = Inbound(
             key=key,
             msg_type=spec.message,
-            channel=self.transport.subscribe(key),
+            channel=None if self.reactor else self.transport.subscribe(key),
             schedule=schedule,
             lag=lag,
             link_class=spec.link_class,
@@ -112,6 +120,8 @@ class Node:
             check=check,
         )
         ib.strict = not self.cfg.realtime
+        if self.reactor is not None:
+            self.transport.subscribe_callback(key, functools.partial(self.reactor.on_frame, ib))
         self.inbound.append(ib)
         return ib
 
@@ -171,7 +181,24 @@ class Node:
 
     # -------------------------------------------------------------------- run
     def loop(self) -> None:
+        """The whole match: the lockstep loop, or the real-time one with `--realtime`."""
+        if self.cfg.realtime:
+            self.loop_realtime()
+        else:
+            self.drive(self.lockstep())
+
+    def lockstep(self) -> Waits:
+        """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""
         raise NotImplementedError
+
+    def loop_realtime(self) -> None:
+        raise NotImplementedError
+
+    def drive(self, steps: Waits) -> None:
+        if self.reactor is not None:
+            self.reactor.run(steps)
+        else:
+            pull(steps)
 
     def summary_extra(self) -> dict[str, object]:
         return {}
@@ -192,6 +219,8 @@ class Node:
             self.watchdog.stop()
         if self.tap is not None:
             self.tap.close(self.last_tick)
+            if self._tap_handoff is not None:
+                self._tap_handoff.close()
         summary = self.summary()
         self.deliver_summary(msgs.encode(summary))
         return summary

@@ -20,6 +20,8 @@ class: not one instruction is added to its `send`.
 from __future__ import annotations
 
 import hashlib
+import queue
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -60,6 +62,34 @@ class Tap:
         self._frames = []
         self._put(encode(TapBatch(tick=watermark, process=self.process, seq=self._seq, final=final, frames=frames)))
         self._seq += 1
+
+
+class Handoff:
+    """A put that happens on a thread of its own, in order.
+
+    A reactive node (runtime/lockstep.py, `Reactor`) runs on zenoh's only
+    network thread. A tap batch is large (up to ~100 kB for the engine): a
+    blocking put that needs more room than the transmit queue has would wait
+    for the transmit task, which runs on that same thread. So batches leave
+    from here instead; `close` waits until every one is out.
+    """
+
+    def __init__(self, put: Callable[[bytes], None]):
+        self._put = put
+        self._queue: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
+        self._thread = threading.Thread(target=self._run, name="tap", daemon=True)
+        self._thread.start()
+
+    def __call__(self, payload: bytes) -> None:
+        self._queue.put(payload)
+
+    def _run(self) -> None:
+        while (payload := self._queue.get()) is not None:
+            self._put(payload)
+
+    def close(self) -> None:
+        self._queue.put(None)
+        self._thread.join()
 
 
 class TappedOutbound(Outbound[Any]):

@@ -32,6 +32,8 @@ class Transport(Protocol):
         """A put function for `key`. With `when_matched`, puts are skipped while no
         remote subscriber matches (for keys nobody in the lockstep waits on)."""
     def subscribe(self, key: str) -> Channel: ...
+    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
+        """Run `callback(payload)` on the transport's own thread for every frame of `key`."""
     def wake(self, key: str) -> None:
         """Deliver WAKE to this process's own subscribers of `key` only."""
     def declare_alive(self, key: str) -> None: ...
@@ -65,6 +67,7 @@ class ZenohTransport:
     """
 
     FIFO = 1 << 14  # frames buffered per subscription
+    callbacks = True  # subscribe_callback works (Node.reactive)
 
     def __init__(self, session: zenoh.Session):
         self.session = session
@@ -105,6 +108,16 @@ class ZenohTransport:
         # main thread's ("Already mutably borrowed").
         self._wakers[key] = self.session.declare_publisher(key, allowed_destination=zenoh.Locality.SESSION_LOCAL)
         return _ZenohChannel(sub)
+
+    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
+        def on_sample(sample: zenoh.Sample) -> None:
+            callback(sample.payload.to_bytes())
+
+        # indirect=False: run on zenoh's receive thread itself. The default hands
+        # every sample to a Python thread of its own, one more wake-up per frame.
+        handler = zenoh.handlers.Callback(on_sample, indirect=False)
+        self._keep.append(self.session.declare_subscriber(key, handler))
+        self._wakers[key] = self.session.declare_publisher(key, allowed_destination=zenoh.Locality.SESSION_LOCAL)
 
     def wake(self, key: str) -> None:
         waker = self._wakers.get(key)
@@ -210,6 +223,8 @@ class MemoryBus:
 
 
 class MemoryTransport:
+    callbacks = False
+
     def __init__(self, bus: MemoryBus):
         self.bus = bus
         self._tokens: list[str] = []
@@ -224,6 +239,11 @@ class MemoryTransport:
 
     def subscribe(self, key: str) -> Channel:
         return self.bus.subscribe(self, key)
+
+    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
+        # A callback would run in the sender's thread, inside the sender's own
+        # tick: nodes on a memory bus pull from channels instead (Node.reactive).
+        raise NotImplementedError("MemoryTransport delivers to channels only")
 
     def wake(self, key: str) -> None:
         self.bus.deliver(key, WAKE, only=self)

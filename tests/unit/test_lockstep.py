@@ -5,12 +5,14 @@ from __future__ import annotations
 import hashlib
 import logging
 import random
+import threading
+import time
 
 import pytest
 
 from arena.runtime.links import LinkEmulator, LinkModel
 from arena.runtime.lockstep import EVERY_TICK, Inbound, Outbound, Rejections, Schedule, Watchdog
-from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.messages import Cmd, encode
 
 KEY = "arena/t/robot/a/1/cmd"
@@ -155,3 +157,118 @@ def test_a_late_old_frame_never_replaces_fresher_news():
         assert harness.inbound.latest.tick == 1
     finally:
         harness.close()
+
+
+# ------------------------------------------------------------------ Reactor
+def _two_link_loop(a, b, log, last=6):
+    """A lockstep loop over two links, as a process writes it (runtime/node.py)."""
+    for k in range(last + 1):
+        yield a, k
+        yield b, k
+        log.append((k, [m.tick for m in a.take(k)], [m.tick for m in b.take(k)]))
+
+
+def _frames(ticks):
+    return [encode(Cmd(tick=t)) for t in ticks]
+
+
+def _two_harnesses(**kw):
+    return Harness(**kw), Harness(schedule=Schedule(2, 0), **kw)
+
+
+def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
+    """Same frames, any arrival order between links: the same steps, whoever drives."""
+    from arena.runtime.lockstep import Reactor, pull
+
+    pulled: list = []
+    a, b = _two_harnesses()
+    for raw in _frames(range(7)):
+        a.put(raw)
+    for raw in _frames(range(0, 7, 2)):
+        b.put(raw)
+    pull(_two_link_loop(a.inbound, b.inbound, pulled))
+
+    reacted: list = []
+    a2, b2 = _two_harnesses()
+    reactor = Reactor(timeout=5.0)
+    done = threading.Thread(target=reactor.run, args=(_two_link_loop(a2.inbound, b2.inbound, reacted),))
+    done.start()
+    # Frames come from another thread, interleaved differently from the pull run.
+    for t in range(7):
+        reactor.on_frame(a2.inbound, _frames([t])[0])
+        if t % 2 == 0:
+            reactor.on_frame(b2.inbound, _frames([t])[0])
+    done.join(5.0)
+    assert not done.is_alive() and reactor.error is None
+    assert reacted == pulled and len(reacted) == 7
+    for harness in (a, b, a2, b2):
+        harness.close()
+
+
+def test_the_reactor_stops_at_the_first_missing_frame_and_goes_on_when_it_comes():
+    from arena.runtime.lockstep import Reactor
+
+    log: list = []
+    a, b = _two_harnesses()
+    reactor = Reactor(timeout=5.0)
+    runner = threading.Thread(target=reactor.run, args=(_two_link_loop(a.inbound, b.inbound, log, last=3),))
+    runner.start()
+    for t in range(3):
+        reactor.on_frame(a.inbound, _frames([t])[0])
+    reactor.on_frame(b.inbound, _frames([0])[0])
+    time.sleep(0.05)
+    assert [k for k, _, _ in log] == [0, 1, 2], "tick 3 needs b's frame sent at 2 (lag 1, period 2)"
+    assert not reactor.done.is_set()
+    reactor.on_frame(b.inbound, _frames([2])[0])
+    runner.join(5.0)
+    assert [k for k, _, _ in log] == [0, 1, 2, 3] and reactor.done.is_set()
+    a.close()
+    b.close()
+
+
+def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
+    from arena.runtime.lockstep import Reactor
+
+    a, b = _two_harnesses()
+    log: list = []
+    reactor = Reactor(timeout=0.3)
+    reactor.on_frame(b.inbound, _frames([0])[0])
+    t0 = time.monotonic()
+    reactor.run(_two_link_loop(a.inbound, b.inbound, log, last=0))  # a never sends tick... lag 1 needs nothing at 0
+    assert log == [(0, [], [])]
+    reactor2 = Reactor(timeout=0.3)
+    a2, b2 = _two_harnesses()
+    reactor2.run(_two_link_loop(a2.inbound, b2.inbound, [], last=3))  # nobody sends anything
+    assert a2.inbound.dead and b2.inbound.dead and "silent" in a2.dead["robot/a/1"]
+    assert time.monotonic() - t0 < 5.0
+
+    # A vanished sender: its wake-up ends the wait at once, a stale one does not.
+    a3, b3 = _two_harnesses()
+    reactor3 = Reactor(timeout=30.0)
+    runner = threading.Thread(target=reactor3.run, args=(_two_link_loop(a3.inbound, b3.inbound, [], last=2),))
+    runner.start()
+    reactor3.on_frame(a3.inbound, WAKE)  # stale: the sender is still there
+    time.sleep(0.05)
+    assert not a3.inbound.dead
+    a3.gone.add("robot/a/1")
+    b3.gone.add("robot/a/1")
+    reactor3.on_frame(a3.inbound, WAKE)
+    reactor3.on_frame(b3.inbound, WAKE)
+    runner.join(5.0)
+    assert not runner.is_alive() and "liveliness" in a3.dead["robot/a/1"]
+    for harness in (a, b, a2, b2, a3, b3):
+        harness.close()
+
+
+def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
+    from arena.runtime.lockstep import Reactor
+
+    h = Harness()
+
+    def broken():
+        yield h.inbound, 0
+        raise ValueError("boom")
+
+    with pytest.raises(ValueError, match="boom"):
+        Reactor(timeout=1.0).run(broken())
+    h.close()
