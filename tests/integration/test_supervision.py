@@ -70,7 +70,7 @@ def test_a_killed_launcher_leaves_no_orphans(reap):
 
 
 def test_a_hung_robot_is_declared_dead_after_a_bounded_wait(reap, tmp_path):
-    """SIGSTOP a robot: its liveliness lease (2 s) expires, and the match plays on without it."""
+    """SIGSTOP a robot: its liveliness lease (6 s) expires, and the match plays on without it."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     proc = spawn(*MATCH, "--half-time", "20", "--match", "hang", "--listen", endpoint)
     reap.append(proc)
