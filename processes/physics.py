@@ -38,7 +38,9 @@ What it models (SI units throughout: m, s, kg, rad):
   rate exceeds dribble_max_omega, when the dribbler is switched off, or to a
   challenge: another robot's body touches the ball, or another robot with its
   own dribbler on comes within `CHALLENGE_DIST` of the ball. A robot that lost
-  a challenge cannot recapture for `NO_CATCH_S`. One holder at a time.
+  a challenge cannot recapture for `NO_CATCH_S`, nor challenge the new holder
+  (by dribbler or body) for `NO_CHALLENGE_S`, so that two robots at one ball do
+  not swap it every tick. One holder at a time.
 * **Kicker.** A kick fires once per `set_command` whose kick_speed > 0, as soon
   as the robot holds the ball or has it within reach in front: the ball leaves
   along the robot's heading at min(kick_speed, kick_max_speed). A lob splits
@@ -110,6 +112,7 @@ HOLD_GAP = 0.005  # [m] held ball's surface to the front face
 CHALLENGE_DIST = 0.20  # [m] challenger's footprint edge to the ball's surface
 BOUNCE_STOP = 0.5  # [m/s] vertical speed below which a landing ball stops bouncing
 NO_CATCH_S = 0.25  # [s] after its own kick or a lost challenge a dribbler cannot capture
+NO_CHALLENGE_S = 0.16  # [s] after a lost challenge a robot cannot challenge the new holder (no 1-tick ping-pong)
 PIN_TOLERANCE = 1e-3  # [m] a pinned ball moved farther than this is put back
 
 _CAT_FENCE = 0b0001
@@ -148,6 +151,7 @@ class _Robot:
     dribbler: bool = False
     dist: float = 0.0  # [m] travelled
     catch_from: int = 0  # first tick at which the dribbler may capture the ball again
+    challenge_from: int = 0  # first tick at which it may challenge a holder again
     ctrl_set: tuple[float, float, float] = (0.0, 0.0, 0.0)  # last control velocity written
     carry_from: tuple[float, float] = (0.0, 0.0)  # [m] its centre when its dribbler took the ball
 
@@ -182,6 +186,7 @@ class Physics:
         self._hold_dist = self._face + HOLD_GAP
         self._challenge = rp.size / 2 + bp.radius + CHALLENGE_DIST  # [m] centre to centre
         self._no_catch_ticks = math.ceil(NO_CATCH_S / self._dt)
+        self._no_challenge_ticks = math.ceil(NO_CHALLENGE_S / self._dt)
         self._drive = Drive(rp)
         self._push_speed = cfg.rules.push_speed  # [m/s]
         self._dribble_limit = cfg.rules.dribble_limit  # [m]
@@ -425,7 +430,8 @@ class Physics:
             r = self._robots[i]
             holder = self._holder
             if holder is not None and holder is not r:
-                self._lose(holder)
+                if self.tick >= r.challenge_from:
+                    self._lose(holder)
             elif self._can_capture(r) and self._in_reach(r, s):
                 self._capture(r, s)
             self._touch(r, s)
@@ -457,17 +463,20 @@ class Physics:
 
     def _challenged(self, holder: _Robot, s: list[float]) -> bool:
         """Another robot touches the held ball, or wants it (dribbler on) and is close."""
-        bx, by = s[self._ball_off], s[self._ball_off + 1]
+        bx, by, tick = s[self._ball_off], s[self._ball_off + 1], self.tick
         for r in self._robots:
-            if r is not holder and r.dribbler and math.hypot(s[r.off] - bx, s[r.off + 1] - by) < self._challenge:
+            if (r is not holder and r.dribbler and tick >= r.challenge_from
+                    and math.hypot(s[r.off] - bx, s[r.off + 1] - by) < self._challenge):
                 return True
         for hit in self._space.shape_query(self._ball_shape):
-            if hit.shape.collision_type >= _ROBOT_TYPE0 and hit.shape.body is not holder.body:
+            t = hit.shape.collision_type - _ROBOT_TYPE0
+            if t >= 0 and hit.shape.body is not holder.body and tick >= self._robots[t].challenge_from:
                 return True
         return False
 
     def _lose(self, holder: _Robot) -> None:
         holder.catch_from = self.tick + self._no_catch_ticks
+        holder.challenge_from = self.tick + self._no_challenge_ticks
         self._release()
 
     # -------------------------------------------------------- ball handling

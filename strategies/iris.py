@@ -3,7 +3,11 @@
 Four strategies, registered by name (:data:`STRATEGIES`): ``basic-static``
 (BS), ``basic-dynamic`` (BD), ``advance-static`` (AS), ``advance-dynamic`` (AD).
 All four share robot speed and kick speed (paper 2: "the speed of movement of
-the robot and the kick on goal is made the same for all the algorithms").
+the robot and the kick on goal is made the same for all the algorithms"), the
+goalkeeper, the ball handling and the referee handling; they differ only in
+what the paper makes them differ in: the attack and the defense of the outfield
+robots (basic or advance, Fig. 7) and the role assignment (static or dynamic,
+Fig. 6).
 
 Base station (`IrisTeam`), every comm period:
 
@@ -20,23 +24,56 @@ Robot (`IrisRobot`), every tick, from its own `Sense` and the latest `Order`
 * referee: stands still on STOP-like commands, positions for set pieces
   (own team: one robot goes behind the ball; opponents keep `setpiece_distance`
   from the spot) and plays on START;
-* goalkeeper (robot 0): guards the mouth and intercepts the predicted ball path
-  (:func:`.skills.keeper_target`), clears balls that stop near it;
-* outfield: per role and team mode (Fig. 6 state in the order):
-  - basic: the robot whose area holds the ball and that is nearest goes for
-    it, dribbles it goal-ward and kicks from `basic_shoot_distance`; the
-    others wait at their home positions;
-  - advance attack (Fig. 7a): a defender holding the ball passes to the
-    attacker; the attacker dribbles goal-ward, sidesteps an opponent in its
-    path with its back to it, and shoots within `advance_shoot_distance` only
-    when the line to the goal is clear;
-  - advance defense (Fig. 7b): the nearest defender blocks the kick line of
-    the opponent ball carrier 1 m from it, retreats down to 3 m from our goal
-    centre, then follows the ball, and takes the ball within 0.5 m.
+* goalkeeper (robot 0, all four strategies): guards the mouth and intercepts
+  the predicted ball path (:func:`.skills.keeper_target`), clears balls that
+  stop near it;
+* outfield robots, per role and team mode (the Fig. 6 state in the order):
+  - the ball: the robot whose area holds the ball and that is nearest goes
+    for it (paper 2: "pick up the ball"); the others take their positions
+    (`home`); a robot that has just passed leaves the ball to the receiver;
+  - basic attack (paper 2, "Basic strategy algorithm"): the holder dribbles
+    straight towards the goal and kicks from `basic_shoot_distance`, whatever
+    stands in the way, at the side of the goal the keeper leaves open; a
+    static defender at the edge of its area kicks the ball on to its attacker
+    (a pass ahead of it, `pass_lead`), blocked line or not;
+  - advance attack (Fig. 7a): shoot within `advance_shoot_distance` only when
+    the line to the goal is clear (`.skills.best_aim`, the clear aim point
+    needing the least turn), and carry a decided shot through for
+    `shot_commit`; pass to a teammate that has a clear shot; a defender feeds
+    the attacker when the pass line is clear; with an opponent in the path,
+    go round it in a circle with the body between it and the ball, on the side
+    away from the near touch line (`.skills.circle_past`, eq. 1 motion), then
+    goal-ward again; closed down (`pressure_range`), release the ball (pass,
+    or a clear shot from up to `long_shot`); the attacker without the ball
+    gets open for a pass and a shot (`.skills.open_point`);
+  - basic defense: the robot whose area holds the ball tries to catch it and
+    grab it from the opponent (`get_ball`), the others wait at home;
+  - advance defense (Fig. 7b): the defender meets an opponent carrying the ball
+    within `block_zone` of our goal on its estimated kick line, 1 m from it,
+    retreating with it down to 3 m from our goal centre and then following the
+    ball (`.skills.block_point`), and takes the ball within 0.5 m; otherwise it
+    marks the other opponent goal-side when that one is within `mark_zone`
+    of our goal (man-to-man marking, the paper's stated approach).
+* ball handling, the same for all four strategies: the MSL dribbling limit (a
+  holder releases the ball before `carry_limit` of straight carry: pass, shot,
+  or a push ahead that it catches again, `nudge_point`); a robot that loses
+  the ball to a tackle steps off it for `regroup` (basic: aside; advance:
+  goal-side, back onto the kick line) instead of wrestling for it; a holder
+  pinned for `stall_hold` plays the ball on (`unstall`).
 * every motion goes through a navigator of :mod:`arena.navigation` (F-SFM by
-  default) so that robots steer round each other; the heading uses the PID of
-  paper 1 eq. 15-16 (:mod:`arena.navigation.pid`), capped below the dribbler's
-  3 rad/s while holding the ball.
+  default, paper 1 eq. 3-14) with the robots within `obstacle_range` as
+  obstacles, so that robots steer round each other; the heading uses the PID
+  of paper 1 eq. 15-16 (:mod:`arena.navigation.pid`), capped below the
+  dribbler's 3 rad/s while holding the ball. The closing speed towards an
+  opponent, of the robot and of a ball it holds, is capped to what the drive
+  can brake to `push_guard` before contact, and to `contact_push` (0) in
+  contact (`guard_push`): no pushing fouls, no shoving, no driving the ball
+  into an opponent.
+
+Cost: what depends only on the order (areas, roles, teammates) is worked out
+once per order (`_Plan`, `support_point`), not once per tick; with no robot
+within `obstacle_range` the navigator is not called (F-SFM then gives the
+straight line at cruise speed).
 """
 
 from __future__ import annotations
@@ -69,26 +106,49 @@ class IrisParams:
     cruise: float = 2.5  # [m/s] travel speed, same for all four strategies
     dribble_speed: float = 1.5  # [m/s] while holding the ball
     approach_speed: float = 1.8  # [m/s] final approach onto the ball
-    kick_speed: float = 6.5  # [m/s] shot speed, same for all four strategies
-    basic_shoot_distance: float = 4.0  # [m] basic: kick from this distance to the goal centre
+    kick_speed: float = 8.0  # [m/s] shot speed (the kicker's full power), same for all four strategies
+    basic_shoot_distance: float = 5.0  # [m] basic: kick from this distance to the goal centre
     advance_shoot_distance: float = 4.5  # [m] advance: shoot within this distance if the line is clear
     close_shot: float = 1.8  # [m] advance: shoot anyway this close
     pass_arrive: float = 1.5  # [m/s] ball speed at the receiver
     dribble_omega: float = 2.4  # [rad/s] turn-rate cap with the ball (the dribbler loses it at 3)
     max_omega: float = 5.0  # [rad/s] turn-rate cap without the ball
-    aim_tolerance: float = 0.08  # [rad] heading error at which a shot or pass is taken
+    aim_tolerance: float = 0.08  # [rad] largest heading error at which a shot or pass is taken
+    shot_spread: float = 0.15  # [m] ... and at most this much off the aim point where the ball gets there
+    min_aim_tolerance: float = 0.025  # [rad] (noise floor: the heading is sensed with 0.01 rad sigma)
+    pass_lead: float = 0.8  # [m] a pass goes this far ahead of the receiver, towards the goal
+    pass_rest: float = 1.0  # [s] after a pass the passer leaves the ball to the receiver this long
     k_pos: float = 2.5  # [1/s] arrival slow-down: speed <= k_pos * distance
     direct_range: float = 0.7  # [m] closer than this to a target the robot drives straight at it
-    obstacle_range: float = 3.0  # [m] robots farther than this are no obstacle
+    # [m] robots farther than this are no obstacle: beyond 1.5 m the F-SFM social force
+    # (paper 1 eq. 6, sigma 0.3 m, r_ij 0.5 m) is below 2 % of the goal force at cruise speed
+    obstacle_range: float = 1.5
     setpiece_distance: float = 2.0  # [m] opponents keep this far from a set-piece spot
     setpiece_behind: float = 0.5  # [m] the taker stands this far behind the ball
     chase_hysteresis: float = 0.4  # [m] the current chaser counts this much nearer
     possession_radius: float = 0.4  # [m] an opponent this close to the ball has it
     max_hold: float = 2.5  # [s] advance: act (shoot, pass or push ahead) after holding the ball this long
     carry_limit: float = 2.0  # [m] release the ball before this straight-line carry (MSL dribble limit 3 m)
-    nudge_speed: float = 1.6  # [m/s] advance: kick the ball ahead to restart a carry at the limit
-    push_guard: float = 0.9  # [m/s] closing speed cap towards a nearby opponent (pushing fouls above 1.5)
-    push_guard_range: float = 1.0  # [m] opponents closer than this (centre to centre) get the cap
+    nudge_speed: float = 1.6  # [m/s] kick the ball ahead to restart a carry at the limit
+    regroup: float = 0.6  # [s] after losing the ball to a tackle, step back this long ...
+    regroup_clear: float = 0.6  # [m] ... first backing straight off the ball to this far (centre to ball centre)
+    regroup_distance: float = 0.9  # [m] ... to this far from the ball (basic: aside, advance: goal-side)
+    cover_depth: float = -2.5  # [m] along the attack direction: the defender's place while the team attacks
+    mark_zone: float = 5.0  # [m] advance defense: an opponent this close to our goal is marked
+    block_zone: float = 6.5  # [m] advance defense: a carrier this close to our goal is blocked, not left to the attacker
+    pressure_range: float = 1.2  # [m] advance attack: a blocker this close leaves no room to go round it
+    long_shot: float = 6.0  # [m] advance attack: under pressure, a clear shot from this far is still taken
+    keeper_zone: float = 1.2  # [m] advance attack: an opponent this close to the goal centre is the keeper, no blocker
+    shot_commit: float = 0.6  # [s] advance attack: once a clear shot is seen, turn and take it within this time
+    stall_hold: float = 4.0  # [s] a holder still holding after this long plays the ball on (`unstall`)
+    unstall_speed: float = 3.0  # [m/s]
+    push_guard: float = 0.5  # [m/s] closing speed at contact with an opponent (pushing fouls above 1.5 for both)
+    brake: float = 1.2  # [m/s^2] deceleration the push guard counts on (the drive gives 2)
+    push_guard_range: float = 2.5  # [m] opponents closer than this (centre to centre) get the cap
+    ball_contact_range: float = 0.4  # [m] held ball's centre to an opponent's centre: touching or nearly
+    separate_speed: float = 0.5  # [m/s] a robot turning with the ball edges away from an opponent in contact
+    contact_range: float = 0.65  # [m] centre to centre: the footprints (0.45 m squares) may touch (corner to corner 0.64)
+    contact_push: float = 0.0  # [m/s] closing speed cap towards an opponent in contact
     heading_pid: PIDParams = PIDParams(k_p=6.0, k_i=0.0, k_d=2.0)  # paper 1 eq. 16 gains for 50 Hz
     skills: S.SkillParams = S.SkillParams()
     fusion: FusionParams = FusionParams()
@@ -170,7 +230,26 @@ class _Memory:
     chasing: bool = False
     carry_from: Vec | None = None  # [m] where this robot took the ball
     hold_since: int = 0  # [tick] when it took the ball
+    passed_at: int = -(1 << 30)  # [tick] of its latest pass
+    kicked_at: int = -(1 << 30)  # [tick] of its latest kick command
+    lost_at: int = -(1 << 30)  # [tick] when it last lost the ball (not by its own kick)
+    circle_rot: float = 0.0  # advance attack: the way round the opponent it is circling (+1 ccw, -1 cw)
+    circle_tick: int = -(1 << 30)  # [tick] of the latest circling step
+    shot_until: int = -(1 << 30)  # [tick] a decided shot is carried through until then
+    shot_aim: Vec = (0.0, 0.0)  # [m]
     pid: PIDState = field(default_factory=PIDState)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What follows from one order alone: roles, areas, teammates (worked out once per order)."""
+
+    role: str
+    area: tuple[float, float]  # (u_min, u_max) [m] of this robot
+    areas: dict[int, tuple[float, float]]  # of every outfield teammate with a role
+    attackers: tuple[Vec, ...]  # positions [m] of the teammates that are attackers, by robot number
+    mates: tuple[Vec, ...]  # positions [m] of the outfield teammates, by robot number
+    attacking: bool  # Fig. 6: the team is in attacking mode
 
 
 class IrisRobot:
@@ -192,6 +271,13 @@ class IrisRobot:
         self.mem = _Memory()
         self.role = "goalkeeper" if ctx.n == 0 else ""
         self.order: Order | None = None
+        self.plan: _Plan | None = None
+        self._support: tuple[Order | None, Vec] | None = None
+        self._planned: Order | None = None
+        self._ticks_2s = int(2.0 / cfg.timing.dt)
+        self.tick = 0
+        self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
+        self._commit_ticks = int(round(p.shot_commit / cfg.timing.dt))
 
     # ------------------------------------------------------------------ report
     def report(self, tick: int, sense: Sense | None) -> Report:
@@ -207,12 +293,18 @@ class IrisRobot:
     def step(self, tick: int, sense: Sense | None, order: Order | None) -> Cmd:
         self.view.update(tick, sense, order)
         self.order = order
+        self.tick = tick
         if order is None or sense is None or self.view.pose is None:
             return Cmd(tick=tick)
         if order.command != self.mem.command:
             self.mem.command, self.mem.command_since = order.command, tick
         self.role = order.role or self.role or "defender"
+        if order is not self._planned:
+            self.plan = self.make_plan(order)
+            self._planned = order
         if not self.view.has_ball:
+            if self.mem.carry_from is not None and tick - self.mem.kicked_at > 2:
+                self.mem.lost_at = tick
             self.mem.carry_from = None
         elif self.mem.carry_from is None:
             self.mem.carry_from = (self.view.pose[0], self.view.pose[1])
@@ -232,6 +324,20 @@ class IrisRobot:
             return self.with_ball(tick, order, ball)
         return self.without_ball(tick, order, ball)
 
+    def make_plan(self, order: Order) -> _Plan:
+        roles = {n: r for n, (_, _, r) in self.view.mates.items() if n != 0 and r in ("attacker", "defender")}
+        if self.n != 0:
+            roles[self.n] = self.role
+        areas = R.areas(roles, self.area_params)
+        attackers = tuple(
+            (x, y) for n, (x, y, r) in sorted(self.view.mates.items()) if n != 0 and r == "attacker"
+        )
+        mates = tuple((x, y) for n, (x, y, _) in sorted(self.view.mates.items()) if n != 0)
+        return _Plan(
+            role=self.role, area=areas.get(self.n, self.area_params.defense), areas=areas,
+            attackers=attackers, mates=mates, attacking=R.is_attacking(order.role_state),
+        )
+
     # ------------------------------------------------------------- geometry
     def goal(self, order: Order) -> Vec:
         return order.attack_dir * self.half_length, 0.0
@@ -248,9 +354,7 @@ class IrisRobot:
         return S.clamp(pt[0], -hx, hx), S.clamp(pt[1], -hy, hy)
 
     def my_area(self, order: Order) -> tuple[float, float]:
-        roles = {n: r for n, (_, _, r) in self.view.mates.items() if n != 0 and r in ("attacker", "defender")}
-        roles[self.n] = self.role
-        return R.areas(roles, self.area_params).get(self.n, self.area_params.defense)
+        return self.plan.area  # type: ignore[union-attr]
 
     # --------------------------------------------------------------- motion
     def drive(
@@ -259,36 +363,62 @@ class IrisRobot:
     ) -> Cmd:
         """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots."""
         x, y, th = self.view.pose  # type: ignore[misc]
-        pos = (x, y)
         target = self.inside(target)
-        d = S.dist(pos, target)
+        tx, ty = target[0] - x, target[1] - y
+        d = math.hypot(tx, ty)
+        vx, vy = tx, ty
         if avoid and d > self.p.direct_range:
-            obstacles = [o for o in self.view.others() if S.dist(o, pos) < self.p.obstacle_range]
-            obstacles.extend(extra_obstacles)
-            vx, vy = self.nav(pos, self.view.vel, target, obstacles, self.nav_params)
-        else:
-            vx, vy = (target[0] - x, target[1] - y)
+            near = self.p.obstacle_range
+            obstacles = [o for o in self.view.others() if abs(o[0] - x) < near and abs(o[1] - y) < near
+                         and math.hypot(o[0] - x, o[1] - y) < near]
+            for o in extra_obstacles:
+                if math.hypot(o[0] - x, o[1] - y) < near:
+                    obstacles.append(o)
+            if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
+                vx, vy = self.nav((x, y), self.view.vel, target, obstacles, self.nav_params)
         speed = math.hypot(vx, vy)
         cap = min(vmax, self.p.k_pos * d)
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
-        vx, vy = self.guard_push(pos, vx, vy)
+        vx, vy = self.guard_push(x, y, vx, vy, self.p.contact_range)
+        if self.view.has_ball:  # the held ball is part of the body: do not push it into an opponent either
+            reach = self.ball_reach
+            vx, vy = self.guard_push(x + reach * math.cos(th), y + reach * math.sin(th), vx, vy, self.p.ball_contact_range)
         omega, self.mem.pid = pid_step(self.mem.pid, heading, th, self.p.heading_pid)
         limit = self.p.dribble_omega if self.view.has_ball or dribbler and d < 0.6 else self.p.max_omega
         omega = S.clamp(omega, -limit, limit)
         c, s = math.cos(th), math.sin(th)
         return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
 
-    def guard_push(self, pos: Vec, vx: float, vy: float) -> Vec:
-        """Cap the closing speed towards every opponent within push_guard_range (no pushing fouls)."""
-        for o in self.view.opponents:
-            d = S.dist(pos, o)
-            if 1e-6 < d < self.p.push_guard_range:
-                ex, ey = (o[0] - pos[0]) / d, (o[1] - pos[1]) / d
+    def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:
+        """Cap the closing speed towards every nearby opponent, so that contact is never a pushing foul.
+
+        (x, y) is the point that must not push: the robot's centre (contact at
+        `contact_range`) or the centre of the ball it holds (`ball_contact_range`).
+        The cap is what the drive can still brake from before the bodies meet:
+        v <= sqrt(push_guard^2 + 2 brake (d - contact)) at distance d [m], so
+        that the robot arrives at `push_guard` or slower whatever its
+        acceleration limit; in contact (d < contact) it is `contact_push`: a
+        robot does not shove an opponent along (MSL: charging), so a carrier
+        that shields the ball with its body can turn away, and a holder does
+        not drive the ball into an opponent (which would knock it loose).
+        """
+        rng, brake2 = self.p.push_guard_range, 2.0 * self.p.brake
+        guard2 = self.p.push_guard * self.p.push_guard
+        for ox, oy in self.view.opponents:
+            dx, dy = ox - x, oy - y
+            if abs(dx) > rng or abs(dy) > rng:
+                continue
+            d = math.hypot(dx, dy)
+            if 1e-6 < d < rng:
+                ex, ey = dx / d, dy / d
                 closing = vx * ex + vy * ey
-                if closing > self.p.push_guard:
-                    vx -= (closing - self.p.push_guard) * ex
-                    vy -= (closing - self.p.push_guard) * ey
+                if closing <= self.p.contact_push:
+                    continue
+                cap = self.p.contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
+                if closing > cap:
+                    vx -= (closing - cap) * ex
+                    vy -= (closing - cap) * ey
         return vx, vy
 
     def get_ball(self, tick: int, ball: Vec, target: Vec) -> Cmd:
@@ -306,18 +436,47 @@ class IrisRobot:
         heading = S.angle_to(ball, target) if S.dist(pos, behind) < 1.0 else to_ball
         return self.drive(tick, behind, heading, self.p.cruise, dribbler=d < 1.0, extra_obstacles=(ball,))
 
-    def turn_and_kick(self, tick: int, aim: Vec, speed: float) -> Cmd:
-        """Holding the ball: turn towards aim (slowly) and kick once facing it."""
+    def turn_and_kick(self, tick: int, aim: Vec, speed: float, *, is_pass: bool = False) -> Cmd:
+        """Holding the ball: turn towards aim (slowly) and kick once facing it.
+
+        The kick is taken once the ball would pass within `shot_spread` of aim,
+        i.e. at a heading error below atan(shot_spread / distance), between
+        `min_aim_tolerance` and `aim_tolerance`; passes allow twice the spread.
+        """
         x, y, th = self.view.pose  # type: ignore[misc]
         want = S.angle_to((x, y), aim)
-        kick = speed if abs(S.wrap(want - th)) < self.p.aim_tolerance else 0.0
-        return self.drive(tick, (x, y), want, 0.0, dribbler=True, kick=kick, avoid=False)
+        spread = self.p.shot_spread * (2.0 if is_pass else 1.0)
+        tol = S.clamp(math.atan2(spread, S.dist((x, y), aim)), self.p.min_aim_tolerance, self.p.aim_tolerance)
+        # The kick leaves along the heading of the next tick, when the command applies.
+        kick = speed if abs(S.wrap(want - th - self.view.omega * self.cfg.timing.dt)) < tol else 0.0
+        if kick:
+            self.mem.kicked_at = tick
+            if is_pass:
+                self.mem.passed_at = tick
+        # Turning on the spot; an opponent in contact would jam the turn, so edge away from it.
+        spot = (x, y)
+        near = self.nearest_opponent(x, y)
+        if near is not None and S.dist(near, spot) < self.p.contact_range:
+            a = S.angle_to(near, spot)
+            spot = (x + 0.5 * math.cos(a), y + 0.5 * math.sin(a))
+        return self.drive(tick, spot, want, self.p.separate_speed if spot != (x, y) else 0.0, dribbler=True,
+                          kick=kick, avoid=False)
+
+    def nearest_opponent(self, x: float, y: float) -> Vec | None:
+        best, found = math.inf, None
+        for o in self.view.opponents:
+            d = abs(o[0] - x) + abs(o[1] - y)
+            if d < best:
+                best, found = d, o
+        return found
+
+    def pass_to(self, tick: int, target: Vec) -> Cmd:
+        return self.turn_and_kick(tick, target, self.pass_speed(target), is_pass=True)
 
     # ---------------------------------------------------------------- referee
     def position_for_restart(self, tick: int, order: Order) -> Cmd:
         spot = (order.spot_x, order.spot_y)
         goal = self.goal(order)
-        x, y, _ = self.view.pose  # type: ignore[misc]
         if self.role == "goalkeeper":
             own = self.own_goal(order)
             target = (own[0] + order.attack_dir * self.p.skills.keeper_depth, 0.0)
@@ -348,39 +507,70 @@ class IrisRobot:
         """After the opponents' set-piece START: stay away until the ball has moved or 2 s passed."""
         if order.command_team in (self.team, "") or self.role == "goalkeeper":
             return False
-        fresh = tick - self.mem.command_since < int(2.0 / self.cfg.timing.dt)
+        fresh = tick - self.mem.command_since < self._ticks_2s
         return fresh and S.dist(ball, (order.spot_x, order.spot_y)) < 0.3
 
     # ------------------------------------------------------------- positions
     def home(self, order: Order, ball: Vec) -> Vec:
+        """Where a robot waits while it does not go for the ball, by role and team mode.
+
+        Attacker: in attacking mode up the field, on the other side from the
+        ball, to receive the ball; in defending mode just ahead of the ball, in
+        its area, ready for a counter-attack. Defender: in attacking mode at
+        `cover_depth` in its own half, following the ball's y a little; in
+        defending mode between the ball and our goal, at most 3.2 m out.
+        S2 (losing) pushes everyone 1 m up, S3 (winning) 1 m back.
+        """
         lo, hi = self.my_area(order)
         d = order.attack_dir
         bu = d * ball[0]
+        shift = 1.0 if order.strategy == R.S_OFFENSIVE else -1.0 if order.strategy == R.S_DEFENSIVE else 0.0
+        attacking = self.plan.attacking  # type: ignore[union-attr]
         if self.role == "attacker":
-            shift = -1.0 if order.strategy == R.S_DEFENSIVE else 0.0
+            if attacking:
+                u = S.clamp(bu + 2.5 + shift, max(lo + 1.5, 1.0), hi - 2.0)
+                yy = -1.5 if ball[1] > 0.5 else 1.5 if ball[1] < -0.5 else (1.5 if self.n % 2 else -1.5)
+                return d * u, yy
             u = S.clamp(bu + 1.5 + shift, lo + 0.5, hi - 1.5)
             yy = S.clamp(-0.5 * ball[1] + (1.0 if ball[1] <= 0 else -1.0), -2.5, 2.5)
             return d * u, yy
-        shift = 1.0 if order.strategy == R.S_OFFENSIVE else 0.0
+        if attacking:  # cover behind the play, little moved by the ball: the defender's area is its own half
+            u = S.clamp(self.p.cover_depth + shift, lo + 1.5, hi - 0.3)
+            return d * u, 0.25 * ball[1]
         own = self.own_goal(order)
-        r = min(3.2 + shift, 0.5 * S.dist(own, ball) + 1.0)
+        r = min(3.2 + max(shift, 0.0), 0.5 * S.dist(own, ball) + 1.0)
         a = S.angle_to(own, ball)
         hx, hy = own[0] + r * math.cos(a), own[1] + r * math.sin(a)
         u = S.clamp(d * hx, lo + 1.0, hi - 0.3)
         return d * u, hy
 
+    def support_point(self, order: Order, ball: Vec) -> Vec:
+        """Advance attack: get open for a pass and a shot (`.skills.open_point`), worked out once per order."""
+        if self._support is not None and self._support[0] is self.order:
+            return self._support[1]
+        lo, hi = self.my_area(order)
+        d = order.attack_dir
+        bu = d * ball[0]
+        us = {S.clamp(bu + k, max(lo + 1.0, 0.5), min(hi - 1.5, 4.5)) for k in (1.5, 3.0)}
+        cands = [(d * u, yy) for u in sorted(us) for yy in (-1.5, 0.0, 1.5)]
+        pt = S.open_point(ball, cands, self.view.opponents, self.goal(order)[0], self.goal_half,
+                          self.p.skills.clear_margin)
+        self._support = (self.order, pt)
+        return pt
+
     def is_chaser(self, order: Order, ball: Vec) -> bool:
-        """Nearest to the ball among our outfield robots whose area holds it."""
+        """Nearest to the ball among our outfield robots whose area holds it (a fresh passer leaves it)."""
         bu = self.u(order, ball[0])
         lo, hi = self.my_area(order)
+        if (self.tick - self.mem.passed_at) * self.cfg.timing.dt < self.p.pass_rest:
+            self.mem.chasing = False
+            return False
         if not lo - 0.3 <= bu <= hi + 0.3:
             self.mem.chasing = False
             return False
         x, y, _ = self.view.pose  # type: ignore[misc]
         mine = S.dist((x, y), ball) - (self.p.chase_hysteresis if self.mem.chasing else 0.0)
-        roles = {n: r for n, (_, _, r) in self.view.mates.items() if n != 0 and r in ("attacker", "defender")}
-        roles[self.n] = self.role
-        area = R.areas(roles, self.area_params)
+        area = self.plan.areas  # type: ignore[union-attr]
         for n, (mx, my, _) in self.view.mates.items():
             if n == 0 or n not in area:
                 continue
@@ -411,67 +601,139 @@ class IrisRobot:
         x, y, _ = self.view.pose  # type: ignore[misc]
         target = self.pass_target(order)
         if target is not None:
-            return self.turn_and_kick(tick, target, self.pass_speed(target))
+            return self.pass_to(tick, target)
         goal = self.goal(order)
         aim = (goal[0], S.clamp(y, -2.0, 2.0))
         return self.turn_and_kick(tick, aim, self.p.kick_speed)
 
-    def pass_target(self, order: Order) -> Vec | None:
-        """An attacker ahead of us with a clear line, if any."""
+    def pass_target(self, order: Order, any_mate: bool = False) -> Vec | None:
+        """Where to pass: `pass_lead` ahead of an attacker ahead of us (any_mate: any outfield
+        teammate not behind us), if the line there is clear."""
         x, y, _ = self.view.pose  # type: ignore[misc]
-        best: Vec | None = None
-        for n, (mx, my, role) in sorted(self.view.mates.items()):
-            if n == 0 or role != "attacker":
+        d = order.attack_dir
+        mates = self.plan.mates if any_mate else self.plan.attackers  # type: ignore[union-attr]
+        for mx, my in mates:
+            if d * (mx - x) <= (-0.5 if any_mate else 1.0) or S.dist((mx, my), (x, y)) < 1.0:
                 continue
-            ahead = self.u(order, mx) - self.u(order, x)
-            if ahead > 1.0 and S.line_clear((x, y), (mx, my), self.view.opponents, self.p.skills.clear_margin):
-                best = (mx, my)
-                break
-        return best
+            lead = self.lead_point(order, (mx, my))
+            if S.line_clear((x, y), lead, self.view.opponents, self.p.skills.clear_margin):
+                return lead
+        return None
+
+    def shooter_target(self, order: Order, pos: Vec, goal: Vec) -> Vec | None:
+        """Advance: a teammate (not the keeper) within shooting distance with a clear shot and a clear pass line."""
+        opponents, margin = self.view.opponents, self.p.skills.clear_margin
+        for n, (mx, my, _) in sorted(self.view.mates.items()):
+            if n == 0 or S.dist((mx, my), goal) > self.p.advance_shoot_distance or S.dist((mx, my), pos) < 1.0:
+                continue
+            if not S.line_clear(pos, (mx, my), opponents, margin):
+                continue
+            if S.best_aim((mx, my), goal[0], self.goal_half, opponents, margin)[1]:
+                return mx, my
+        return None
+
+    def lead_point(self, order: Order, mate: Vec) -> Vec:
+        """`pass_lead` in front of a teammate, towards the goal: it runs onto the ball facing the goal."""
+        goal = self.goal(order)
+        a = S.angle_to(mate, goal)
+        return self.inside((mate[0] + self.p.pass_lead * math.cos(a), mate[1] + self.p.pass_lead * math.sin(a)), -0.5)
+
+    def feed_target(self, order: Order) -> Vec | None:
+        """Basic: an attacker ahead of us, clear line or not."""
+        x, _, _ = self.view.pose  # type: ignore[misc]
+        for mx, my in self.plan.attackers:  # type: ignore[union-attr]
+            if self.u(order, mx) - self.u(order, x) > 0.5:
+                return self.lead_point(order, (mx, my))
+        return None
 
     def pass_speed(self, target: Vec) -> float:
         x, y, _ = self.view.pose  # type: ignore[misc]
         return S.pass_speed(S.dist((x, y), target), self.p.pass_arrive, self.cfg.ball.rolling_decel, self.p.kick_speed)
 
     def with_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
-        x, y, th = self.view.pose  # type: ignore[misc]
+        x, y, _ = self.view.pose  # type: ignore[misc]
         pos = (x, y)
         goal = self.goal(order)
-        lo, hi = self.my_area(order)
-        u = self.u(order, x)
-        d_goal = S.dist(pos, goal)
-        opponents = self.view.opponents
         carried = S.dist(pos, self.mem.carry_from) if self.mem.carry_from is not None else 0.0
         at_limit = carried > self.p.carry_limit
-        held_long = (tick - self.mem.hold_since) * self.cfg.timing.dt > self.p.max_hold
+        if (tick - self.mem.hold_since) * self.cfg.timing.dt > self.p.stall_hold:
+            return self.unstall(tick, order)
         if self.p.advance:
-            if self.role == "defender":
-                target = self.pass_target(order)
-                if target is not None:
-                    return self.turn_and_kick(tick, target, self.pass_speed(target))
-            aim, clear = S.best_aim(pos, goal[0], self.goal_half, opponents, self.p.skills.clear_margin)
-            if (d_goal < self.p.advance_shoot_distance and clear) or d_goal < self.p.close_shot:
-                return self.turn_and_kick(tick, aim, self.p.kick_speed)
-            if u > hi - 0.3:  # static defender at the edge of its area
-                return self.clear(tick, order, ball)
-            if at_limit or held_long:
-                target = self.pass_target(order)
-                if target is not None:
-                    return self.turn_and_kick(tick, target, self.pass_speed(target))
-                if clear and d_goal < 2.0 * self.p.advance_shoot_distance:
-                    return self.turn_and_kick(tick, aim, self.p.kick_speed)
-                return self.turn_and_kick(tick, self.nudge_point(pos, goal, opponents), self.p.nudge_speed)
-            blocker = S.blocker_ahead(pos, goal, opponents, self.p.skills.path_corridor, self.p.skills.path_lookahead)
-            if blocker is not None:
-                side = S.sidestep_target(pos, blocker, goal, self.p.skills.sidestep)
-                back_to_it = S.angle_to(blocker, pos)
-                return self.drive(tick, side, back_to_it, self.p.dribble_speed, dribbler=True, avoid=False)
-            ahead = (goal[0] - order.attack_dir * min(self.p.advance_shoot_distance - 0.5, d_goal), aim[1] * 0.5)
-            return self.drive(tick, ahead, S.angle_to(pos, aim), self.p.dribble_speed, dribbler=True, avoid=False)
+            return self.advance_attack(tick, order, ball, pos, goal, at_limit)
+        return self.basic_attack(tick, order, ball, pos, goal, at_limit)
+
+    def basic_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
+        """Paper 2, basic strategy: dribble towards the goal, kick from a set distance."""
         aim = (goal[0], self.open_side(goal[0]))
-        if d_goal < self.p.basic_shoot_distance or u > hi - 0.3 or at_limit:
+        if S.dist(pos, goal) < self.p.basic_shoot_distance:
             return self.turn_and_kick(tick, aim, self.p.kick_speed)
+        _, hi = self.my_area(order)
+        if not self.p.dynamic and self.u(order, pos[0]) > hi - 0.3:
+            # A static robot may not leave its area: kick the ball on to the attacker, else at the goal.
+            target = self.feed_target(order)
+            if target is not None:
+                return self.pass_to(tick, target)
+            return self.turn_and_kick(tick, aim, self.p.kick_speed)
+        if at_limit:
+            return self.turn_and_kick(tick, self.nudge_point(pos, goal, []), self.p.nudge_speed)
         return self.drive(tick, goal, S.angle_to(pos, goal), self.p.dribble_speed, dribbler=True, avoid=False)
+
+    def advance_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
+        """Paper 2, Fig. 7a: feed the attacker, sidestep blockers with the back to them, shoot when clear."""
+        opponents = self.view.opponents
+        d_goal = S.dist(pos, goal)
+        sp = self.p.skills
+        if tick <= self.mem.shot_until:  # a shot once decided is carried through (the line may flicker)
+            return self.turn_and_kick(tick, self.mem.shot_aim, self.p.kick_speed)
+        heading = self.view.pose[2]  # type: ignore[index]
+        aim, clear = S.best_aim(pos, goal[0], self.goal_half, opponents, sp.clear_margin, heading=heading)
+        if (d_goal < self.p.advance_shoot_distance and clear) or d_goal < self.p.close_shot:
+            self.mem.shot_until, self.mem.shot_aim = tick + self._commit_ticks, aim
+            return self.turn_and_kick(tick, aim, self.p.kick_speed)
+        target = self.shooter_target(order, pos, goal)
+        if target is not None:
+            return self.pass_to(tick, target)
+        if self.role == "defender":
+            target = self.pass_target(order)
+            if target is not None:
+                return self.pass_to(tick, target)
+        _, hi = self.my_area(order)
+        if not self.p.dynamic and self.u(order, pos[0]) > hi - 0.3:  # static defender at the edge of its area
+            return self.clear(tick, order, ball)
+        held_long = (tick - self.mem.hold_since) * self.cfg.timing.dt > self.p.max_hold
+        if at_limit or held_long:
+            target = self.pass_target(order)
+            if target is not None:
+                return self.pass_to(tick, target)
+            if clear and d_goal < 2.0 * self.p.advance_shoot_distance:
+                return self.turn_and_kick(tick, aim, self.p.kick_speed)
+            return self.turn_and_kick(tick, self.nudge_point(pos, goal, opponents), self.p.nudge_speed)
+        field_players = [o for o in opponents if S.dist(o, goal) > self.p.keeper_zone]  # the keeper is no blocker
+        blocker = S.blocker_ahead(pos, goal, field_players, sp.path_corridor, sp.path_lookahead)
+        if blocker is not None:
+            if S.dist(blocker, pos) < self.p.pressure_range:
+                # Closed down: no room left to go round; release the ball if there is any way.
+                target = self.pass_target(order, any_mate=True)
+                if target is not None:
+                    return self.pass_to(tick, target)
+                if clear and d_goal < self.p.long_shot:
+                    self.mem.shot_until, self.mem.shot_aim = tick + self._commit_ticks, aim
+                    return self.turn_and_kick(tick, aim, self.p.kick_speed)
+            rot = self.mem.circle_rot if tick - self.mem.circle_tick <= 2 else 0.0
+            way, heading, self.mem.circle_rot = S.circle_past(pos, blocker, goal, sp.sidestep, rot=rot)
+            self.mem.circle_tick = tick
+            return self.drive(tick, way, heading, self.p.dribble_speed, dribbler=True, avoid=False)
+        ahead = (goal[0] - order.attack_dir * min(self.p.advance_shoot_distance - 0.5, d_goal), aim[1] * 0.5)
+        return self.drive(tick, ahead, S.angle_to(pos, aim), self.p.dribble_speed, dribbler=True, avoid=False)
+
+    def unstall(self, tick: int, order: Order) -> Cmd:
+        """Held the ball too long (pinned against an opponent): play it on along the heading,
+        unless that points towards our goal."""
+        x, y, th = self.view.pose  # type: ignore[misc]
+        if math.cos(th) * order.attack_dir > -0.3:
+            self.mem.kicked_at = tick
+            return self.drive(tick, (x, y), th, 0.0, dribbler=True, kick=self.p.unstall_speed, avoid=False)
+        return self.turn_and_kick(tick, self.goal(order), self.p.unstall_speed)
 
     def nudge_point(self, pos: Vec, goal: Vec, opponents: list[Vec]) -> Vec:
         """Where to push the ball ahead at the carry limit: goal-ward, turned away from the nearest opponent."""
@@ -502,20 +764,70 @@ class IrisRobot:
         x, y, _ = self.view.pose  # type: ignore[misc]
         pos = (x, y)
         goal = self.goal(order)
-        attacking = R.is_attacking(order.role_state)
+        if (tick - self.mem.lost_at) * self.cfg.timing.dt < self.p.regroup and self.carrier(ball) is not None:
+            # Lost the ball to a tackle: step back instead of wrestling for it, then challenge again;
+            # basic: aside; advance: goal-side, onto the carrier's kick line (Fig. 7b).
+            if S.dist(pos, ball) < self.p.regroup_clear:  # first get the body off the ball, straight back
+                a = S.angle_to(ball, pos)
+                back = (x + 0.5 * math.cos(a), y + 0.5 * math.sin(a))
+            elif self.p.advance:
+                back = S.behind_point(ball, goal, self.p.regroup_distance)
+            else:
+                back = S.aside_point(ball, self.own_goal(order), pos, self.p.regroup_distance)
+            return self.drive(tick, back, S.angle_to(pos, ball), self.p.cruise, avoid=False)
+        attacking = self.plan.attacking  # type: ignore[union-attr]
         mate_has_it = attacking and any(S.dist((mx, my), ball) < 0.4 for mx, my, _ in self.view.mates.values())
         if mate_has_it:
-            home = self.home(order, ball)
+            home = self.support_point(order, ball) if self.p.advance and self.role == "attacker" else self.home(order, ball)
             return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
+        chaser = self.is_chaser(order, ball)
         if self.p.advance and self.role == "defender" and not attacking:
-            carrier = self.carrier(ball)
-            if carrier is not None and S.dist(pos, ball) > self.p.skills.take_distance and self.is_chaser(order, ball):
-                block = S.block_point(carrier, self.own_goal(order), self.p.skills)
-                return self.drive(tick, block, S.angle_to(block, carrier), self.p.cruise, dribbler=True)
-        if self.is_chaser(order, ball):
+            cmd = self.advance_defense(tick, order, ball, pos, chaser)
+            if cmd is not None:
+                return cmd
+        if chaser:
             return self.get_ball(tick, ball, goal)
         home = self.home(order, ball)
         return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
+
+    def advance_defense(self, tick: int, order: Order, ball: Vec, pos: Vec, chaser: bool) -> Cmd | None:
+        """Paper 2, Fig. 7b, for a defender while the team defends; None: play the ball as usual.
+
+        An opponent carrying the ball within `block_zone` of our goal is met by
+        the chasing defender on its kick line to our goal, `block_distance`
+        (1 m) from it and no closer than `retreat_radius` (3 m) to our goal
+        centre, facing it (`.skills.block_point`); within `take_distance`
+        (0.5 m) of the ball the defender takes it. A defender not doing that
+        marks the most dangerous other opponent in our half goal-side
+        (man-to-man marking, `.skills.mark_point`), which also cuts the pass to it.
+        """
+        sp = self.p.skills
+        own = self.own_goal(order)
+        carrier = self.carrier(ball)
+        if carrier is None:
+            return None
+        if chaser and S.dist(carrier, own) < self.p.block_zone:
+            if S.dist(pos, ball) < sp.take_distance:
+                return self.get_ball(tick, ball, self.goal(order))
+            block = S.block_point(carrier, own, sp)
+            return self.drive(tick, block, S.angle_to(block, carrier), self.p.cruise, dribbler=True)
+        target = self.marking_target(order, carrier)
+        if target is None:
+            return None
+        mark = S.mark_point(target, own, sp.mark_distance)
+        return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
+
+    def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
+        """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""
+        own = self.own_goal(order)
+        best, found = self.p.mark_zone, None
+        for o in self.view.opponents:
+            if S.dist(o, carrier) < 0.3:
+                continue
+            d = S.dist(o, own)
+            if d < best:
+                best, found = d, o
+        return found
 
 
 def _make(name: str, alias: str, advance: bool, dynamic: bool) -> Strategy:

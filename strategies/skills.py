@@ -9,13 +9,19 @@ Paper 2 (IRIS, "Advance attack and defense strategy ...") gives the behaviours:
 
 * basic strategy: pick up the ball, dribble it, kick from a set distance to goal;
 * advance attack (Fig. 7a): detect an opponent in the path (`blocker_ahead`),
-  turn the back to it and sidestep away from the near touch line
-  (`sidestep_target`), go goal-ward again once past, shoot when within shooting
-  distance and the line to the goal is clear (`line_clear`, `best_aim`);
+  turn the back to it and go round it on the side away from the near touch
+  line (`sidestep_side`, `circle_past`: the paper's "circular motion"), go
+  goal-ward again once past, shoot when within shooting distance and the line
+  to the goal is clear (`line_clear`, `best_aim`); the teammate without the
+  ball finds an attacking position (`open_point`);
 * advance defense (Fig. 7b): stand on the estimated kick line between the
   opponent ball carrier and our goal, 1 m from the carrier, retreat with it down
   to a 3 m radius around our goal centre, then follow the ball
-  (`block_point`); take the ball when within 0.5 m;
+  (`block_point`); take the ball when within 0.5 m; mark the other opponent
+  goal-side (`mark_point`, man-to-man marking);
+* ball handling for everyone: approach behind the ball (`behind_point`,
+  `lined_up`), step aside after losing a tackle (`aside_point`), pass speed
+  (`pass_speed`);
 * goalkeeper: guard the goal mouth and intercept the predicted ball path
   (`keeper_target`).
 """
@@ -35,8 +41,9 @@ class SkillParams:
     block_distance: float = 1.0  # [m] advance defense: from the carrier on the kick line (paper 2)
     retreat_radius: float = 3.0  # [m] advance defense: closest approach to our goal centre (paper 2)
     take_distance: float = 0.5  # [m] advance defense: take the ball when this close (paper 2)
-    path_corridor: float = 0.6  # [m] half width of the corridor in which an opponent blocks the path
-    path_lookahead: float = 1.6  # [m] how far ahead an opponent counts as in the path
+    path_corridor: float = 0.8  # [m] half width of the corridor in which an opponent blocks the path
+    path_lookahead: float = 2.5  # [m] how far ahead an opponent counts as in the path
+    mark_distance: float = 0.8  # [m] advance defense: marker from the marked opponent, towards our goal
     sidestep: float = 1.0  # [m] lateral offset of the sidestep around an opponent
     clear_margin: float = 0.36  # [m] a robot closer than this to the kick line blocks it
     keeper_depth: float = 0.35  # [m] goalkeeper line in front of the goal line
@@ -76,6 +83,14 @@ def behind_point(ball: Vec, target: Vec, offset: float) -> Vec:
     return ball[0] - offset * math.cos(a), ball[1] - offset * math.sin(a)
 
 
+def aside_point(ball: Vec, own_goal: Vec, pos: Vec, offset: float) -> Vec:
+    """`offset` [m] from the ball, square to the line ball -> own_goal, on pos's side of that line."""
+    a = angle_to(ball, own_goal)
+    c, s = math.cos(a), math.sin(a)
+    side = 1.0 if -(pos[0] - ball[0]) * s + (pos[1] - ball[1]) * c >= 0.0 else -1.0
+    return ball[0] - side * offset * s, ball[1] + side * offset * c
+
+
 def lined_up(pos: Vec, ball: Vec, target: Vec, lane: float) -> bool:
     """True when pos is behind the ball w.r.t. target and within `lane` [m] of the line through them."""
     a = angle_to(ball, target)
@@ -94,22 +109,57 @@ def line_clear(a: Vec, b: Vec, robots: list[Vec], margin: float) -> bool:
     return True
 
 
-def best_aim(ball: Vec, goal_x: float, goal_half: float, robots: list[Vec], margin: float) -> tuple[Vec, bool]:
+def best_aim(
+    ball: Vec, goal_x: float, goal_half: float, robots: list[Vec], margin: float, post_margin: float = 0.25,
+    heading: float | None = None, turn_cost: float = 0.3,
+) -> tuple[Vec, bool]:
     """Aim point on the goal line with the most room, and whether its line is clear.
 
-    Candidates are 5 points across the mouth, 0.15 m inside the posts; the one
-    whose line from the ball keeps the largest distance to every robot wins.
+    Candidates are 5 points across the mouth, `post_margin` inside the posts; the one
+    whose line from the ball keeps the largest distance to every robot wins. With
+    `heading` [rad] (the shooter's), among the clear candidates the one with the
+    most room (up to 1.5 m) less `turn_cost` [m/rad] times the turn it needs wins:
+    a shot that needs less turning is taken sooner.
     """
     best: Vec = (goal_x, 0.0)
     best_room = -1.0
-    inner = goal_half - 0.15
+    best_turn = math.inf
+    inner = goal_half - post_margin
+    near = [r for r in robots if dist(r, ball) > 0.3]
     for i in range(5):
         y = -inner + i * (2.0 * inner / 4.0)
         aim = (goal_x, y)
-        room = min((segment_distance(r, ball, aim)[0] for r in robots if dist(r, ball) > 0.3), default=math.inf)
-        if room > best_room + 1e-9:
+        room = min((segment_distance(r, ball, aim)[0] for r in near), default=math.inf)
+        if heading is not None and room >= margin:
+            cost = turn_cost * abs(wrap(angle_to(ball, aim) - heading)) - min(room, 1.5)
+            if best_room < margin or cost < best_turn:
+                best, best_room, best_turn = aim, room, cost
+        elif room > best_room + 1e-9 and (heading is None or best_room < margin):
             best, best_room = aim, room
     return best, best_room >= margin
+
+
+def open_point(
+    ball: Vec, candidates: list[Vec], opponents: list[Vec], goal_x: float, goal_half: float, margin: float
+) -> Vec:
+    """Advance attack, the teammate without the ball ("finding attacking positions", paper 2):
+    the candidate point with the clearest pass line from the ball and shot line
+    to the goal, and the most room from the opponents.
+
+    Score: room [m] to the nearest opponent (at most 2), +1 if the pass line
+    from the ball is clear by `margin`, +1 if the best shot line is.
+    """
+    best, best_score = candidates[0], -math.inf
+    for c in candidates:
+        room = min((dist(o, c) for o in opponents), default=2.0)
+        score = min(room, 2.0)
+        if line_clear(ball, c, opponents, margin):
+            score += 1.0
+        if best_aim(c, goal_x, goal_half, opponents, margin)[1]:
+            score += 1.0
+        if score > best_score + 1e-9:
+            best, best_score = c, score
+    return best
 
 
 def blocker_ahead(pos: Vec, heading_to: Vec, opponents: list[Vec], corridor: float, lookahead: float) -> Vec | None:
@@ -126,20 +176,53 @@ def blocker_ahead(pos: Vec, heading_to: Vec, opponents: list[Vec], corridor: flo
     return found
 
 
-def sidestep_target(pos: Vec, opponent: Vec, goal: Vec, step: float, beyond: float = 0.5) -> Vec:
-    """Advance attack: a point beside the opponent, on the side of the field centre line (y = 0).
+def sidestep_side(pos: Vec, goal: Vec) -> float:
+    """+1 to pass an opponent on its left (seen towards goal), -1 on its right: away from the near touch line.
 
     Paper 2: "if the robot is on the left side of the field, the robot will move
-    to the right and vice versa", so that it ends closer to the goal. The point
-    lies `step` [m] sideways of the opponent, across the line to the goal, and
-    `beyond` [m] past it goal-ward, so that driving there circles round the opponent.
+    to the right and vice versa" (left: y > 0 when attacking +x).
     """
     a = angle_to(pos, goal)
-    nx, ny = -math.sin(a), math.cos(a)  # left of the goal direction
-    side = -1.0 if pos[1] > 0.0 else 1.0  # towards y = 0 (away from the near touch line)
-    if ny * side < 0.0:
-        nx, ny = -nx, -ny
-    return opponent[0] + step * nx + beyond * math.cos(a), opponent[1] + step * ny + beyond * math.sin(a)
+    ny = math.cos(a)  # y of the unit vector to the left of the goal direction
+    side = -1.0 if pos[1] > 0.0 else 1.0  # towards y = 0
+    return 1.0 if ny * side >= 0.0 else -1.0
+
+
+def circle_past(
+    pos: Vec, opponent: Vec, goal: Vec, radius: float, step: float = 0.9, rot: float = 0.0
+) -> tuple[Vec, float, float]:
+    """Advance attack (Fig. 7a, "passing the opposing defender in a circular motion").
+
+    Returns (waypoint, heading, rot): the waypoint lies on the circle of `radius` [m]
+    round the opponent, `step` [rad] further round it than we are, going round
+    on the side of `sidestep_side` (rot: +1 counter-clockwise, -1 clockwise;
+    pass the previous rot back to keep going the same way round); followed
+    tick after tick, the robot circles
+    the opponent until it is past it. The heading [rad] is the circle's tangent
+    the robot moves along: the opponent stays square to its side, so the body
+    is between the opponent and the ball in the dribbler (the paper's "turn
+    its back to the opponent"; side-on, the ball is 0.56 m or more from the
+    opponent's centre, out of its dribbler's reach) and, once past, the robot
+    already faces the goal.
+    """
+    b = angle_to(opponent, pos)  # bearing of us seen from the opponent
+    g = angle_to(opponent, goal)
+    off = wrap(g - b)
+    r = radius
+    if dist(pos, opponent) > 1.5 * radius:
+        # Still short of it: make for its side, facing the goal, and curve round it from there.
+        if rot == 0.0:
+            rot = -sidestep_side(pos, goal)
+        side = g - rot * math.pi / 2.0  # rot -1 (clockwise) passes on the opponent's left
+        return (opponent[0] + r * math.cos(side), opponent[1] + r * math.sin(side)), angle_to(pos, goal), rot
+    if abs(off) < step:  # nearly round: head for the goal-ward point of the circle
+        return (opponent[0] + r * math.cos(g), opponent[1] + r * math.sin(g)), angle_to(pos, goal), rot
+    # Behind the opponent, go round on the chosen side (left of it: clockwise);
+    # already beside it, keep going the short way round.
+    if rot == 0.0:
+        rot = math.copysign(1.0, off) if abs(off) < 2.0 else -sidestep_side(pos, goal)
+    a = b + rot * step
+    return (opponent[0] + r * math.cos(a), opponent[1] + r * math.sin(a)), wrap(b + rot * math.pi / 2.0), rot
 
 
 def passed(pos: Vec, opponent: Vec, goal: Vec) -> bool:
@@ -160,6 +243,12 @@ def block_point(carrier: Vec, own_goal: Vec, p: SkillParams) -> Vec:
     a = angle_to(own_goal, carrier)
     r = max(p.retreat_radius, d - p.block_distance)
     return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
+
+
+def mark_point(opponent: Vec, own_goal: Vec, distance: float) -> Vec:
+    """Man-to-man marking: `distance` [m] from the opponent towards our goal centre (goal-side)."""
+    a = angle_to(opponent, own_goal)
+    return opponent[0] + distance * math.cos(a), opponent[1] + distance * math.sin(a)
 
 
 def predict_crossing(ball: Vec, vel: Vec, line_x: float) -> float | None:

@@ -151,6 +151,15 @@ class TeamModel:
         return t.xy
 
 
+def _apart(x: float, y: float, points: list[Vec], min2: float) -> bool:
+    """No point within sqrt(min2) [m] of (x, y)."""
+    for a, b in points:
+        dx, dy = x - a, y - b
+        if dx * dx + dy * dy < min2:
+            return False
+    return True
+
+
 class RobotView:
     """One robot's picture of the world for this tick."""
 
@@ -164,6 +173,7 @@ class RobotView:
         self.own_ball = BallFilter(p, dt)
         self.pose: tuple[float, float, float] | None = None
         self.vel: Vec = (0.0, 0.0)  # [m/s] field frame
+        self.omega = 0.0  # [rad/s] odometry
         self.ball: Vec | None = None
         self.ball_vel: Vec = (0.0, 0.0)
         self.ball_age = 1 << 30  # [ticks]
@@ -171,6 +181,7 @@ class RobotView:
         self.mates: dict[int, tuple[float, float, str]] = {}  # n -> x, y, role
         self.has_ball = False
         self.mate_obstacles: list[Vec] = []
+        self._order: Order | None = None
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
         if sense is not None:
@@ -178,6 +189,7 @@ class RobotView:
             self.pose = (p.x, p.y, p.theta)
             c, s = math.cos(p.theta), math.sin(p.theta)
             self.vel = (c * sense.vx - s * sense.vy, s * sense.vx + c * sense.vy)
+            self.omega = sense.omega
             self.has_ball = sense.has_ball
             if sense.ball.visible:
                 self.own_ball.observe(tick, sense.ball.x, sense.ball.y)
@@ -195,24 +207,28 @@ class RobotView:
             self.ball, self.ball_vel, self.ball_age = None, (0.0, 0.0), 1 << 30
         if self.ball_age > self.p.ball_memory:
             self.ball = None
-        seen = [(r.x, r.y) for r in sense.robots if r.team == self.other] if sense is not None else []
-        self.opponents = list(seen)
-        mates: dict[int, tuple[float, float, str]] = {}
+        seen: list[Vec] = []
+        near: list[Vec] = []
+        if sense is not None:
+            other = self.other
+            for r in sense.robots:
+                (seen if r.team == other else near).append((r.x, r.y))
+        if order is not self._order:  # the teammates change with the order only
+            self._order = order
+            self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != self.n} if order else {}
+        merge2 = self.p.merge_radius * self.p.merge_radius
+        opponents = list(seen)
         if order is not None:
+            memory = self.p.opponent_memory - (tick - order.tick)
             for tp in order.opponents:
-                if tp.age + (tick - order.tick) > self.p.opponent_memory:
-                    continue
-                if all(math.hypot(tp.x - x, tp.y - y) >= self.p.merge_radius for x, y in seen):
-                    self.opponents.append((tp.x, tp.y))
-            for tp in order.own:
-                if tp.robot != self.n:
-                    mates[tp.robot] = (tp.x, tp.y, tp.role)
-        self.mates = mates
-        near = [(r.x, r.y) for r in sense.robots if r.team == self.team] if sense is not None else []
-        for x, y, _ in mates.values():
-            if all(math.hypot(x - a, y - b) >= self.p.merge_radius for a, b in near):
-                near.append((x, y))
-        self.mate_obstacles = near
+                if tp.age <= memory and _apart(tp.x, tp.y, seen, merge2):
+                    opponents.append((tp.x, tp.y))
+        self.opponents = opponents
+        mates = list(near)
+        for x, y, _ in self.mates.values():
+            if _apart(x, y, near, merge2):
+                mates.append((x, y))
+        self.mate_obstacles = mates
 
     def others(self) -> list[Vec]:
         """Every other robot's position (obstacles): own detections first, then the base station's."""

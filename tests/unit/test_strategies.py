@@ -267,7 +267,7 @@ def test_blocker_and_sidestep_away_from_the_near_touch_line():
     opp = (1.0, 1.85)
     assert S.blocker_ahead(pos, goal, [opp, (-1.0, 2.0)], 0.6, 1.6) == opp
     assert S.blocker_ahead(pos, goal, [(3.0, 2.0)], 0.6, 1.6) is None  # too far ahead
-    side = S.sidestep_target(pos, opp, goal, 1.0)
+    side, _, _ = S.circle_past(pos, opp, goal, 1.0)
     assert side[1] < opp[1]  # robot on the left (y > 0) goes right, towards the middle
     assert S.passed((2.0, 1.0), opp, goal) and not S.passed(pos, opp, goal)
 

@@ -1,0 +1,192 @@
+"""Team play (issue 4): the advance attack and defense skills of paper 2 (Fig. 7), the ball
+handling every strategy shares, the robot brain's reactions in set situations, and the
+physics rule that keeps two robots from swapping the ball every tick."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import pytest
+
+from arena.processes.physics import NO_CHALLENGE_S, Physics
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RobotSeen, Sense, TeamPose
+from arena.strategies import registry
+from arena.strategies import roles as R
+from arena.strategies import skills as S
+from arena.strategies.base import RobotContext
+
+CFG = MatchConfig()
+CHALLENGE = CFG.robot.size / 2 + CFG.ball.radius + 0.20  # [m] physics: a dribbler this close to the ball challenges
+REACH = CFG.robot.size / 2 + CFG.ball.radius  # [m] robot centre to a held ball
+
+
+# ------------------------------------------------------------------ skills
+def test_circle_past_heads_for_the_side_away_from_the_near_touch_line_while_far():
+    pos, opp, goal = (0.0, 1.0), (2.0, 1.0), (6.0, 0.0)  # we are on the left (y > 0)
+    way, heading, rot = S.circle_past(pos, opp, goal, 1.0)
+    assert way[1] < opp[1] - 0.9  # beside it, on the right: towards the middle (paper 2)
+    assert heading == pytest.approx(S.angle_to(pos, goal))  # still facing the goal
+    assert rot == 1.0
+
+
+def test_circle_past_goes_round_with_the_body_between_opponent_and_ball():
+    opp, goal = (2.0, 1.0), (6.0, 0.0)
+    pos = (1.3, 0.6)  # close behind it, on the right
+    way, heading, rot = S.circle_past(pos, opp, goal, 1.0)
+    before, after = S.angle_to(opp, pos), S.angle_to(opp, way)
+    assert S.wrap(after - before) * rot > 0.5  # the waypoint is further round the opponent
+    assert S.dist(way, opp) == pytest.approx(1.0)
+    ball = (pos[0] + REACH * math.cos(heading), pos[1] + REACH * math.sin(heading))
+    assert S.dist(ball, opp) > CHALLENGE  # side-on: the held ball is out of the opponent's reach
+    # the way round is kept once chosen, even from the other side of the decision line
+    _, _, again = S.circle_past((1.2, 1.4), opp, goal, 1.0, rot=rot)
+    assert again == rot
+
+
+def test_circle_past_heads_for_the_goal_once_round():
+    opp, goal = (2.0, 1.0), (6.0, 0.0)
+    pos = (2.9, 0.7)  # past it
+    way, heading, _ = S.circle_past(pos, opp, goal, 1.0, rot=1.0)
+    assert heading == pytest.approx(S.angle_to(pos, goal))
+    assert S.angle_to(opp, way) == pytest.approx(S.angle_to(opp, goal))
+
+
+def test_best_aim_with_a_heading_prefers_a_clear_aim_that_needs_less_turn():
+    keeper = [(5.65, 0.0)]
+    free, clear = S.best_aim((2.0, 0.0), 6.0, 1.0, keeper, 0.36)
+    assert clear and abs(free[1]) > 0.5  # most room: a corner
+    left, _ = S.best_aim((2.0, 0.0), 6.0, 1.0, keeper, 0.36, heading=0.2)
+    right, _ = S.best_aim((2.0, 0.0), 6.0, 1.0, keeper, 0.36, heading=-0.2)
+    assert left[1] > 0.5 and right[1] < -0.5  # the corner it already faces
+    blocked, clear = S.best_aim((2.0, 0.0), 6.0, 1.0, [(2.8, 0.0)], 0.36, heading=0.0)
+    assert not clear  # a defender 0.8 m ahead blocks every aim point
+
+
+def test_aside_point_is_square_to_the_line_to_our_goal_on_our_side():
+    ball, own = (0.0, 0.0), (-6.0, 0.0)
+    assert S.aside_point(ball, own, (0.3, 0.4), 0.9) == pytest.approx((0.0, 0.9))
+    assert S.aside_point(ball, own, (0.3, -0.4), 0.9) == pytest.approx((0.0, -0.9))
+
+
+def test_mark_point_is_goal_side_of_the_marked_opponent():
+    assert S.mark_point((-3.0, 0.0), (-6.0, 0.0), 0.8) == pytest.approx((-3.8, 0.0))
+
+
+def test_open_point_prefers_clear_pass_and_shot_lines():
+    ball = (0.0, 0.0)
+    opponents = [(1.5, 0.0), (5.65, 0.0)]  # a defender straight ahead, the keeper
+    got = S.open_point(ball, [(3.0, 0.0), (3.0, 1.5)], opponents, 6.0, 1.0, 0.36)
+    assert got == (3.0, 1.5)
+
+
+# ------------------------------------------------------------ robot brain
+def _robot(name: str, n: int = 1):
+    return registry.get(name).make_robot(RobotContext(cfg=CFG, team="a", n=n, rng=random.Random(0)))
+
+
+def _order(tick: int, n: int, role: str, state: int, **kw) -> Order:
+    return Order(tick=tick, robot=n, command="START", command_team="a", attack_dir=1, role=role, role_state=state, **kw)
+
+
+def _body_to_field(c: Cmd, theta: float) -> tuple[float, float]:
+    return (math.cos(theta) * c.vx - math.sin(theta) * c.vy, math.sin(theta) * c.vx + math.cos(theta) * c.vy)
+
+
+def test_advance_defender_blocks_the_kick_line_one_metre_from_the_carrier():
+    robot = _robot("AD", n=2)
+    carrier, ball = (-1.0, 0.0), (-1.35, 0.0)  # opponent dribbling towards our goal at -x
+    sense = Sense(tick=10, pose=Pose(x=-3.0, y=0.8, theta=0.0), ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+                  robots=[RobotSeen(team="b", x=carrier[0], y=carrier[1])])
+    own = [TeamPose(robot=1, x=2.0, y=0.0, role="attacker"), TeamPose(robot=2, x=-3.0, y=0.8, role="defender")]
+    cmd = None
+    for t in range(10, 14):
+        cmd = robot.step(t, sense, _order(9, 2, "defender", R.DEFENDING_DEFENDER, own=own))
+    vx, vy = _body_to_field(cmd, 0.0)
+    block = S.block_point(carrier, (-6.0, 0.0), S.SkillParams())
+    assert block == pytest.approx((-2.0, 0.0))
+    assert vx > 0.0 and vy < 0.0  # towards the block point on the line carrier -> goal
+    assert cmd.dribbler  # ready to take the ball when the carrier comes within 0.5 m
+
+
+def _holding(name: str, pos: tuple[float, float], opponents: list[tuple[float, float]], tick: int = 20) -> Cmd:
+    """A robot holding the ball at pos, facing the +x goal, left to turn (its heading follows its
+    own omega) for up to 1 s: its first kick command, else its last command."""
+    robot = _robot(name)
+    theta = S.angle_to(pos, (6.0, 0.0))
+    own = [TeamPose(robot=1, x=pos[0], y=pos[1], role="attacker"), TeamPose(robot=2, x=-3.0, y=0.0, role="defender")]
+    order = _order(tick - 1, 1, "attacker", R.ATTACKING_ATTACKER, own=own)
+    cmd = Cmd(tick=0)
+    for t in range(tick, tick + 50):
+        ball = (pos[0] + REACH * math.cos(theta), pos[1] + REACH * math.sin(theta))
+        sense = Sense(tick=t, pose=Pose(x=pos[0], y=pos[1], theta=theta), omega=cmd.omega,
+                      ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+                      robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents], has_ball=True)
+        cmd = robot.step(t, sense, order)
+        if cmd.kick_speed > 0.0:
+            return cmd
+        theta += cmd.omega * CFG.timing.dt
+    return cmd
+
+
+def test_basic_attacker_kicks_from_the_set_distance_even_into_a_defender():
+    cmd = _holding("BS", (1.5, 0.4), [(2.6, 0.4), (5.65, 0.0)])  # 4.5 m out, a defender 1.1 m ahead
+    assert cmd.kick_speed == pytest.approx(8.0)
+
+
+def test_advance_attacker_does_not_shoot_into_a_blocker_and_shoots_when_clear():
+    blocked = _holding("AD", (1.5, 0.4), [(2.6, 0.4), (5.65, 0.0)])
+    assert blocked.kick_speed == 0.0
+    clear = _holding("AD", (2.0, 0.4), [(2.2, 3.0), (5.65, -0.3)])  # 4 m out, only the keeper in front
+    assert clear.kick_speed == pytest.approx(8.0)
+
+
+def test_a_robot_that_loses_the_ball_steps_off_it_with_the_dribbler_off():
+    robot = _robot("BS")
+    pose = Pose(x=0.0, y=0.0, theta=0.0)
+    ball = BallSeen(visible=True, x=REACH, y=0.0)
+    tackler = [RobotSeen(team="b", x=REACH + 0.45, y=0.0)]
+    own = [TeamPose(robot=1, x=0.0, y=0.0, role="attacker")]
+    robot.step(30, Sense(tick=30, pose=pose, ball=ball, robots=tackler, has_ball=True),
+               _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own))
+    cmd = robot.step(31, Sense(tick=31, pose=pose, ball=ball, robots=tackler, has_ball=False),
+                     _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own))
+    assert not cmd.dribbler and cmd.vx < 0.0  # backs straight off the ball instead of wrestling for it
+
+
+def test_the_push_guard_stops_a_robot_from_shoving_an_opponent():
+    robot = _robot("AD")
+    sense = Sense(tick=5, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=[RobotSeen(team="b", x=0.55, y=0.0)],
+                  ball=BallSeen(visible=True, x=-3.0, y=0.0))
+    robot.step(5, sense, _order(4, 1, "attacker", R.ATTACKING_ATTACKER))
+    cmd = robot.drive(5, (3.0, 0.0), 0.0, 2.5, avoid=False)  # straight through the opponent in contact
+    assert cmd.vx <= 1e-9
+    far = robot.guard_push(0.0, 0.0, 2.5, 0.0, 0.65)  # 0.55 m away: in contact
+    assert far[0] == pytest.approx(0.0)
+    sense = Sense(tick=6, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=[RobotSeen(team="b", x=1.5, y=0.0)])
+    robot.step(6, sense, _order(4, 1, "attacker", R.ATTACKING_ATTACKER))
+    vx, _ = robot.guard_push(0.0, 0.0, 2.5, 0.0, 0.65)
+    assert vx == pytest.approx(math.sqrt(0.5**2 + 2 * 1.2 * (1.5 - 0.65)))  # what it can still brake from
+
+
+# ----------------------------------------------------------------- physics
+def test_the_loser_of_a_challenge_cannot_win_the_ball_straight_back():
+    """Face to face at one ball, both dribblers on: without NO_CHALLENGE_S the ball changes holder every tick."""
+    ph = Physics(CFG.replace(robots=1))
+    ph.place_robot("a", 0, 0.0, 0.0, 0.0)
+    ph.place_robot("b", 0, 2 * REACH + 0.02, 0.0, math.pi)  # its front face at the ball too
+    ph.place_ball(REACH + 0.01, 0.0)
+    ph.set_command("a", 0, Cmd(tick=0, dribbler=True))
+    ph.step()
+    assert ph.holder() == ("a", 0)
+    ph.set_command("b", 0, Cmd(tick=0, dribbler=True))  # b challenges and takes the ball
+    holders = []
+    for _ in range(12):
+        ph.step()
+        holders.append(ph.holder())
+    first = holders.index(("b", 0))
+    quiet = math.ceil(NO_CHALLENGE_S / CFG.timing.dt)
+    assert first <= 2
+    # a, the loser, still touches the ball with its dribbler on, but b keeps it until a may challenge again
+    assert all(h == ("b", 0) for h in holders[first:quiet - 1]), holders
