@@ -428,6 +428,10 @@ class Runner:
                 p.send_signal(signal.SIGINT)  # arena match stops its whole process group
 
 
+def _interrupt(signum, frame) -> None:  # noqa: ARG001
+    raise KeyboardInterrupt
+
+
 def default_jobs() -> int:
     """A match keeps about two cores busy: one match per two cores."""
     return max(1, (os.cpu_count() or 2) // 2)
@@ -456,6 +460,12 @@ def run(args) -> tuple[dict, bool]:
         TextColumn("{task.fields[last]}"), console=console, disable=not show, transient=False,
     ) as bar:
         task = bar.add_task("t", total=len(fixtures), completed=len(results), last="")
+        # SIGTERM (a service manager, `kill`) stops like Ctrl-C: the running
+        # matches are stopped and the finished results kept. Without this the
+        # interpreter died at once and left the running match behind.
+        previous = None
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, _interrupt)
         with ThreadPoolExecutor(max_workers=args.jobs or default_jobs()) as pool:
             futures: dict[Future, Fixture] = {pool.submit(runner.play, fx): fx for fx in todo}
             pending = set(futures)
@@ -478,6 +488,9 @@ def run(args) -> tuple[dict, bool]:
                 runner.stop()
                 for f in pending:
                     f.cancel()
+            finally:
+                if previous is not None:
+                    signal.signal(signal.SIGTERM, previous)
     ordered = [results[fx.id] for fx in fixtures if fx.id in results]
     summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed)
     summary["skipped"] = len(fixtures) - len(todo)

@@ -3,22 +3,29 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 
-from tests.integration.helpers import arena_json, spawn, wait_for
+import pytest
+
+from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "3", "--half-time", "2", "--seed", "5", "--jobs", "1")
 
 
-def test_interrupt_then_resume(tmp_path, reap):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_interrupt_then_resume(tmp_path, reap, sig):
     out = tmp_path / "t"
     proc = spawn(*ARGS, "--out", str(out))
     reap.append(proc)
     matches = out / "matches"
     wait_for(lambda: matches.is_dir() and any(matches.glob("*.json")), 120, "the first finished match")
-    proc.send_signal(signal.SIGINT)
+    kids = descendants(proc.pid)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
+    wait_for(lambda: not any(os.path.exists(f"/proc/{k}") and "arena" in cmdline(k) for k in kids), 20,
+             "the running match to be stopped with the tournament")
     assert "--resume" in err and "Traceback" not in err
     kept = sorted(p.name for p in matches.glob("*.json"))
     assert 1 <= len(kept) < 3
