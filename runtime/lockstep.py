@@ -108,14 +108,16 @@ class Watchdog:
     that key's subscription. Cheap: no work on the hot path but two stores.
     """
 
-    def __init__(self, transport: Transport, timeout: float):
+    def __init__(self, transport: Transport, timeout: float, thread: bool = True):
         self.transport = transport
         self.timeout = timeout
         self._key: str | None = None
         self._since = 0.0
         self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="watchdog", daemon=True)
-        self._thread.start()
+        # No thread for a reactive node: its Reactor bounds the waits itself.
+        self._thread = threading.Thread(target=self._run, name="watchdog", daemon=True) if thread else None
+        if self._thread is not None:
+            self._thread.start()
 
     def arm(self, key: str) -> None:
         self._since = time.monotonic()
@@ -135,7 +137,8 @@ class Watchdog:
 
     def stop(self) -> None:
         self._stop.set()
-        self._thread.join(timeout=1.0)
+        if self._thread is not None:
+            self._thread.join(timeout=1.0)
 
 
 class Outbound(Generic[M]):

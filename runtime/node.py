@@ -51,11 +51,11 @@ class Node:
         self.links = resolve(cfg.link, cfg.link_overrides)
         self.digest = hashlib.blake2b(digest_size=16)
         self.rejections = Rejections(self.log)
-        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout)
         # Lockstep over zenoh runs the loop in the receive callbacks (`Reactor`);
         # real time, and the memory transport of in-process runs, pull instead.
         self.reactive = not cfg.realtime and getattr(transport, "callbacks", False)
         self.reactor = Reactor(cfg.timing.wait_timeout) if self.reactive else None
+        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout, thread=not self.reactive)
         self.outbound: list[Outbound[Any]] = []
         self.inbound: list[Inbound[Any]] = []
         self.gone: set[str] = set()  # peers whose liveliness token vanished
