@@ -111,7 +111,7 @@ def up(path: str, timeout: float = 600.0) -> dict:
     if len(routers) != 1:
         raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
     children: list[launcher.Child] = []
-    ok = False
+    keep = False  # a failed match keeps the services' logs (and says where); bad input leaves nothing behind
     try:
         router = routers[0]
         children.append(launcher.spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
@@ -140,13 +140,17 @@ def up(path: str, timeout: float = 600.0) -> dict:
                 raise ComposeError(str(exc)) from None
             finally:
                 transport.close()
-        ok = True
         result = launcher.assemble(cfg, got, time.monotonic() - t_start, children)
         result["services"] = list(services)
         return result
+    except ComposeError as exc:
+        if exc.bad_input:
+            raise
+        keep = True
+        raise ComposeError(f"{exc}\nevery service's log is kept in {tmp}") from None
     finally:
         launcher.stop_all(children)
-        if ok:
+        if not keep:
             shutil.rmtree(tmp, ignore_errors=True)
 
 

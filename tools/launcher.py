@@ -344,7 +344,7 @@ def play_match(
     logs = Path(log_dir) if log_dir else tmp
     logs.mkdir(parents=True, exist_ok=True)
     children: list[Child] = []
-    ok = False
+    keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     try:
         with open_session(NetConfig(mode="router", listen=(endpoint,))) as session:
             transport = ZenohTransport(session)
@@ -380,9 +380,13 @@ def play_match(
                 c.popen.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 pass
-        ok = True
         return assemble(cfg, got, time.monotonic() - t_start, children)
+    except MatchError as exc:
+        if log_dir is None:
+            keep = True
+            raise MatchError(f"{exc}\nevery process's log is kept in {tmp}") from None
+        raise
     finally:
         stop_all(children)
-        if log_dir is None and ok:
+        if not keep:
             shutil.rmtree(tmp, ignore_errors=True)

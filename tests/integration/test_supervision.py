@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
+import tempfile
+from pathlib import Path
 
 from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for, wait_until_playing
 
@@ -35,7 +38,12 @@ def test_two_matches_at_once_do_not_hear_each_other(reap):
     assert {p["pid"] for p in ra["processes"]}.isdisjoint({p["pid"] for p in rb["processes"]})
 
 
+def match_dirs() -> set[Path]:
+    return set(Path(tempfile.gettempdir()).glob("arena-*"))
+
+
 def test_ctrl_c_stops_every_process(reap):
+    before = match_dirs()
     proc = spawn(*MATCH, "--half-time", "300")
     reap.append(proc)
     kids = all_ten(proc.pid)
@@ -45,6 +53,7 @@ def test_ctrl_c_stops_every_process(reap):
     assert "interrupted" in err and "Traceback" not in err
     survivors = [p for p in kids if alive(p)]
     assert survivors == [], f"orphans: {survivors}"
+    assert match_dirs() - before == set(), "an interrupted match leaves no temp dir behind"
 
 
 def test_a_crashing_child_ends_the_match_with_a_clear_message(reap):
@@ -58,6 +67,9 @@ def test_a_crashing_child_ends_the_match_with_a_clear_message(reap):
     assert f"robot/a/2 (pid {victim}) exited with code -9" in err
     assert "Traceback" not in err.splitlines()[0]
     wait_for(lambda: not [p for p in kids if alive(p)], 10, "every process of the match to stop")
+    kept = re.search(r"every process's log is kept in (\S+)", err)
+    assert kept, err
+    assert (Path(kept.group(1)) / "robot_a_2.log").exists()
 
 
 def test_a_killed_launcher_leaves_no_orphans(reap):
