@@ -4,7 +4,16 @@ from __future__ import annotations
 
 import pytest
 
-from arena.tools.tournament import Result, bradley_terry, coverage, ratings, schedule, standings, table1_rows
+from arena.tools.tournament import (
+    Result,
+    bradley_terry,
+    coverage,
+    ratings,
+    replay_odds,
+    schedule,
+    standings,
+    table1_rows,
+)
 
 AD, AS, BD, BS = "advance-dynamic", "advance-static", "basic-dynamic", "basic-static"
 
@@ -87,6 +96,42 @@ def test_too_few_legs_gives_a_plain_note():
     many = [match(AD, BS, 3, 0, leg=i) for i in range(40)]
     _, notes = ratings(many, [AD, BS], boot=100)
     assert notes == []
+
+
+@pytest.mark.parametrize("p", [0.02, 0.1, 0.3, 0.5, 0.8, 0.97])
+@pytest.mark.parametrize("draw_rate", [0.0, 0.1, 0.2, 0.5])
+def test_a_replayed_fixture_keeps_the_fitted_expected_score(p, draw_rate):
+    """Draws count half a win in the fit, so a replay must score p on average.
+
+    Replaying draws at the plain rate from every fixture gave a weak team
+    0.8 p + 0.1 (with 20 % draws): in a real 60-match run BD's whole interval
+    then lay above its rating (1190 against 1198-1376).
+    """
+    win, draw, loss = replay_odds(p, draw_rate)
+    assert min(win, draw, loss) >= 0.0
+    assert win + draw + loss == pytest.approx(1.0)
+    assert win + draw / 2 == pytest.approx(p)
+    assert draw <= draw_rate
+
+
+def test_every_rating_lies_inside_its_own_interval():
+    """The win/draw/loss pattern of that run (seed 0, 2026-11-21): BD won 1, drew 4, lost 25."""
+    wdl = {  # (team, opponent): (wins, draws, losses) over 10 legs
+        (AD, AS): (4, 2, 4),
+        (AD, BD): (9, 1, 0),
+        (AD, BS): (10, 0, 0),
+        (AS, BD): (10, 0, 0),
+        (AS, BS): (10, 0, 0),
+        (BD, BS): (1, 3, 6),
+    }
+    results = []
+    for (a, b), (w, d, l) in wdl.items():
+        scores = [(1, 0)] * w + [(1, 1)] * d + [(0, 1)] * l
+        results += [match(a, b, h, g, leg=i) if i % 2 else match(b, a, g, h, leg=i) for i, (h, g) in enumerate(scores)]
+    rows, _ = ratings(results, [AD, AS, BD, BS])
+    for r in rows:
+        lo, hi = r["ci95"]
+        assert lo <= r["rating"] <= hi, r
 
 
 def test_table1_lists_each_pairings_score_first_named_team_first():
