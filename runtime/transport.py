@@ -147,9 +147,11 @@ class ZenohTransport:
         self._wakers[key] = self.session.declare_publisher(key, allowed_destination=zenoh.Locality.SESSION_LOCAL)
 
     def wake(self, key: str) -> None:
-        waker = self._wakers.get(key)
-        if waker is not None:
-            with self._wake_lock:
+        # Looked up under the lock: `close` undeclares the wakers under it, and a
+        # liveliness callback racing the close must find none, not a dead one.
+        with self._wake_lock:
+            waker = self._wakers.get(key)
+            if waker is not None:
                 waker.put(WAKE)
 
     def declare_alive(self, key: str) -> None:

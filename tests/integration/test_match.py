@@ -17,8 +17,21 @@ BASE = ("match", "--home", "basic-static", "--away", "basic-static", "--half-tim
 
 
 @pytest.fixture(scope="module")
-def seed7(tmp_path_factory):
-    return arena_json(*BASE, "--seed", "7")
+def seed7_logs(tmp_path_factory):
+    return tmp_path_factory.mktemp("seed7-logs")
+
+
+@pytest.fixture(scope="module")
+def seed7(seed7_logs):
+    return arena_json(*BASE, "--seed", "7", "--logs", str(seed7_logs))
+
+
+def test_a_clean_match_logs_no_traceback(seed7, seed7_logs):
+    """Not even at the end, when peers leave while others are closing (a liveliness callback once raced the close)."""
+    logs = sorted(seed7_logs.glob("*.log"))
+    assert len(logs) == 10
+    for log in logs:
+        assert "Traceback" not in log.read_text(), f"{log.name}:\n{log.read_text()[-2000:]}"
 
 
 def test_every_process_is_its_own_live_os_process(reap):
