@@ -1,0 +1,50 @@
+"""The zenoh transport itself, in one process over a real session."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from arena.runtime.session import NetConfig, open_session
+from arena.runtime.transport import ZenohTransport
+
+
+def test_a_callback_thread_keeps_its_python_thread_state(tmp_path):
+    """zenoh enters Python from its own thread for every sample; the thread keeps one state.
+
+    Without `keep_thread_state` each callback ran in a fresh thread state (an
+    mmap and a munmap per message), and a `threading.local` set in one
+    callback was gone in the next.
+    """
+    local = threading.local()
+    seen: list[tuple[int, int]] = []
+    done = threading.Event()
+
+    def on_frame(payload: bytes) -> None:
+        local.count = getattr(local, "count", 0) + 1
+        seen.append((threading.get_native_id(), local.count))
+        if len(seen) == 20:
+            done.set()
+
+    endpoint = f"unixsock-stream/{tmp_path}/s.sock"
+    with open_session(NetConfig(mode="peer", listen=(endpoint,))) as receiver, open_session(
+        NetConfig(mode="peer", connect=(endpoint,))
+    ) as sender:
+        rx, tx = ZenohTransport(receiver), ZenohTransport(sender)
+        rx.subscribe_callback("arena/t/x", on_frame)
+        put = tx.publisher("arena/t/x")
+        deadline = time.monotonic() + 10
+        i = 0
+        while not done.is_set() and time.monotonic() < deadline:
+            put(bytes([i % 256]))
+            i += 1
+            time.sleep(0.005)
+        assert done.is_set(), f"only {len(seen)} samples arrived"
+        tx.close()
+        rx.close()
+    assert threading.get_native_id() not in {t for t, _ in seen}, "delivered on zenoh's own thread"
+    counts: dict[int, list[int]] = {}
+    for thread, count in seen:
+        counts.setdefault(thread, []).append(count)
+    for thread, got in counts.items():
+        assert got == list(range(1, len(got) + 1)), f"thread {thread} lost its state between callbacks: {got}"
