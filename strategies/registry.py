@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from functools import cache
-from importlib.metadata import entry_points
 
 from arena.runtime.config import ConfigError
 from arena.strategies.base import Strategy
@@ -24,11 +23,19 @@ def _builtin() -> list[Strategy]:
 
 
 @cache
+def builtin_strategies() -> dict[str, Strategy]:
+    """Canonical name -> Strategy, the built-ins only."""
+    return {s.name: s for s in _builtin()}
+
+
+@cache
 def all_strategies() -> dict[str, Strategy]:
     """Canonical name -> Strategy. Plugins cannot shadow a built-in name."""
-    found: dict[str, Strategy] = {}
-    for s in _builtin():
-        found[s.name] = s
+    # Imported here: importlib.metadata costs ~30 ms of CPU, paid by every
+    # process of every match if it were imported for a built-in name.
+    from importlib.metadata import entry_points
+
+    found = dict(builtin_strategies())
     for ep in sorted(entry_points(group=GROUP), key=lambda e: e.name):
         obj = ep.load()
         strategy = obj() if callable(obj) and not isinstance(obj, Strategy) else obj
@@ -40,16 +47,28 @@ def all_strategies() -> dict[str, Strategy]:
     return found
 
 
-def resolve_name(name: str) -> str:
-    """Canonical name for a name or alias (case-insensitive); ConfigError if unknown."""
-    table = all_strategies()
-    wanted = name.strip().lower()
+def _find(table: dict[str, Strategy], wanted: str) -> str | None:
     for s in table.values():
         if wanted == s.name.lower() or wanted in (a.lower() for a in s.aliases):
             return s.name
+    return None
+
+
+def resolve_name(name: str) -> str:
+    """Canonical name for a name or alias (case-insensitive); ConfigError if unknown.
+
+    Built-ins come first, as in `all_strategies`, so the entry points are read
+    only for a name that is not built in.
+    """
+    wanted = name.strip().lower()
+    found = _find(builtin_strategies(), wanted) or _find(all_strategies(), wanted)
+    if found is not None:
+        return found
+    table = all_strategies()
     names = ", ".join(f"{s.name} ({'/'.join(s.aliases)})" if s.aliases else s.name for s in table.values())
     raise ConfigError(f"unknown strategy {name!r}; known: {names}")
 
 
 def get(name: str) -> Strategy:
-    return all_strategies()[resolve_name(name)]
+    canonical = resolve_name(name)
+    return builtin_strategies().get(canonical) or all_strategies()[canonical]

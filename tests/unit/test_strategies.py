@@ -84,7 +84,7 @@ def test_a_plugin_entry_point_is_found_and_plays(monkeypatch):
     def fake(**kw):
         return [EP()] if kw.get("group") == registry.GROUP else real(**kw)
 
-    monkeypatch.setattr(registry, "entry_points", fake)
+    monkeypatch.setattr(metadata, "entry_points", fake)  # registry imports it when it needs it
     registry.all_strategies.cache_clear()
     try:
         assert registry.resolve_name("cr") == "creep"
