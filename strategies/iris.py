@@ -48,12 +48,18 @@ Robot (`IrisRobot`), every tick, from its own `Sense` and the latest `Order`
     gets open for a pass and a shot (`.skills.open_point`);
   - basic defense: the robot whose area holds the ball tries to catch it and
     grab it from the opponent (`get_ball`), the others wait at home;
-  - advance defense (Fig. 7b): the defender meets an opponent carrying the ball
-    within `block_zone` of our goal on its estimated kick line, 1 m from it,
-    retreating with it down to 3 m from our goal centre and then following the
-    ball (`.skills.block_point`), and takes the ball within 0.5 m; otherwise it
-    marks the other opponent goal-side when that one is within `mark_zone`
-    of our goal (man-to-man marking, the paper's stated approach).
+  - advance defense (Fig. 7b): the outfield robot that gets onto the kick line
+    soonest (`is_blocker`) meets an opponent carrying the ball within
+    `block_zone` of our goal on its estimated kick line (the ball's line to our
+    goal centre), 1 m from it, retreating with it down to 3 m from our goal
+    centre and then following the ball (`.skills.block_point`), tracking the
+    line at `block_gain`, and takes the ball within 0.5 m from the kick line;
+    the other marks the opponent nearest our goal goal-side when it is within
+    `mark_zone` of our goal (man-to-man marking, the paper's stated approach;
+    the attacker only while the ball is within `drop_back` of our goal); at
+    the opponents' free kicks, throw-ins, corners and kick-offs one robot
+    walls the kick line 2.2 m from the spot and the other marks
+    (`setpiece_defense`).
 * ball handling, the same for all four strategies: the MSL dribbling limit (a
   holder releases the ball before `carry_limit` of straight carry: pass, shot,
   or a push ahead that it catches again, `nudge_point`); a robot that loses
@@ -96,6 +102,7 @@ Vec = tuple[float, float]
 
 PLAY = "START"
 SET_PIECES = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL"})
+WALL_PIECES = frozenset({"KICKOFF", "FREEKICK", "THROWIN", "CORNER"})  # advance defense: wall and mark at these
 
 
 @dataclass(frozen=True)
@@ -134,8 +141,17 @@ class IrisParams:
     regroup_clear: float = 0.6  # [m] ... first backing straight off the ball to this far (centre to ball centre)
     regroup_distance: float = 0.9  # [m] ... to this far from the ball (basic: aside, advance: goal-side)
     cover_depth: float = -2.5  # [m] along the attack direction: the defender's place while the team attacks
-    mark_zone: float = 5.0  # [m] advance defense: an opponent this close to our goal is marked
+    mark_zone: float = 6.5  # [m] advance defense: an opponent this close to our goal (about our half) is marked (was 5)
     block_zone: float = 6.5  # [m] advance defense: a carrier this close to our goal is blocked, not left to the attacker
+    # [1/s] advance defense: the blocker drives straight onto the kick line at this speed per metre off it
+    # (the plain 1 m/s per metre lets a carrier turning or circling at 1.5 m/s open a post); higher gains
+    # rush the carrier into pushing fouls and long shots
+    block_gain: float = 3.0
+    drop_back: float = 4.5  # [m] advance defense: with the ball this close to our goal the attacker marks too
+    take_angle: float = 0.5  # [rad] advance defense: the blocker takes the ball only this close to the kick line
+    behind_penalty: float = 1.5  # [m] advance defense: extra way to the kick line for a robot not goal-side of the carrier
+    wall_margin: float = 0.2  # [m] advance defense: the set-piece wall stands this far beyond the 2 m the rules ask
+    wall_exit_turn: float = 1.0  # [rad] ... a robot inside the 2 m circle leaves it at most this far off straight away
     pressure_range: float = 1.2  # [m] advance attack: a blocker this close leaves no room to go round it
     long_shot: float = 6.0  # [m] advance attack: under pressure, a clear shot from this far is still taken
     keeper_zone: float = 1.2  # [m] advance attack: an opponent this close to the goal centre is the keeper, no blocker
@@ -237,6 +253,7 @@ class _Memory:
     circle_tick: int = -(1 << 30)  # [tick] of the latest circling step
     shot_until: int = -(1 << 30)  # [tick] a decided shot is carried through until then
     shot_aim: Vec = (0.0, 0.0)  # [m]
+    blocking: bool = False  # advance defense: this robot is the one blocking the carrier
     pid: PIDState = field(default_factory=PIDState)
 
 
@@ -359,14 +376,19 @@ class IrisRobot:
     # --------------------------------------------------------------- motion
     def drive(
         self, tick: int, target: Vec, heading: float, vmax: float, *, dribbler: bool = False, kick: float = 0.0,
-        avoid: bool = True, extra_obstacles: tuple[Vec, ...] = (),
+        avoid: bool = True, extra_obstacles: tuple[Vec, ...] = (), gain: float = 0.0,
     ) -> Cmd:
-        """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots."""
+        """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots;
+        `gain` [1/s]: drive straight at speed min(vmax, gain * distance) (without it the straight
+        speed is the distance per second, capped by `k_pos`)."""
         x, y, th = self.view.pose  # type: ignore[misc]
         target = self.inside(target)
         tx, ty = target[0] - x, target[1] - y
         d = math.hypot(tx, ty)
-        vx, vy = tx, ty
+        vx, vy = tx, ty  # straight at it, at 1 m/s per metre to go (capped below)
+        if gain and d > 1e-9:  # straight at it at gain * distance (a tracking robot: blocker, marker)
+            k = min(vmax, gain * d) / d
+            vx, vy = tx * k, ty * k
         if avoid and d > self.p.direct_range:
             near = self.p.obstacle_range
             obstacles = [o for o in self.view.others() if abs(o[0] - x) < near and abs(o[1] - y) < near
@@ -377,7 +399,7 @@ class IrisRobot:
             if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
                 vx, vy = self.nav((x, y), self.view.vel, target, obstacles, self.nav_params)
         speed = math.hypot(vx, vy)
-        cap = min(vmax, self.p.k_pos * d)
+        cap = min(vmax, (gain or self.p.k_pos) * d)
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
         vx, vy = self.guard_push(x, y, vx, vy, self.p.contact_range)
@@ -487,12 +509,60 @@ class IrisRobot:
             gap = self.p.setpiece_behind if order.command_team == self.team or behind else 1.0
             target = S.behind_point(spot, goal, gap)
             return self.drive(tick, target, S.angle_to(target, goal), self.p.cruise, extra_obstacles=(spot,))
+        if self.p.advance and order.command_team not in (self.team, "") and order.command in WALL_PIECES:
+            target = self.setpiece_defense(order, spot)
+            if target is not None:
+                x, y, _ = self.view.pose  # type: ignore[misc]
+                keep = self.p.setpiece_distance + self.p.wall_margin
+                if S.dist((x, y), spot) < keep - 0.1:
+                    # Inside the 2 m circle: out of it first, away from the spot but turned (by up to
+                    # `wall_exit_turn`) towards the target, so that it leaves on the way round to it.
+                    a = S.angle_to(spot, (x, y)) if S.dist((x, y), spot) > 1e-6 else S.angle_to(spot, target)
+                    turn = S.wrap(S.angle_to(spot, target) - a)
+                    a += S.clamp(turn, -self.p.wall_exit_turn, self.p.wall_exit_turn)
+                    target = (spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a))
+                return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise, extra_obstacles=(spot,))
         home = self.home(order, spot)
         keep = self.p.setpiece_distance + 0.2 if order.command_team != self.team else 1.2
         if S.dist(home, spot) < keep:
             a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, self.own_goal(order))
             home = self.inside((spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a)), margin=-0.2)
         return self.drive(tick, home, S.angle_to(home, spot), self.p.cruise, extra_obstacles=(spot,))
+
+    def setpiece_defense(self, order: Order, spot: Vec) -> Vec | None:
+        """Advance defense at the opponents' set piece: Fig. 7b before the ball is in play.
+
+        The outfield robot nearer the wall point stands on the kick line from
+        the spot to our goal centre, `setpiece_distance` + `wall_margin` from
+        the spot (the block of Fig. 7b at the distance the rules allow, never
+        nearer our goal centre than `retreat_radius` less 1 m); the other marks the
+        opponent nearest our goal other than the taker goal-side
+        (`.skills.mark_point`), kept out of the 2 m circle too. None: no mark
+        for it (it takes its usual place).
+        """
+        own = self.own_goal(order)
+        keep = self.p.setpiece_distance + self.p.wall_margin
+        d = S.dist(spot, own)
+        r = max(min(self.p.skills.retreat_radius - 1.0, d), d - keep)
+        a = S.angle_to(own, spot)
+        wall = self.inside((own[0] + r * math.cos(a), own[1] + r * math.sin(a)), margin=-0.3)
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        mine = (S.dist((x, y), wall), self.n)
+        walls = all((S.dist((mx, my), wall), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
+        if walls:
+            return wall
+        best, found = self.p.mark_zone + 1.0, None
+        for o in self.view.opponents:
+            dd = S.dist(o, own)
+            if S.dist(o, spot) > 1.0 and dd < best:
+                best, found = dd, o
+        if found is None:
+            return None
+        mark = S.mark_point(found, own, self.p.skills.mark_distance)
+        if S.dist(mark, spot) < keep:
+            b = S.angle_to(spot, mark)
+            mark = (spot[0] + keep * math.cos(b), spot[1] + keep * math.sin(b))
+        return self.inside(mark, margin=-0.3)
 
     def is_taker(self, order: Order, spot: Vec) -> bool:
         """The outfield robot of ours nearest the spot takes the set piece (robot number breaks ties)."""
@@ -781,7 +851,7 @@ class IrisRobot:
             home = self.support_point(order, ball) if self.p.advance and self.role == "attacker" else self.home(order, ball)
             return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
         chaser = self.is_chaser(order, ball)
-        if self.p.advance and self.role == "defender" and not attacking:
+        if self.p.advance and not attacking:
             cmd = self.advance_defense(tick, order, ball, pos, chaser)
             if cmd is not None:
                 return cmd
@@ -791,31 +861,66 @@ class IrisRobot:
         return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
 
     def advance_defense(self, tick: int, order: Order, ball: Vec, pos: Vec, chaser: bool) -> Cmd | None:
-        """Paper 2, Fig. 7b, for a defender while the team defends; None: play the ball as usual.
+        """Paper 2, Fig. 7b, for an outfield robot while the team defends; None: play the ball as usual.
 
         An opponent carrying the ball within `block_zone` of our goal is met by
-        the chasing defender on its kick line to our goal, `block_distance`
-        (1 m) from it and no closer than `retreat_radius` (3 m) to our goal
-        centre, facing it (`.skills.block_point`); within `take_distance`
-        (0.5 m) of the ball the defender takes it. A defender not doing that
-        marks the most dangerous other opponent in our half goal-side
-        (man-to-man marking, `.skills.mark_point`), which also cuts the pass to it.
+        the robot that gets onto its kick line soonest (`is_blocker`) on that
+        line (the ball's line to our goal centre), `block_distance` (1 m) from
+        the carrier and no closer than `retreat_radius` (3 m) to our goal
+        centre, facing the ball (`.skills.block_point`); within
+        `take_distance` (0.5 m) of the ball it takes it, straight from the kick
+        line (within `take_angle` of it). It drives there straight once goal-side of the carrier
+        (steering round it only to get goal-side) and with the tracking gain
+        `block_gain`, so that it stays on the line while the carrier turns to
+        aim or circles. The other outfield robot marks the most dangerous
+        other opponent goal-side (man-to-man marking, `.skills.mark_point`),
+        which also cuts the pass to it: the defender always, the attacker while
+        the ball is within `drop_back` of our goal (both field robots defend
+        when the team has lost the ball deep in its half; paper 2: "defender
+        robots ... will always block opposing attacker to score goal").
         """
         sp = self.p.skills
         own = self.own_goal(order)
         carrier = self.carrier(ball)
-        if carrier is None:
+        if carrier is not None and S.dist(carrier, own) < self.p.block_zone:
+            block = S.block_point(carrier, own, sp, ball)
+            if self.is_blocker(block, carrier, own):
+                # Within take_distance of the ball, take it, but only from the kick line: straight at the
+                # ball from goal-side; going round the ball to get behind it would open the line to our goal.
+                on_line = abs(S.wrap(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
+                if S.dist(pos, ball) < sp.take_distance and on_line:
+                    return self.drive(tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True,
+                                      avoid=False)
+                goal_side = S.dist(pos, own) < S.dist(carrier, own) - 0.2
+                return self.drive(tick, block, S.angle_to(block, ball), self.p.cruise, dribbler=True,
+                                  avoid=not goal_side, gain=self.p.block_gain)
+        else:
+            self.mem.blocking = False
+            if chaser:
+                return None
+        if self.role == "attacker" and S.dist(ball, own) > self.p.drop_back:
             return None
-        if chaser and S.dist(carrier, own) < self.p.block_zone:
-            if S.dist(pos, ball) < sp.take_distance:
-                return self.get_ball(tick, ball, self.goal(order))
-            block = S.block_point(carrier, own, sp)
-            return self.drive(tick, block, S.angle_to(block, carrier), self.p.cruise, dribbler=True)
-        target = self.marking_target(order, carrier)
+        target = self.marking_target(order, carrier if carrier is not None else ball)
         if target is None:
             return None
         mark = S.mark_point(target, own, sp.mark_distance)
         return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
+
+    def is_blocker(self, block: Vec, carrier: Vec, own: Vec) -> bool:
+        """Advance defense: of our outfield robots, the one that gets onto the kick line soonest blocks:
+        the nearest to the block point, counting `behind_penalty` more for a robot not goal-side of the
+        carrier (it has to go round it) and `chase_hysteresis` less for the current blocker."""
+        limit = S.dist(carrier, own) - 0.2
+
+        def cost(pt: Vec) -> float:
+            return S.dist(pt, block) + (self.p.behind_penalty if S.dist(pt, own) > limit else 0.0)
+
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        mine = (cost((x, y)) - (self.p.chase_hysteresis if self.mem.blocking else 0.0), self.n)
+        self.mem.blocking = all(
+            (cost((mx, my)), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0
+        )
+        return self.mem.blocking
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
         """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""

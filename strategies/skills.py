@@ -40,6 +40,7 @@ class SkillParams:
     capture_lane: float = 0.18  # [m] lateral error tolerated on the final approach to the ball
     block_distance: float = 1.0  # [m] advance defense: from the carrier on the kick line (paper 2)
     retreat_radius: float = 3.0  # [m] advance defense: closest approach to our goal centre (paper 2)
+    block_gap: float = 0.55  # [m] advance defense: blocker centre at least this far from the ball it blocks
     take_distance: float = 0.5  # [m] advance defense: take the ball when this close (paper 2)
     path_corridor: float = 0.8  # [m] half width of the corridor in which an opponent blocks the path
     path_lookahead: float = 2.5  # [m] how far ahead an opponent counts as in the path
@@ -231,17 +232,30 @@ def passed(pos: Vec, opponent: Vec, goal: Vec) -> bool:
     return (opponent[0] - pos[0]) * math.cos(a) + (opponent[1] - pos[1]) * math.sin(a) <= 0.0
 
 
-def block_point(carrier: Vec, own_goal: Vec, p: SkillParams) -> Vec:
-    """Advance defense (paper 2, Fig. 7b): on the kick line carrier -> own goal centre.
+def block_point(carrier: Vec, own_goal: Vec, p: SkillParams, ball: Vec | None = None) -> Vec:
+    """Advance defense (paper 2, Fig. 7b): on the estimated kick line to our goal centre.
 
     `block_distance` from the carrier towards our goal, but never closer than
     `retreat_radius` to the goal centre: once the carrier is within
     retreat_radius + block_distance, the defender stays on the retreat circle
     at the carrier's bearing (it follows the ball instead of backing up).
+
+    With `ball` (the ball the carrier holds, in front of it) the kick line is
+    the ball's line to our goal centre, where the kick will start, not the
+    carrier centre's: a carrier turning to aim holds the ball up to a robot's
+    half size off its own line, enough to open a post for it. The point is
+    then on that line `block_distance` from the carrier's centre (the ball's
+    distance less), at least `block_gap` from the ball.
     """
-    d = dist(carrier, own_goal)
-    a = angle_to(own_goal, carrier)
-    r = max(p.retreat_radius, d - p.block_distance)
+    if ball is None:
+        d = dist(carrier, own_goal)
+        a = angle_to(own_goal, carrier)
+        r = max(p.retreat_radius, d - p.block_distance)
+        return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
+    d = dist(ball, own_goal)
+    a = angle_to(own_goal, ball)
+    gap = max(p.block_gap, p.block_distance - dist(carrier, ball))
+    r = max(p.retreat_radius, d - gap)
     return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
 
 

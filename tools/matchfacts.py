@@ -31,7 +31,11 @@ Team play (issue 4), per team in `teams` (`TeamFacts`, team a first):
 * `conceded_while_stuck`: goals conceded while one of its outfield robots was
   stuck (a match "decided in a corner" shows up here);
 * `distance_m`: metres travelled by robots 0..n-1 (the engine's coverage
-  distance, paper 2 Fig. 9).
+  distance, paper 2 Fig. 9);
+* `goal_shots`: for each goal that came from an on-target shot, the distance
+  [m] from the strike point to the goal centre (the summary sorts them into
+  close range, mid range and long shots; goals not from a detected shot, e.g.
+  deflections or a ball dribbled in, are the rest).
 
 Between robots (`contact_s`, `overlap_s`, `max_overlap_m`): the footprints are
 the robots' squares; `contact_s` counts pair-seconds in play with the
@@ -75,6 +79,8 @@ FENCE_BAND = 0.5  # [m] a robot centre within this of a line (or beyond it) is b
 STUCK_WINDOW = 2.0  # [s]
 STUCK_MOVE = 0.25  # [m] moving less than this over STUCK_WINDOW by the fence is being stuck
 CORNER_ZONE = 1.5  # [m] from a field corner in both x and y
+GOAL_NEAR = 2.5  # [m] summary: a goal struck closer than this to the goal centre is a close-range goal
+GOAL_FAR = 4.5  # [m] ... farther than this a long shot (the advance shooting distance)
 
 
 @dataclass(frozen=True)
@@ -92,6 +98,7 @@ class TeamFacts:
     corner_s: float = 0.0  # [robot-s]
     conceded_while_stuck: int = 0
     distance_m: tuple[float, ...] = ()
+    goal_shots: tuple[float, ...] = ()  # [m] per goal scored from an on-target shot: strike point to the goal centre
 
 
 @dataclass(frozen=True)
@@ -179,6 +186,7 @@ def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], 
     contact = overlap = 0
     max_overlap = 0.0
     open_shots: list[dict] = []  # on-target shots whose outcome is pending
+    goal_dist: dict[str, list[float]] = {t: [] for t in teams}
     prev: World | None = None
     goal_iter = iter(goal_ticks)
     next_goal = next(goal_iter, None)
@@ -244,9 +252,11 @@ def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], 
             conceding = "b" if scorer == "a" else "a"
             if stuck_now[conceding]:
                 count[conceding]["conceded_stuck"] += 1
-            for s in open_shots:
-                if s["team"] == scorer and s["outcome"] == "":
-                    s["outcome"] = "goal"
+            mine = [s for s in open_shots if s["team"] == scorer and s["outcome"] == ""]
+            for s in mine:
+                s["outcome"] = "goal"
+            if mine:  # the latest pending shot is the one that went in
+                goal_dist[scorer].append(mine[-1]["dist"])
             next_goal = next(goal_iter, None)
         # ---- strikes, shots and their outcome
         if prev is not None:
@@ -269,7 +279,8 @@ def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], 
                         count[t]["shots"] += 1
                         if abs(y) < goal_half:
                             count[t]["on_target"] += 1
-                            open_shots.append({"team": t, "end": w.tick + shot_ticks, "outcome": "", "touch": ""})
+                            open_shots.append({"team": t, "end": w.tick + shot_ticks, "outcome": "", "touch": "",
+                                               "dist": round(math.hypot(line_x - w.ball_x, w.ball_y), 2)})
         pending = []
         for s in open_shots:
             if s["outcome"] == "" and w.tick < s["end"]:
@@ -305,6 +316,7 @@ def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], 
             corner_s=round(count[t]["corner"] * dt, 2),
             conceded_while_stuck=count[t]["conceded_stuck"],
             distance_m=tuple(round(distance.get(f"{t}/{i}", 0.0), 1) for i in range(n)),
+            goal_shots=tuple(goal_dist[t]),
         )
         for k, t in enumerate(teams)
     )
@@ -362,7 +374,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
             row = per.setdefault(t.strategy, {"sides": 0, "W": 0, "D": 0, "L": 0, "GF": 0, "GA": 0, "shots": 0,
                                               "on_target": 0, "faced": 0, "saves": 0, "blocks": 0, "stuck": 0.0,
                                               "longest": 0.0, "corner": 0.0, "conceded_stuck": 0, "pushing": 0,
-                                              "d1": 0.0, "d2": 0.0})
+                                              "d1": 0.0, "d2": 0.0, "g_near": 0, "g_mid": 0, "g_far": 0})
             row["sides"] += 1
             row["W" if t.goals > other.goals else "D" if t.goals == other.goals else "L"] += 1
             row["GF"] += t.goals
@@ -377,6 +389,8 @@ def summary(facts: list[MatchFacts]) -> list[str]:
             row["corner"] += t.corner_s
             row["conceded_stuck"] += t.conceded_while_stuck
             row["pushing"] += t.pushing
+            for g in t.goal_shots:
+                row["g_near" if g < GOAL_NEAR else "g_mid" if g < GOAL_FAR else "g_far"] += 1
             if len(t.distance_m) > 2:
                 row["d1"] += t.distance_m[1]
                 row["d2"] += t.distance_m[2]
@@ -392,6 +406,11 @@ def summary(facts: list[MatchFacts]) -> list[str]:
                    f"{r['shots']:5d}  {r['on_target']:9d}  {r['faced']:5d}  {r['saves']:5d}  {r['blocks']:6d}  "
                    f"{r['stuck'] / k:12.1f}  {r['longest']:13.1f}  {r['corner'] / k:13.1f}  {r['conceded_stuck']:14d}  "
                    f"{r['pushing']:7d}  {ratio:>13s}")
+    out.append(f"goals by strike distance to the goal centre (< {GOAL_NEAR:.1f} m / < {GOAL_FAR:.1f} m / farther"
+               " / not from a detected on-target shot):")
+    for s, r in sorted(per.items()):
+        near, mid, far = r["g_near"], r["g_mid"], r["g_far"]
+        out.append(f"  {short(s):8s} scored {near:3d} / {mid:3d} / {far:3d} / {r['GF'] - near - mid - far:3d}")
     contact = sum(m.contact_s for m in facts) / n
     overlap = sum(m.overlap_s for m in facts) / n
     deepest = max(m.max_overlap_m for m in facts)

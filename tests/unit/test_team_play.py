@@ -190,3 +190,73 @@ def test_the_loser_of_a_challenge_cannot_win_the_ball_straight_back():
     assert first <= 2
     # a, the loser, still touches the ball with its dribbler on, but b keeps it until a may challenge again
     assert all(h == ("b", 0) for h in holders[first:quiet - 1]), holders
+
+
+# ------------------------------------------------- advance defense (issue 4, goal rates)
+def test_block_point_is_on_the_ball_kick_line_one_metre_from_the_carrier():
+    p = S.SkillParams()
+    carrier, ball, own = (0.0, 0.0), (-0.33, -0.1), (-6.0, 0.0)  # the carrier holds the ball turned off its own line
+    block = S.block_point(carrier, own, p, ball)
+    seg, _ = S.segment_distance(block, ball, own)
+    assert seg == pytest.approx(0.0, abs=1e-9)  # on the ball's line to our goal centre, where the kick starts
+    assert S.dist(block, ball) == pytest.approx(p.block_distance - S.dist(carrier, ball))
+    # the old carrier-centre line leaves this kick line uncovered by more than the shooter's clear margin
+    assert S.segment_distance(S.block_point(carrier, own, p), ball, (-6.0, -0.9))[0] > 0.0
+    # a carrier holding the ball at arm's length still leaves block_gap between ball and blocker
+    assert S.dist(S.block_point(carrier, own, p, (-0.6, 0.0)), (-0.6, 0.0)) == pytest.approx(p.block_gap)
+    # retreat: never nearer our goal centre than retreat_radius
+    assert S.dist(S.block_point((-3.2, 0.0), own, p, (-3.5, 0.0)), own) == pytest.approx(p.retreat_radius)
+
+
+def _defending_view(robot, pose, ball, opponents, own, tick=10):
+    cmd = None
+    for t in range(tick, tick + 4):
+        sense = Sense(tick=t, pose=Pose(x=pose[0], y=pose[1], theta=0.0), ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+                      robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents])
+        cmd = robot.step(t, sense, _order(tick - 1, robot.n, robot.role or "defender",
+                                          R.DEFENDING_DEFENDER if robot.n == 2 else R.DEFENDING_ATTACKER, own=own))
+    return cmd
+
+
+def test_advance_attacker_drops_back_to_mark_when_the_ball_is_deep_in_our_half():
+    carrier, ball, other = (-2.0, 1.0), (-2.33, 1.0), (-3.0, -2.0)
+    own = [TeamPose(robot=1, x=0.0, y=-1.0, role="attacker"), TeamPose(robot=2, x=-3.5, y=0.8, role="defender")]
+    for name, marks in (("AD", True), ("BD", False)):
+        robot = _robot(name, n=1)
+        robot.role = "attacker"
+        cmd = _defending_view(robot, (0.0, -1.0), ball, [carrier, other], own)
+        vx, vy = _body_to_field(cmd, 0.0)
+        mark = S.mark_point(other, (-6.0, 0.0), S.SkillParams().mark_distance)
+        towards = (vx * (mark[0] - 0.0) + vy * (mark[1] + 1.0)) / S.dist(mark, (0.0, -1.0))
+        if marks:  # advance: the second outfield robot marks the other attacker goal-side
+            assert towards > 0.9 * math.hypot(vx, vy) > 0.0
+        else:  # basic: it waits ahead of the ball for the counter-attack
+            assert vx >= 0.0
+
+
+def test_the_robot_nearest_the_kick_line_blocks_and_the_other_marks():
+    carrier, ball, other = (-1.0, 0.0), (-1.33, 0.0), (-2.5, 2.0)
+    own = [TeamPose(robot=1, x=-2.2, y=0.3, role="attacker"), TeamPose(robot=2, x=0.5, y=-0.5, role="defender")]
+    block = S.block_point(carrier, (-6.0, 0.0), S.SkillParams(), ball)
+    near = _robot("AD", n=1)
+    near.role = "attacker"
+    vx, vy = _body_to_field(_defending_view(near, (-2.2, 0.3), ball, [carrier, other], own), 0.0)
+    assert vx * (block[0] + 2.2) + vy * (block[1] - 0.3) > 0.0  # goal-side and nearer: it blocks
+    far = _robot("AD", n=2)  # the defender behind the carrier: it would have to go round it, so it marks
+    vx, vy = _body_to_field(_defending_view(far, (0.5, -0.5), ball, [carrier, other], own), 0.0)
+    mark = S.mark_point(other, (-6.0, 0.0), S.SkillParams().mark_distance)
+    assert vx * (mark[0] - 0.5) + vy * (mark[1] + 0.5) > 0.9 * math.hypot(vx, vy) * S.dist(mark, (0.5, -0.5))
+
+
+def test_advance_defense_walls_the_kick_line_at_an_opponent_free_kick():
+    spot = (-1.0, 1.0)
+    own = [TeamPose(robot=1, x=-3.0, y=0.0, role="attacker"), TeamPose(robot=2, x=1.0, y=0.0, role="defender")]
+    robot = _robot("AD", n=1)
+    sense = Sense(tick=5, pose=Pose(x=-3.0, y=0.0, theta=0.0), ball=BallSeen(visible=True, x=spot[0], y=spot[1]))
+    fk = Order(tick=4, robot=1, command="FREEKICK", command_team="b", spot_x=spot[0], spot_y=spot[1], attack_dir=1,
+               role="attacker", own=own)
+    wall = robot.setpiece_defense(fk, spot) if robot.step(5, sense, fk) is not None else None
+    assert S.segment_distance(wall, spot, (-6.0, 0.0))[0] == pytest.approx(0.0, abs=1e-9)  # on the kick line
+    assert S.dist(wall, spot) == pytest.approx(2.2)  # as near as the rules allow, and a little more
+    # nearer our goal the wall does not back into the keeper: at least retreat_radius - 1 m from the goal centre
+    assert S.dist(robot.setpiece_defense(fk, (-4.0, 0.5)), (-6.0, 0.0)) == pytest.approx(2.0)
