@@ -43,8 +43,10 @@ Robot (`IrisRobot`), every tick, from its own `Sense` and the latest `Order`
     the attacker when the pass line is clear; with an opponent in the path,
     go round it in a circle with the body between it and the ball, on the side
     away from the near touch line (`.skills.circle_past`, eq. 1 motion), then
-    goal-ward again; closed down (`pressure_range`), release the ball (pass,
-    or a clear shot from up to `long_shot`); the attacker without the ball
+    goal-ward again; closed down (`pressure_range`), pass if it can; at the
+    carry limit, pass or push the ball ahead; never a shot from beyond
+    `advance_shoot_distance` (paper 2: "shoot when within shooting distance
+    and the line to the goal is clear"); the attacker without the ball
     gets open for a pass and a shot (`.skills.open_point`);
   - basic defense: the robot whose area holds the ball tries to catch it and
     grab it from the opponent (`get_ball`), the others wait at home;
@@ -153,7 +155,6 @@ class IrisParams:
     wall_margin: float = 0.2  # [m] advance defense: the set-piece wall stands this far beyond the 2 m the rules ask
     wall_exit_turn: float = 1.0  # [rad] ... a robot inside the 2 m circle leaves it at most this far off straight away
     pressure_range: float = 1.2  # [m] advance attack: a blocker this close leaves no room to go round it
-    long_shot: float = 6.0  # [m] advance attack: under pressure, a clear shot from this far is still taken
     keeper_zone: float = 1.2  # [m] advance attack: an opponent this close to the goal centre is the keeper, no blocker
     shot_commit: float = 0.6  # [s] advance attack: once a clear shot is seen, turn and take it within this time
     stall_hold: float = 4.0  # [s] a holder still holding after this long plays the ball on (`unstall`)
@@ -775,20 +776,16 @@ class IrisRobot:
             target = self.pass_target(order)
             if target is not None:
                 return self.pass_to(tick, target)
-            if clear and d_goal < 2.0 * self.p.advance_shoot_distance:
-                return self.turn_and_kick(tick, aim, self.p.kick_speed)
             return self.turn_and_kick(tick, self.nudge_point(pos, goal, opponents), self.p.nudge_speed)
         field_players = [o for o in opponents if S.dist(o, goal) > self.p.keeper_zone]  # the keeper is no blocker
         blocker = S.blocker_ahead(pos, goal, field_players, sp.path_corridor, sp.path_lookahead)
         if blocker is not None:
             if S.dist(blocker, pos) < self.p.pressure_range:
-                # Closed down: no room left to go round; release the ball if there is any way.
+                # Closed down: no room left to go round; pass if there is any way (a shot was
+                # taken above if one was on: only within `advance_shoot_distance`, paper 2).
                 target = self.pass_target(order, any_mate=True)
                 if target is not None:
                     return self.pass_to(tick, target)
-                if clear and d_goal < self.p.long_shot:
-                    self.mem.shot_until, self.mem.shot_aim = tick + self._commit_ticks, aim
-                    return self.turn_and_kick(tick, aim, self.p.kick_speed)
             rot = self.mem.circle_rot if tick - self.mem.circle_tick <= 2 else 0.0
             way, heading, self.mem.circle_rot = S.circle_past(pos, blocker, goal, sp.sidestep, rot=rot)
             self.mem.circle_tick = tick
