@@ -145,7 +145,7 @@ def build_parser() -> Parser:
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
     t.add_argument("--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter")
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
-    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per two cores)")
+    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
     t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
     t.add_argument("--json", action="store_true", help="print one JSON object")

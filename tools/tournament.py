@@ -447,8 +447,15 @@ def _interrupt(signum, frame) -> None:  # noqa: ARG001
 
 
 def default_jobs() -> int:
-    """A match keeps about two cores busy: one match per two cores."""
-    return max(1, (os.cpu_count() or 2) // 2)
+    """One match per core.
+
+    A lockstep match keeps its cores only ~80 % busy (it waits on its own
+    critical path) and spends ~2 s starting its processes, so a second match
+    fills the gaps. On the 2-core development machine, 6 matches of 2 x 60 s
+    (AD, BS, AS, 2 legs) took 56.6 and 56.3 s with one at a time and 43.8 and
+    46.3 s with two, with the same results and digests.
+    """
+    return max(1, os.cpu_count() or 1)
 
 
 def run(args) -> tuple[dict, bool]:
