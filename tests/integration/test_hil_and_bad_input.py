@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import msgspec
@@ -44,11 +45,9 @@ def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
     assert result["rejected"] == 0 and result["dead"] == []
 
 
-def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payloads) -> dict:
-    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key`. Returns the match JSON.
-
-    `tick` is the tick of the first referee frame heard: the match is at or past it.
-    """
+@contextmanager
+def _client_of_a_match(tmp_path, reap, match_id: str, seed: int):
+    """Start a 2 x 20 s BS v BS match on a socket in `tmp_path`; yield (the match process, a client session)."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     match = spawn(
         "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", str(seed),
@@ -57,6 +56,21 @@ def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payl
     reap.append(match)
     wait_for(lambda: Path(endpoint.split("/", 1)[1]).exists(), 30, "the router socket")
     with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        yield match, session
+
+
+def _result(match) -> dict:
+    out, err = match.communicate(timeout=240)
+    assert match.returncode == 0, err
+    return json.loads(out)
+
+
+def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payloads) -> dict:
+    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key`. Returns the match JSON.
+
+    `tick` is the tick of the first referee frame heard: the match is at or past it.
+    """
+    with _client_of_a_match(tmp_path, reap, match_id, seed) as (match, session):
         # Wait until the match is being played: the referee has sent a frame. Stop
         # listening before publishing: on the referee key we would hear ourselves.
         referee = session.declare_subscriber(f"arena/{match_id}/referee", zenoh.handlers.FifoChannel(1000))
@@ -66,9 +80,7 @@ def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payl
         pub = session.declare_publisher(f"arena/{match_id}/{key}", congestion_control=zenoh.CongestionControl.BLOCK)
         for payload in payloads(tick):
             pub.put(payload)
-        out, err = match.communicate(timeout=240)
-    assert match.returncode == 0, err
-    return json.loads(out)
+        return _result(match)
 
 
 def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path, reap):
@@ -100,16 +112,9 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
     (A single burst sent once at the start lost it at times: the match may be
     far on by the time it arrives.)
     """
-    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", "6",
-        "--match", "refnoise", "--listen", endpoint, "--json", "--logs", str(tmp_path / "logs"),
-    )
-    reap.append(match)
-    wait_for(lambda: Path(endpoint.split("/", 1)[1]).exists(), 30, "the router socket")
     decode = msgspec.msgpack.Decoder(Referee).decode
     rounds = 0
-    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+    with _client_of_a_match(tmp_path, reap, "refnoise", 6) as (match, session):
         referee = session.declare_subscriber("arena/refnoise/referee", zenoh.handlers.FifoChannel(1000))
         # REMOTE: our own subscriber above does not hear the bad frames.
         pub = session.declare_publisher(
@@ -130,9 +135,7 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
                     pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="START", command_team="c")))  # no team c
                 rounds += 1
             time.sleep(0.02)
-        out, err = match.communicate(timeout=240)
-    assert match.returncode == 0, err
-    result = json.loads(out)
+        result = _result(match)
     assert rounds >= 10, f"only {rounds} rounds of bad frames before the match ended"
     reasons = result["rejected_reasons"]
     assert reasons.get("invalid", 0) >= 3, reasons  # at least one per receiver: engine and two base stations
