@@ -35,7 +35,7 @@ from arena.processes import setpieces
 from arena.processes.drive import Drive
 from arena.processes.physics import Physics
 from arena.processes.referee_box import check_referee
-from arena.processes.sensors import sense
+from arena.processes.sensors import NormalStream, sense
 from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
@@ -117,7 +117,7 @@ class EngineNode(Node):
         self.restarts = Restarts(cfg, self.physics)
         self.wheels = Drive(cfg.robot).wheels  # wheel speeds a `cmd` in mode "wheels" must carry
         self.sensor_rng = {
-            r: np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r)) for r in self.robots
+            r: NormalStream(np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r))) for r in self.robots
         }
         self.cmd_in = {
             (team, n): self.inp(

@@ -18,7 +18,10 @@ Noise comes from the caller's numpy `Generator`, one per robot. Every call
 draws the same number of standard normals (3 + 2 + 2 per other robot, seen or
 not), so a robot's noise stream never depends on what it happened to see, and
 one vectorised draw replaces ~30 calls of `random.gauss` (the engine's hottest
-Python code before).
+Python code before). The engine wraps each generator in a `NormalStream`,
+which draws a few thousand normals at a time: a numpy call per robot per tick
+was half the cost of `sense`, and the numbers are the same (a Generator's
+standard normals come out in the same order whatever the block size).
 """
 
 from __future__ import annotations
@@ -34,12 +37,38 @@ from arena.schemas.messages import BallSeen, Pose, RobotSeen, Sense
 RobotStates = list[tuple[str, int, float, float, float, float, float, float]]
 
 
+class NormalStream:
+    """A numpy Generator's standard normals, drawn `block` at a time and handed out in order."""
+
+    __slots__ = ("rng", "block", "_buf", "_i")
+
+    def __init__(self, rng: np.random.Generator, block: int = 4096):
+        self.rng = rng
+        self.block = block
+        self._buf: list[float] = []
+        self._i = 0
+
+    def take(self, n: int) -> list[float]:
+        """The next n normals of the stream (exactly what `rng.standard_normal(n)` would give)."""
+        i, j = self._i, self._i + n
+        if j <= len(self._buf):
+            self._i = j
+            return self._buf[i:j]
+        out = self._buf[i:]
+        while len(out) < n:
+            self._buf = self.rng.standard_normal(self.block).tolist()
+            need = n - len(out)
+            out += self._buf[:need]
+            self._i = min(need, self.block)
+        return out
+
+
 def sense(
     physics: Physics,
     team: str,
     n: int,
     tick: int,
-    rng: np.random.Generator,
+    rng: np.random.Generator | NormalStream,
     p: SensorParams,
     states: RobotStates | None = None,
 ) -> Sense:
@@ -50,7 +79,8 @@ def sense(
     """
     if states is None:
         states = physics.robot_states()
-    z = rng.standard_normal(3 + 2 * len(states)).tolist()
+    n_z = 3 + 2 * len(states)
+    z = rng.take(n_z) if isinstance(rng, NormalStream) else rng.standard_normal(n_z).tolist()
     me = next(st for st in states if st[0] == team and st[1] == n)
     _, _, x, y, theta, vx, vy, omega = me
     c, s = math.cos(theta), math.sin(theta)

@@ -132,3 +132,22 @@ def test_seeded_reproducibility_and_no_global_random():
         random.setstate(saved)
     assert first == again
     assert sense(ph, "a", 0, 0, np.random.default_rng(43), P) != first[0]
+
+
+@pytest.mark.parametrize("block", [1, 7, 13, 4096])
+def test_normal_stream_gives_the_generators_normals_in_order(block):
+    """The engine draws sensor noise in blocks; the numbers must be the ones drawn one call at a time."""
+    from arena.processes.sensors import NormalStream
+
+    stream, ref = NormalStream(np.random.default_rng(3), block), np.random.default_rng(3)
+    for n in [13, 13, 1, 0, 5000, 2, 4096, 13] * 3:
+        assert stream.take(n) == ref.standard_normal(n).tolist()
+
+
+def test_sense_is_the_same_with_a_normal_stream():
+    from arena.processes.sensors import NormalStream
+
+    ph = make()
+    stream, gen = NormalStream(np.random.default_rng(9)), np.random.default_rng(9)
+    for k in range(50):
+        assert sense(ph, "a", 0, k, stream, P) == sense(ph, "a", 0, k, gen, P)
