@@ -108,5 +108,15 @@ class Drive:
             s = saturation_scale(cmd.wheels, self.max_wheel_speed)
             return self._cap(*self.body_twist([w * s for w in cmd.wheels]))
         vx, vy, w = self._cap(cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega)
-        s = saturation_scale(self.wheel_speeds(vx, vy, w), self.max_wheel_speed)
+        # saturation_scale(self.wheel_speeds(vx, vy, w), ...) without building the
+        # list: the engine does this six times a tick. Same operations, same bits
+        # (and x * 1.0 == x, so an unsaturated twist is returned as it is).
+        peak = 0.0
+        for a, b, c in self.inverse_rows:
+            m = abs(a * vx + b * vy + c * w)
+            if m > peak:
+                peak = m
+        if 0.0 < self.max_wheel_speed and peak <= self.max_wheel_speed:
+            return vx, vy, w
+        s = saturation_scale((peak,), self.max_wheel_speed)  # raises for a limit <= 0
         return vx * s, vy * s, w * s

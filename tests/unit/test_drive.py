@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import random
 
 import pytest
 
@@ -91,3 +92,29 @@ def test_unknown_model_is_refused():
 )
 def test_the_engine_rejects_commands_the_robot_model_cannot_mean(cmd, model, problem):
     assert check_cmd(cmd, Drive(model).wheels) == problem
+
+
+@pytest.mark.parametrize("model", ["omni4", "omni3", "diff"])
+def test_body_twist_is_bit_for_bit_the_saturated_inverse(model):
+    """`twist` skips the wheel list; it must equal the written-out formula exactly."""
+    from dataclasses import replace
+
+    from arena.navigation.saturation import saturation_scale
+
+    d = Drive(replace(IRIS, model=model))
+    rng = random.Random(11)
+    saturated = 0
+    for _ in range(2000):
+        c = body(rng.uniform(-8, 8), rng.uniform(-8, 8), rng.uniform(-30, 30))
+        vx, vy, w = d._cap(c.vx, c.vy if d.holonomic else 0.0, c.omega)
+        s = saturation_scale(d.wheel_speeds(vx, vy, w), d.max_wheel_speed)
+        saturated += s < 1.0
+        assert d.twist(c) == (vx * s, vy * s, w * s)
+    assert saturated > 100  # both branches ran
+
+
+def test_a_limit_of_zero_is_still_an_error():
+    from dataclasses import replace
+
+    with pytest.raises(ValueError, match="max_wheel_speed"):
+        Drive(replace(IRIS, max_wheel_speed=0.0)).twist(body(1.0))
