@@ -10,8 +10,10 @@ an error, ends the whole group; children also die with the launcher
 
 from __future__ import annotations
 
+import compileall
 import ctypes
 import hashlib
+import importlib.util
 import os
 import shutil
 import signal
@@ -59,6 +61,31 @@ class Child:
         except OSError:
             return ""
         return "\n".join("    " + line for line in text[-lines:])
+
+
+_PACKAGES = ("arena", "arena.runtime", "arena.processes", "arena.schemas", "arena.strategies", "arena.navigation", "arena.tools")
+
+
+def compile_sources() -> None:
+    """Write the bytecode of arena's own modules before eleven interpreters import them.
+
+    With PYTHONDONTWRITEBYTECODE set and an editable install (the README's),
+    no interpreter writes a cache, so every process of every match compiled
+    arena's sources again: about 0.1 s of CPU per process, ~1 s per match
+    (measured with `arena match --half-time 1`: 3.6 against 2.6 CPU s). This
+    writes the usual `__pycache__` files of arena's own packages only (skipping
+    fresh ones, a few ms), never anything else. Without the variable the
+    interpreters write them themselves, so this does nothing.
+    """
+    if not sys.dont_write_bytecode:
+        return
+    for name in _PACKAGES:
+        spec = importlib.util.find_spec(name)
+        for root in (spec.submodule_search_locations or []) if spec else []:
+            try:
+                compileall.compile_dir(root, maxlevels=0, quiet=2)
+            except OSError:
+                pass  # a read-only install: the processes compile in memory, as before
 
 
 def new_match_id(seed: int) -> str:
@@ -220,7 +247,10 @@ def supervise(
             if deadline is not None and time.monotonic() > deadline:
                 missing = sorted(waiting - set(got.summaries))
                 raise MatchError(f"match timed out after {timeout:g} s waiting for: {', '.join(missing)}")
-            time.sleep(0.02)
+            # Nothing to do while the match plays but show progress and notice a
+            # failed child: a slow poll leaves the two cores to the match. The
+            # summaries all come within a few ms of each other: poll fast then.
+            time.sleep(0.01 if got.summaries else 0.1)
     got.ended = time.monotonic()
     return got
 
@@ -334,6 +364,7 @@ def play_match(
     Raises MatchError when the match cannot be completed.
     """
     t_start = time.monotonic()
+    compile_sources()
     match = match or new_match_id(cfg.seed)
     keys = Keys(match)
     tmp = Path(tempfile.mkdtemp(prefix="arena-"))
