@@ -50,6 +50,7 @@ from arena.navigation.frames import wrap_angle
 from arena.navigation.sfm import SFMParams, command_velocity, goal_force
 
 _PI = math.pi
+_TAU = 2.0 * _PI
 
 
 @dataclass(frozen=True)
@@ -138,11 +139,20 @@ class FIS:
     outputs: OutputSets = SCHEME_5
     # rules resolved to numbers, [direction][distance]; derived in __post_init__.
     table: tuple[tuple[float, ...], ...] = field(init=False, repr=False, compare=False)
+    # the sets as (index, u, v, w, v - u, w - v) for `gain`; derived in __post_init__.
+    distance_mf: tuple[tuple[int, float, float, float, float, float], ...] = field(
+        init=False, repr=False, compare=False
+    )
+    direction_mf: tuple[tuple[int, float, float, float, float, float], ...] = field(
+        init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         if len(self.rules) != len(self.direction_sets) or any(len(r) != len(self.distance_sets) for r in self.rules):
             raise ValueError("rules must have one row per direction set and one column per distance set")
         object.__setattr__(self, "table", tuple(tuple(getattr(self.outputs, lab) for lab in row) for row in self.rules))
+        for name, sets in (("distance_mf", self.distance_sets), ("direction_mf", self.direction_sets)):
+            object.__setattr__(self, name, tuple((i, s.u, s.v, s.w, s.v - s.u, s.w - s.v) for i, s in enumerate(sets)))
 
 
 @dataclass(frozen=True)
@@ -181,17 +191,28 @@ def gain(d: float, phi: float, fis: FIS = FIS()) -> float:
     a non-zero degree take part (at most two per input with these partitions).
     """
     phi = abs(phi)
-    mu_d = [(a, m) for a, s in enumerate(fis.distance_sets) if (m := s.degree(d)) > 0.0]
+    # Eq. 8, TriangularMF.degree inlined (this runs per obstacle and tick).
+    mu_d = []
+    for a, u, v, w, vu, wv in fis.distance_mf:
+        if d <= v:
+            m = 1.0 if u == v else (d - u) / vu if d > u else 0.0
+        else:
+            m = 1.0 if v == w else (w - d) / wv if d < w else 0.0
+        if m > 0.0:
+            mu_d.append((a, m))
     num = den = 0.0
     table = fis.table
-    for b, s in enumerate(fis.direction_sets):
-        mg = s.degree(phi)
+    for b, u, v, w, vu, wv in fis.direction_mf:
+        if phi <= v:
+            mg = 1.0 if u == v else (phi - u) / vu if phi > u else 0.0
+        else:
+            mg = 1.0 if v == w else (w - phi) / wv if phi < w else 0.0
         if mg > 0.0:
             row = table[b]
             for a, md in mu_d:
-                w = mg * md
-                num += w * row[a]
-                den += w
+                fire = mg * md  # B_ab, eq. 9
+                num += fire * row[a]
+                den += fire
     if den == 0.0:
         raise ValueError(f"no rule fires for d={d}, phi={phi}: the input sets do not cover it")
     return num / den
@@ -249,7 +270,7 @@ def navigation_force(
         d = hypot(dx, dy)  # eq. 12
         if d < EPS_DISTANCE or d > cutoff:
             continue
-        phi = remainder(atan2(-dy, -dx) - front, 2.0 * _PI)  # gamma (eq. 14) relative to the front
+        phi = remainder(atan2(-dy, -dx) - front, _TAU)  # gamma (eq. 14) relative to the front
         k = gain(d, phi, fis)  # eq. 8-10
         overlap = r_ij - d
         c = k * (exp(overlap / sigma) + (overlap if overlap > 0.0 else 0.0)) / d  # eq. 5-7

@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arena.navigation.frames import wrap_angle
+from arena.navigation.frames import TAU, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -56,11 +56,33 @@ def heading_error(beta: float, theta: float) -> float:
     return wrap_angle(beta - theta)
 
 
+def update(
+    integral: float, prev_error: float | None, beta: float, theta: float, params: PIDParams = PIDParams()
+) -> tuple[float, float, float]:
+    """Eq. 15-16 on plain floats: (V_theta [rad/s], next integral [rad], err [rad]) for the state
+    (``integral``, ``prev_error``); :func:`step` without the state objects, for per-tick callers."""
+    remainder, pi = math.remainder, math.pi
+    err = remainder(beta - theta, TAU)  # eq. 15, wrap_angle inlined
+    if err == -pi:
+        err = pi
+    bound = params.max_integral
+    integral += err
+    if not -bound < integral < bound:  # the clip, only where it can change the value (or on NaN)
+        integral = max(-bound, min(bound, integral))
+    if prev_error is None:
+        derivative = 0.0
+    else:
+        derivative = remainder(err - prev_error, TAU)
+        if derivative == -pi:
+            derivative = pi
+    out = params.k_p * err + params.k_i * integral + params.k_d * derivative
+    bound = params.max_output
+    if not -bound < out < bound:
+        out = max(-bound, min(bound, out))
+    return out, integral, err
+
+
 def step(state: PIDState, beta: float, theta: float, params: PIDParams = PIDParams()) -> tuple[float, PIDState]:
     """Eq. 16: (V_theta [rad/s], next state) for target direction ``beta`` and heading ``theta`` [rad]."""
-    err = heading_error(beta, theta)
-    integral = max(-params.max_integral, min(params.max_integral, state.integral + err))
-    derivative = 0.0 if state.prev_error is None else wrap_angle(err - state.prev_error)
-    out = params.k_p * err + params.k_i * integral + params.k_d * derivative
-    out = max(-params.max_output, min(params.max_output, out))
+    out, integral, err = update(state.integral, state.prev_error, beta, theta, params)
     return out, PIDState(integral=integral, prev_error=err)

@@ -81,18 +81,23 @@ Robot (`IrisRobot`), every tick, from its own `Sense` and the latest `Order`
 Cost: what depends only on the order (areas, roles, teammates) is worked out
 once per order (`_Plan`, `support_point`), not once per tick; with no robot
 within `obstacle_range` the navigator is not called (F-SFM then gives the
-straight line at cruise speed).
+straight line at cruise speed). The per-tick path (`step`, `drive`, the
+goalkeeper, the chaser) keeps its constants in attributes worked out in
+`__init__` and inlines small helpers (`inside`, `S.dist`, `S.angle_to`, `min`);
+each inlined expression does the very float operations of the helper it stands
+for, so that matches replay bit for bit.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from math import cos, hypot, sin
 
 from arena.navigation import PARAMS, get
 from arena.navigation.fsfm import FSFMParams
-from arena.navigation.pid import PIDParams, PIDState
-from arena.navigation.pid import step as pid_step
+from arena.navigation.pid import PIDParams
+from arena.navigation.pid import update as pid_update
 from arena.navigation.sfm import SFMParams
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, Sense, TeamPose
 from arena.strategies import roles as R
@@ -255,12 +260,13 @@ class _Memory:
     shot_until: int = -(1 << 30)  # [tick] a decided shot is carried through until then
     shot_aim: Vec = (0.0, 0.0)  # [m]
     blocking: bool = False  # advance defense: this robot is the one blocking the carrier
-    pid: PIDState = field(default_factory=PIDState)
+    pid_integral: float = 0.0  # [rad] heading PID state (paper 1 eq. 16): the sum of errors ...
+    pid_error: float | None = None  # [rad] ... and the latest error (None before the first step)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class _Plan:
-    """What follows from one order alone: roles, areas, teammates (worked out once per order)."""
+    """What follows from one order alone: roles, areas, teammates (worked out once per order; never changed)."""
 
     role: str
     area: tuple[float, float]  # (u_min, u_max) [m] of this robot
@@ -296,6 +302,15 @@ class IrisRobot:
         self.tick = 0
         self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
         self._commit_ticks = int(round(p.shot_commit / cfg.timing.dt))
+        # Constants of the per-tick path, worked out once.
+        self._dt = cfg.timing.dt  # [s]
+        self._defense_area = self.area_params.defense
+        self._areas: dict[tuple, dict[int, tuple[float, float]]] = {}  # R.areas by the roles it was given
+        self._drive_hx = self.half_length + 0.3  # [m] `inside` with its default margin, for `drive`
+        self._drive_hy = self.half_width + 0.3  # [m]
+        self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
+        self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
+        self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
 
     # ------------------------------------------------------------------ report
     def report(self, tick: int, sense: Sense | None) -> Report:
@@ -309,36 +324,40 @@ class IrisRobot:
 
     # -------------------------------------------------------------------- step
     def step(self, tick: int, sense: Sense | None, order: Order | None) -> Cmd:
-        self.view.update(tick, sense, order)
+        view = self.view
+        view.update(tick, sense, order)
         self.order = order
         self.tick = tick
-        if order is None or sense is None or self.view.pose is None:
+        if order is None or sense is None or view.pose is None:
             return Cmd(tick=tick)
-        if order.command != self.mem.command:
-            self.mem.command, self.mem.command_since = order.command, tick
+        mem = self.mem
+        command = order.command
+        if command != mem.command:
+            mem.command, mem.command_since = command, tick
         self.role = order.role or self.role or "defender"
         if order is not self._planned:
             self.plan = self.make_plan(order)
             self._planned = order
-        if not self.view.has_ball:
-            if self.mem.carry_from is not None and tick - self.mem.kicked_at > 2:
-                self.mem.lost_at = tick
-            self.mem.carry_from = None
-        elif self.mem.carry_from is None:
-            self.mem.carry_from = (self.view.pose[0], self.view.pose[1])
-            self.mem.hold_since = tick
-        if order.command in SET_PIECES:
+        has_ball = view.has_ball
+        if not has_ball:
+            if mem.carry_from is not None and tick - mem.kicked_at > 2:
+                mem.lost_at = tick
+            mem.carry_from = None
+        elif mem.carry_from is None:
+            mem.carry_from = (view.pose[0], view.pose[1])
+            mem.hold_since = tick
+        if command in SET_PIECES:
             return self.position_for_restart(tick, order)
-        if order.command != PLAY:
+        if command != PLAY:
             return Cmd(tick=tick)
-        ball = self.view.ball
+        ball = view.ball
         if ball is None:
             return Cmd(tick=tick, omega=1.0)  # look round for the ball
         if self.keep_setpiece_distance(tick, order, ball):
             return self.position_for_restart(tick, order)
         if self.role == "goalkeeper":
             return self.goalkeeper(tick, order, ball)
-        if self.view.has_ball:
+        if has_ball:
             return self.with_ball(tick, order, ball)
         return self.without_ball(tick, order, ball)
 
@@ -346,14 +365,20 @@ class IrisRobot:
         roles = {n: r for n, (_, _, r) in self.view.mates.items() if n != 0 and r in ("attacker", "defender")}
         if self.n != 0:
             roles[self.n] = self.role
-        areas = R.areas(roles, self.area_params)
-        attackers = tuple(
-            (x, y) for n, (x, y, r) in sorted(self.view.mates.items()) if n != 0 and r == "attacker"
-        )
-        mates = tuple((x, y) for n, (x, y, _) in sorted(self.view.mates.items()) if n != 0)
+        key = tuple(roles.items())  # the areas follow from the roles alone: worked out once per set of roles
+        areas = self._areas.get(key)
+        if areas is None:
+            areas = self._areas[key] = R.areas(roles, self.area_params)
+        attackers: list[Vec] = []
+        mates: list[Vec] = []
+        for n, (x, y, r) in sorted(self.view.mates.items()):
+            if n != 0:
+                mates.append((x, y))
+                if r == "attacker":
+                    attackers.append((x, y))
         return _Plan(
-            role=self.role, area=areas.get(self.n, self.area_params.defense), areas=areas,
-            attackers=attackers, mates=mates, attacking=R.is_attacking(order.role_state),
+            role=self.role, area=areas.get(self.n, self._defense_area), areas=areas,
+            attackers=tuple(attackers), mates=tuple(mates), attacking=R.is_attacking(order.role_state),
         )
 
     # ------------------------------------------------------------- geometry
@@ -382,35 +407,44 @@ class IrisRobot:
         """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots;
         `gain` [1/s]: drive straight at speed min(vmax, gain * distance) (without it the straight
         speed is the distance per second, capped by `k_pos`)."""
-        x, y, th = self.view.pose  # type: ignore[misc]
-        target = self.inside(target)
-        tx, ty = target[0] - x, target[1] - y
-        d = math.hypot(tx, ty)
+        view, p = self.view, self.p
+        x, y, th = view.pose  # type: ignore[misc]
+        # target = self.inside(target), inlined
+        gx, gy, hx, hy = target[0], target[1], self._drive_hx, self._drive_hy
+        gx = -hx if gx < -hx else hx if gx > hx else gx
+        gy = -hy if gy < -hy else hy if gy > hy else gy
+        tx, ty = gx - x, gy - y
+        d = hypot(tx, ty)
         vx, vy = tx, ty  # straight at it, at 1 m/s per metre to go (capped below)
         if gain and d > 1e-9:  # straight at it at gain * distance (a tracking robot: blocker, marker)
-            k = min(vmax, gain * d) / d
+            k = gain * d
+            k = (k if k < vmax else vmax) / d  # min(vmax, gain * d) / d
             vx, vy = tx * k, ty * k
-        if avoid and d > self.p.direct_range:
-            near = self.p.obstacle_range
-            obstacles = [o for o in self.view.others() if abs(o[0] - x) < near and abs(o[1] - y) < near
-                         and math.hypot(o[0] - x, o[1] - y) < near]
-            for o in extra_obstacles:
-                if math.hypot(o[0] - x, o[1] - y) < near:
-                    obstacles.append(o)
+        if avoid and d > p.direct_range:
+            near = p.obstacle_range
+            obstacles = []  # every other robot (view.others(): opponents, then teammates) and the extras within reach
+            for group in (view.opponents, view.mate_obstacles, extra_obstacles):
+                for o in group:
+                    dx, dy = o[0] - x, o[1] - y
+                    if -near < dx < near and -near < dy < near and hypot(dx, dy) < near:
+                        obstacles.append(o)
             if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
-                vx, vy = self.nav((x, y), self.view.vel, target, obstacles, self.nav_params)
-        speed = math.hypot(vx, vy)
-        cap = min(vmax, (gain or self.p.k_pos) * d)
+                vx, vy = self.nav((x, y), view.vel, (gx, gy), obstacles, self.nav_params)
+        speed = hypot(vx, vy)
+        cap = (gain or p.k_pos) * d
+        cap = cap if cap < vmax else vmax  # min(vmax, (gain or k_pos) * d)
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
-        vx, vy = self.guard_push(x, y, vx, vy, self.p.contact_range)
-        if self.view.has_ball:  # the held ball is part of the body: do not push it into an opponent either
+        c, s = cos(th), sin(th)
+        vx, vy = self.guard_push(x, y, vx, vy, p.contact_range)
+        has_ball = view.has_ball
+        if has_ball:  # the held ball is part of the body: do not push it into an opponent either
             reach = self.ball_reach
-            vx, vy = self.guard_push(x + reach * math.cos(th), y + reach * math.sin(th), vx, vy, self.p.ball_contact_range)
-        omega, self.mem.pid = pid_step(self.mem.pid, heading, th, self.p.heading_pid)
-        limit = self.p.dribble_omega if self.view.has_ball or dribbler and d < 0.6 else self.p.max_omega
-        omega = S.clamp(omega, -limit, limit)
-        c, s = math.cos(th), math.sin(th)
+            vx, vy = self.guard_push(x + reach * c, y + reach * s, vx, vy, p.ball_contact_range)
+        mem = self.mem
+        omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
+        limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
+        omega = -limit if omega < -limit else limit if omega > limit else omega
         return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
 
     def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:
@@ -426,19 +460,20 @@ class IrisRobot:
         that shields the ball with its body can turn away, and a holder does
         not drive the ball into an opponent (which would knock it loose).
         """
-        rng, brake2 = self.p.push_guard_range, 2.0 * self.p.brake
-        guard2 = self.p.push_guard * self.p.push_guard
+        rng, brake2, guard2, contact_push = self._guard
+        if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
+            return vx, vy
         for ox, oy in self.view.opponents:
             dx, dy = ox - x, oy - y
             if abs(dx) > rng or abs(dy) > rng:
                 continue
-            d = math.hypot(dx, dy)
+            d = hypot(dx, dy)
             if 1e-6 < d < rng:
                 ex, ey = dx / d, dy / d
                 closing = vx * ex + vy * ey
-                if closing <= self.p.contact_push:
+                if closing <= contact_push:
                     continue
-                cap = self.p.contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
+                cap = contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
                 if closing > cap:
                     vx -= (closing - cap) * ex
                     vy -= (closing - cap) * ey
@@ -446,18 +481,22 @@ class IrisRobot:
 
     def get_ball(self, tick: int, ball: Vec, target: Vec) -> Cmd:
         """Catch the ball so that it can then be pushed towards `target`."""
-        sp = self.p.skills
+        p = self.p
+        sp = p.skills
         x, y, th = self.view.pose  # type: ignore[misc]
         pos = (x, y)
-        to_ball = S.angle_to(pos, ball)
-        d = S.dist(pos, ball)
-        if d < sp.behind_ball + 0.3 and (
+        bx, by = ball
+        to_ball = math.atan2(by - y, bx - x)  # S.angle_to(pos, ball)
+        d = hypot(x - bx, y - by)  # S.dist(pos, ball)
+        if d < self._near_ball and (
             S.lined_up(pos, ball, target, sp.capture_lane) or abs(S.wrap(to_ball - th)) < 0.35
         ):
-            return self.drive(tick, ball, to_ball, self.p.approach_speed, dribbler=True, avoid=False)
-        behind = self.inside(S.behind_point(ball, target, sp.behind_ball), margin=0.1)
-        heading = S.angle_to(ball, target) if S.dist(pos, behind) < 1.0 else to_ball
-        return self.drive(tick, behind, heading, self.p.cruise, dribbler=d < 1.0, extra_obstacles=(ball,))
+            return self.drive(tick, ball, to_ball, p.approach_speed, dribbler=True, avoid=False)
+        a = math.atan2(target[1] - by, target[0] - bx)  # S.angle_to(ball, target) ...
+        off = sp.behind_ball  # ... for S.behind_point(ball, target, behind_ball)
+        behind = self.inside((bx - off * cos(a), by - off * sin(a)), margin=0.1)
+        heading = a if hypot(x - behind[0], y - behind[1]) < 1.0 else to_ball
+        return self.drive(tick, behind, heading, p.cruise, dribbler=d < 1.0, extra_obstacles=(ball,))
 
     def turn_and_kick(self, tick: int, aim: Vec, speed: float, *, is_pass: bool = False) -> Cmd:
         """Holding the ball: turn towards aim (slowly) and kick once facing it.
@@ -592,7 +631,7 @@ class IrisRobot:
         defending mode between the ball and our goal, at most 3.2 m out.
         S2 (losing) pushes everyone 1 m up, S3 (winning) 1 m back.
         """
-        lo, hi = self.my_area(order)
+        lo, hi = self.plan.area  # type: ignore[union-attr]
         d = order.attack_dir
         bu = d * ball[0]
         shift = 1.0 if order.strategy == R.S_OFFENSIVE else -1.0 if order.strategy == R.S_DEFENSIVE else 0.0
@@ -631,41 +670,52 @@ class IrisRobot:
 
     def is_chaser(self, order: Order, ball: Vec) -> bool:
         """Nearest to the ball among our outfield robots whose area holds it (a fresh passer leaves it)."""
-        bu = self.u(order, ball[0])
-        lo, hi = self.my_area(order)
-        if (self.tick - self.mem.passed_at) * self.cfg.timing.dt < self.p.pass_rest:
-            self.mem.chasing = False
+        mem = self.mem
+        bu = order.attack_dir * ball[0]  # self.u(order, ball[0])
+        lo, hi = self.plan.area  # type: ignore[union-attr]
+        if (self.tick - mem.passed_at) * self._dt < self.p.pass_rest:
+            mem.chasing = False
             return False
         if not lo - 0.3 <= bu <= hi + 0.3:
-            self.mem.chasing = False
+            mem.chasing = False
             return False
         x, y, _ = self.view.pose  # type: ignore[misc]
-        mine = S.dist((x, y), ball) - (self.p.chase_hysteresis if self.mem.chasing else 0.0)
+        bx, by = ball
+        mine = hypot(x - bx, y - by) - (self.p.chase_hysteresis if mem.chasing else 0.0)
+        me = self.n
         area = self.plan.areas  # type: ignore[union-attr]
         for n, (mx, my, _) in self.view.mates.items():
             if n == 0 or n not in area:
                 continue
             mlo, mhi = area[n]
-            if mlo - 0.3 <= bu <= mhi + 0.3 and (S.dist((mx, my), ball), n) < (mine, self.n):
-                self.mem.chasing = False
-                return False
-        self.mem.chasing = True
+            if mlo - 0.3 <= bu <= mhi + 0.3:
+                dm = hypot(mx - bx, my - by)
+                if dm < mine or dm == mine and n < me:  # (dm, n) < (mine, me)
+                    mem.chasing = False
+                    return False
+        mem.chasing = True
         return True
 
     # ------------------------------------------------------------ behaviours
     def goalkeeper(self, tick: int, order: Order, ball: Vec) -> Cmd:
-        own = self.own_goal(order)
-        x, y, _ = self.view.pose  # type: ignore[misc]
-        pos = (x, y)
-        if self.view.has_ball:
+        view = self.view
+        if view.has_ball:
             return self.clear(tick, order, ball)
-        near_goal = abs(ball[0] - own[0]) < self.cfg.field.penalty_area_depth and abs(ball[1]) < self.cfg.field.penalty_area_width / 2
-        slow = math.hypot(*self.view.ball_vel) < 1.0
-        opp = min((S.dist(o, ball) for o in self.view.opponents), default=math.inf)
-        if near_goal and slow and S.dist(pos, ball) < min(1.5, opp):
-            return self.get_ball(tick, ball, self.goal(order))
-        target, _ = S.keeper_target(ball, self.view.ball_vel, own[0], self.goal_half, self.p.skills)
-        return self.drive(tick, target, S.angle_to(pos, ball), self.p.cruise, dribbler=S.dist(pos, ball) < 1.0, avoid=False)
+        own_x = self.own_goal(order)[0]
+        x, y, _ = view.pose  # type: ignore[misc]
+        bx, by = ball
+        d_ball = hypot(x - bx, y - by)  # S.dist(pos, ball)
+        near_goal = abs(bx - own_x) < self.cfg.field.penalty_area_depth and abs(by) < self._penalty_half_width
+        if near_goal and hypot(*view.ball_vel) < 1.0:  # near our goal and slow: the keeper may take it
+            opp = math.inf  # the nearest opponent's distance to the ball
+            for ox, oy in view.opponents:
+                dd = hypot(ox - bx, oy - by)
+                if dd < opp:
+                    opp = dd
+            if d_ball < (opp if opp < 1.5 else 1.5):  # min(1.5, opp)
+                return self.get_ball(tick, ball, self.goal(order))
+        target, _ = S.keeper_target(ball, view.ball_vel, own_x, self.goal_half, self.p.skills)
+        return self.drive(tick, target, math.atan2(by - y, bx - x), self.p.cruise, dribbler=d_ball < 1.0, avoid=False)
 
     def clear(self, tick: int, order: Order, ball: Vec) -> Cmd:
         """Goalkeeper or cornered defender with the ball: pass to a free teammate, else kick upfield."""
@@ -821,17 +871,23 @@ class IrisRobot:
         return -0.6 * self.goal_half if keeper_y > 0 else 0.6 * self.goal_half
 
     def carrier(self, ball: Vec) -> Vec | None:
-        near = [(S.dist(o, ball), o) for o in self.view.opponents]
-        if not near:
+        """The opponent nearest the ball if it is close enough to have it (min of (distance, position))."""
+        bx, by = ball
+        best_d, best = math.inf, None
+        for o in self.view.opponents:
+            dd = hypot(o[0] - bx, o[1] - by)  # S.dist(o, ball)
+            if best is None or dd < best_d or dd == best_d and o < best:
+                best_d, best = dd, o
+        if best is None:
             return None
-        dd, o = min(near)
-        return o if dd < self.p.possession_radius + 0.1 else None
+        return best if best_d < self.p.possession_radius + 0.1 else None
 
     def without_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
-        x, y, _ = self.view.pose  # type: ignore[misc]
+        view, p = self.view, self.p
+        x, y, _ = view.pose  # type: ignore[misc]
         pos = (x, y)
         goal = self.goal(order)
-        if (tick - self.mem.lost_at) * self.cfg.timing.dt < self.p.regroup and self.carrier(ball) is not None:
+        if (tick - self.mem.lost_at) * self._dt < p.regroup and self.carrier(ball) is not None:
             # Lost the ball to a tackle: step back instead of wrestling for it, then challenge again;
             # basic: aside; advance: goal-side, onto the carrier's kick line (Fig. 7b).
             if S.dist(pos, ball) < self.p.regroup_clear:  # first get the body off the ball, straight back
@@ -843,19 +899,24 @@ class IrisRobot:
                 back = S.aside_point(ball, self.own_goal(order), pos, self.p.regroup_distance)
             return self.drive(tick, back, S.angle_to(pos, ball), self.p.cruise, avoid=False)
         attacking = self.plan.attacking  # type: ignore[union-attr]
-        mate_has_it = attacking and any(S.dist((mx, my), ball) < 0.4 for mx, my, _ in self.view.mates.values())
-        if mate_has_it:
-            home = self.support_point(order, ball) if self.p.advance and self.role == "attacker" else self.home(order, ball)
-            return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
+        if attacking:
+            bx, by = ball
+            for mx, my, _ in view.mates.values():
+                if hypot(mx - bx, my - by) < 0.4:  # a teammate has the ball
+                    if p.advance and self.role == "attacker":
+                        home = self.support_point(order, ball)
+                    else:
+                        home = self.home(order, ball)
+                    return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
         chaser = self.is_chaser(order, ball)
-        if self.p.advance and not attacking:
+        if p.advance and not attacking:
             cmd = self.advance_defense(tick, order, ball, pos, chaser)
             if cmd is not None:
                 return cmd
         if chaser:
             return self.get_ball(tick, ball, goal)
         home = self.home(order, ball)
-        return self.drive(tick, home, S.angle_to(home, ball), self.p.cruise)
+        return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
 
     def advance_defense(self, tick: int, order: Order, ball: Vec, pos: Vec, chaser: bool) -> Cmd | None:
         """Paper 2, Fig. 7b, for an outfield robot while the team defends; None: play the ball as usual.

@@ -45,7 +45,7 @@ def detection_sigma(sensor: SensorParams, rng_m: float) -> float:
     return sensor.det_sigma + sensor.det_sigma_per_m * rng_m
 
 
-@dataclass
+@dataclass(slots=True)
 class Track:
     x: float
     y: float
@@ -151,15 +151,6 @@ class TeamModel:
         return t.xy
 
 
-def _apart(x: float, y: float, points: list[Vec], min2: float) -> bool:
-    """No point within sqrt(min2) [m] of (x, y)."""
-    for a, b in points:
-        dx, dy = x - a, y - b
-        if dx * dx + dy * dy < min2:
-            return False
-    return True
-
-
 class RobotView:
     """One robot's picture of the world for this tick."""
 
@@ -180,55 +171,98 @@ class RobotView:
         self.opponents: list[Vec] = []
         self.mates: dict[int, tuple[float, float, str]] = {}  # n -> x, y, role
         self.has_ball = False
-        self.mate_obstacles: list[Vec] = []
+        self._near: list[Vec] = []  # teammates seen this tick
+        self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
+        self._order_opponents: list[tuple[int, Vec]] = []  # (age, position) of the order's P_B entries
+        self._mate_xy: list[Vec] = []  # the teammates' positions of the order
+        self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
+        self._opponent_memory = p.opponent_memory
+        self._ball_memory = p.ball_memory
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
         if sense is not None:
             p = sense.pose
-            self.pose = (p.x, p.y, p.theta)
-            c, s = math.cos(p.theta), math.sin(p.theta)
-            self.vel = (c * sense.vx - s * sense.vy, s * sense.vx + c * sense.vy)
+            theta = p.theta
+            self.pose = (p.x, p.y, theta)
+            c, s = math.cos(theta), math.sin(theta)
+            svx, svy = sense.vx, sense.vy
+            self.vel = (c * svx - s * svy, s * svx + c * svy)
             self.omega = sense.omega
             self.has_ball = sense.has_ball
-            if sense.ball.visible:
-                self.own_ball.observe(tick, sense.ball.x, sense.ball.y)
+            b = sense.ball
+            if b.visible:
+                self.own_ball.observe(tick, b.x, b.y)
         elif order is not None and self.pose is None:
             for tp in order.own:
                 if tp.robot == self.n:
                     self.pose = (tp.x, tp.y, tp.theta)
-        own_age = self.own_ball.age(tick)
-        order_age = order.ball_age + (tick - order.tick) if order is not None and order.ball_valid else 1 << 30
-        if own_age <= order_age and self.own_ball.track is not None:
-            self.ball, self.ball_vel, self.ball_age = self.own_ball.track.xy, self.own_ball.vel, own_age
-        elif order is not None and order.ball_valid:
-            self.ball, self.ball_vel, self.ball_age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age
+        track = self.own_ball.track
+        own_age = tick - track.tick if track is not None else 1 << 30
+        order_ball = order is not None and order.ball_valid
+        order_age = order.ball_age + (tick - order.tick) if order_ball else 1 << 30  # type: ignore[union-attr]
+        if own_age <= order_age and track is not None:
+            ball, self.ball_vel, age = (track.x, track.y), self.own_ball.vel, own_age
+        elif order_ball:
+            ball, self.ball_vel, age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age  # type: ignore[union-attr]
         else:
-            self.ball, self.ball_vel, self.ball_age = None, (0.0, 0.0), 1 << 30
-        if self.ball_age > self.p.ball_memory:
-            self.ball = None
-        seen: list[Vec] = []
-        near: list[Vec] = []
+            ball, self.ball_vel, age = None, (0.0, 0.0), 1 << 30
+        self.ball_age = age
+        self.ball = None if age > self._ball_memory else ball
+        if order is not self._order:  # the teammates and the base station's opponents change with the order only
+            self._order = order
+            if order is not None:
+                n = self.n
+                self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != n}
+                self._order_opponents = [(tp.age, (tp.x, tp.y)) for tp in order.opponents]
+            else:
+                self.mates = {}
+                self._order_opponents = []
+            self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
+        seen: list[Vec] = []  # own detections: opponents ...
+        near: list[Vec] = []  # ... and teammates
         if sense is not None:
             other = self.other
             for r in sense.robots:
                 (seen if r.team == other else near).append((r.x, r.y))
-        if order is not self._order:  # the teammates change with the order only
-            self._order = order
-            self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != self.n} if order else {}
-        merge2 = self.p.merge_radius * self.p.merge_radius
-        opponents = list(seen)
+        # The base station's entries that no own detection within merge_radius explains.
+        merge2 = self._merge2
+        opponents = seen[:]
         if order is not None:
-            memory = self.p.opponent_memory - (tick - order.tick)
-            for tp in order.opponents:
-                if tp.age <= memory and _apart(tp.x, tp.y, seen, merge2):
-                    opponents.append((tp.x, tp.y))
+            memory = self._opponent_memory - (tick - order.tick)
+            for age, xy in self._order_opponents:
+                if age <= memory:
+                    x, y = xy
+                    for a, b in seen:
+                        dx, dy = x - a, y - b
+                        if dx * dx + dy * dy < merge2:
+                            break
+                    else:
+                        opponents.append(xy)
         self.opponents = opponents
-        mates = list(near)
-        for x, y, _ in self.mates.values():
-            if _apart(x, y, near, merge2):
-                mates.append((x, y))
-        self.mate_obstacles = mates
+        self._near = near
+        self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
+
+    @property
+    def mate_obstacles(self) -> list[Vec]:
+        """The teammates' positions: own detections first, then the order's that no own detection explains."""
+        mates = self._mate_obstacles
+        if mates is None:
+            near, merge2 = self._near, self._merge2
+            if near:
+                mates = near[:]
+                for xy in self._mate_xy:
+                    x, y = xy
+                    for a, b in near:
+                        dx, dy = x - a, y - b
+                        if dx * dx + dy * dy < merge2:
+                            break
+                    else:
+                        mates.append(xy)
+            else:
+                mates = self._mate_xy[:]
+            self._mate_obstacles = mates
+        return mates
 
     def others(self) -> list[Vec]:
         """Every other robot's position (obstacles): own detections first, then the base station's."""

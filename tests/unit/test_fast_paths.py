@@ -1,0 +1,76 @@
+"""The per-tick fast paths give bit for bit what the plain formulas give (matches replay identically)."""
+
+from __future__ import annotations
+
+import math
+import random
+
+from arena.navigation import fsfm, pid
+from arena.navigation.frames import wrap_angle
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
+from arena.strategies.world import FusionParams, RobotView
+
+
+def _gain_reference(d: float, phi: float, fis: fsfm.FIS) -> float:
+    """Eq. 8-10 straight from the TriangularMF sets (the form `fsfm.gain` inlines)."""
+    phi = abs(phi)
+    mu_d = [(a, m) for a, s in enumerate(fis.distance_sets) if (m := s.degree(d)) > 0.0]
+    num = den = 0.0
+    for b, s in enumerate(fis.direction_sets):
+        mg = s.degree(phi)
+        if mg > 0.0:
+            for a, md in mu_d:
+                w = mg * md
+                num += w * fis.table[b][a]
+                den += w
+    return num / den
+
+
+def test_fis_gain_is_bit_identical_to_the_membership_functions():
+    rng = random.Random(7)
+    edges = [0.0, 0.45, 0.9, 1.2, 1.5, 3.6, 5.7, 9.0, math.pi / 3, 2 * math.pi / 3, math.pi, 5e-324]
+    for fis in (fsfm.FIS(), fsfm.FIS(outputs=fsfm.SCHEME_6)):
+        for _ in range(20000):
+            d = rng.choice(edges) if rng.random() < 0.2 else rng.uniform(0.0, 8.0)
+            phi = rng.choice(edges) if rng.random() < 0.2 else rng.uniform(-math.pi, math.pi)
+            assert fsfm.gain(d, phi, fis) == _gain_reference(d, phi, fis)
+
+
+def _pid_reference(state: pid.PIDState, beta: float, theta: float, p: pid.PIDParams) -> tuple[float, pid.PIDState]:
+    """Eq. 15-16 as written in the module docstring."""
+    err = wrap_angle(beta - theta)
+    integral = max(-p.max_integral, min(p.max_integral, state.integral + err))
+    derivative = 0.0 if state.prev_error is None else wrap_angle(err - state.prev_error)
+    out = p.k_p * err + p.k_i * integral + p.k_d * derivative
+    return max(-p.max_output, min(p.max_output, out)), pid.PIDState(integral=integral, prev_error=err)
+
+
+def test_pid_update_is_bit_identical_to_eq_16():
+    rng = random.Random(3)
+    params = (pid.PIDParams(), pid.PIDParams(k_p=6.0, k_i=0.0, k_d=2.0), pid.PIDParams(max_output=2.0, max_integral=0.5))
+    for p in params:
+        a = b = pid.PIDState()
+        for _ in range(5000):
+            beta, theta = rng.uniform(-4.0, 4.0), rng.choice([math.pi, -math.pi, rng.uniform(-4.0, 4.0)])
+            out_a, a = pid.step(a, beta, theta, p)
+            out_b, b = _pid_reference(b, beta, theta, p)
+            assert (out_a, a) == (out_b, b)
+            assert math.copysign(1.0, out_a) == math.copysign(1.0, out_b)
+
+
+def test_robot_view_merges_the_order_with_own_detections():
+    cfg = MatchConfig()
+    view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams())
+    order = Order(
+        tick=10, robot=1, command="START", attack_dir=1,
+        own=[TeamPose(robot=0, x=-5.5, y=0.0), TeamPose(robot=1, x=0.0, y=0.0), TeamPose(robot=2, x=2.0, y=1.0)],
+        opponents=[TeamPose(robot=-1, x=1.0, y=0.0, age=0), TeamPose(robot=-1, x=3.0, y=-2.0, age=0),
+                   TeamPose(robot=-1, x=4.0, y=2.0, age=500)],
+    )
+    sense = Sense(tick=12, pose=Pose(x=0.0, y=0.0, theta=0.0), ball=BallSeen(visible=False),
+                  robots=[RobotSeen(team="b", x=1.1, y=0.1), RobotSeen(team="a", x=2.1, y=1.0)])
+    view.update(12, sense, order)
+    assert view.opponents == [(1.1, 0.1), (3.0, -2.0)]  # (1, 0) is the own detection; (4, 2) is too old
+    assert view.mate_obstacles == [(2.1, 1.0), (-5.5, 0.0)]  # (2, 1) is the own detection
+    assert view.others() == view.opponents + view.mate_obstacles
