@@ -184,35 +184,35 @@ def firing_strengths(d: float, phi: float, fis: FIS = FIS()) -> list[list[float]
     return [[mg * md for md in mu_d] for mg in memberships(abs(phi), fis.direction_sets)]
 
 
+def _degrees(x: float, sets: tuple[tuple[int, float, float, float, float, float], ...]) -> list[tuple[int, float]]:
+    """(index, mu(x)) of every set with a non-zero degree: eq. 8, `TriangularMF.degree` with the
+    same arithmetic on the sets' precomputed (index, u, v, w, v - u, w - v) (this runs per obstacle and tick)."""
+    out = []
+    for i, u, v, w, vu, wv in sets:
+        if x <= v:
+            m = 1.0 if u == v else (x - u) / vu if x > u else 0.0
+        else:
+            m = 1.0 if v == w else (w - x) / wv if x < w else 0.0
+        if m > 0.0:
+            out.append((i, m))
+    return out
+
+
 def gain(d: float, phi: float, fis: FIS = FIS()) -> float:
     """Eq. 8-10: the obstacle gain k for distance ``d`` [m] and relative direction ``phi`` [rad].
 
     ``phi`` may be signed; left and right are symmetric. Only the sets with
     a non-zero degree take part (at most two per input with these partitions).
     """
-    phi = abs(phi)
-    # Eq. 8, TriangularMF.degree inlined (this runs per obstacle and tick).
-    mu_d = []
-    for a, u, v, w, vu, wv in fis.distance_mf:
-        if d <= v:
-            m = 1.0 if u == v else (d - u) / vu if d > u else 0.0
-        else:
-            m = 1.0 if v == w else (w - d) / wv if d < w else 0.0
-        if m > 0.0:
-            mu_d.append((a, m))
+    mu_d = _degrees(d, fis.distance_mf)
     num = den = 0.0
     table = fis.table
-    for b, u, v, w, vu, wv in fis.direction_mf:
-        if phi <= v:
-            mg = 1.0 if u == v else (phi - u) / vu if phi > u else 0.0
-        else:
-            mg = 1.0 if v == w else (w - phi) / wv if phi < w else 0.0
-        if mg > 0.0:
-            row = table[b]
-            for a, md in mu_d:
-                fire = mg * md  # B_ab, eq. 9
-                num += fire * row[a]
-                den += fire
+    for b, mg in _degrees(abs(phi), fis.direction_mf):
+        row = table[b]
+        for a, md in mu_d:
+            fire = mg * md  # B_ab, eq. 9
+            num += fire * row[a]
+            den += fire
     if den == 0.0:
         raise ValueError(f"no rule fires for d={d}, phi={phi}: the input sets do not cover it")
     return num / den

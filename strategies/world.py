@@ -151,6 +151,18 @@ class TeamModel:
         return t.xy
 
 
+def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
+    """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
+    for xy in entries:
+        x, y = xy
+        for a, b in seen:
+            dx, dy = x - a, y - b
+            if dx * dx + dy * dy < min2:
+                break
+        else:
+            out.append(xy)
+
+
 class RobotView:
     """One robot's picture of the world for this tick."""
 
@@ -230,15 +242,7 @@ class RobotView:
         opponents = seen[:]
         if order is not None:
             memory = self._opponent_memory - (tick - order.tick)
-            for age, xy in self._order_opponents:
-                if age <= memory:
-                    x, y = xy
-                    for a, b in seen:
-                        dx, dy = x - a, y - b
-                        if dx * dx + dy * dy < merge2:
-                            break
-                    else:
-                        opponents.append(xy)
+            _add_unexplained(opponents, [xy for age, xy in self._order_opponents if age <= memory], seen, merge2)
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
@@ -249,18 +253,8 @@ class RobotView:
         mates = self._mate_obstacles
         if mates is None:
             near, merge2 = self._near, self._merge2
-            if near:
-                mates = near[:]
-                for xy in self._mate_xy:
-                    x, y = xy
-                    for a, b in near:
-                        dx, dy = x - a, y - b
-                        if dx * dx + dy * dy < merge2:
-                            break
-                    else:
-                        mates.append(xy)
-            else:
-                mates = self._mate_xy[:]
+            mates = near[:]
+            _add_unexplained(mates, self._mate_xy, near, merge2)
             self._mate_obstacles = mates
         return mates
 
