@@ -81,7 +81,11 @@ def sense(
         states = physics.robot_states()
     n_z = 3 + 2 * len(states)
     z = rng.take(n_z) if isinstance(rng, NormalStream) else rng.standard_normal(n_z).tolist()
-    me = next(st for st in states if st[0] == team and st[1] == n)
+    for me in states:
+        if me[1] == n and me[0] == team:
+            break
+    else:
+        raise ValueError(f"no robot {team}/{n} in the states")
     _, _, x, y, theta, vx, vy, omega = me
     c, s = math.cos(theta), math.sin(theta)
     pose = Pose(
@@ -89,23 +93,26 @@ def sense(
         y=y + p.pose_sigma * z[1],
         theta=wrap_angle(theta + p.heading_sigma * z[2]),
     )
+    hypot, det, per_m = math.hypot, p.det_sigma, p.det_sigma_per_m
     bx, by = physics.ball_state()[:2]
-    d_ball = math.hypot(bx - x, by - y)
+    d_ball = hypot(bx - x, by - y)
     if d_ball <= p.ball_range:
-        sigma = p.det_sigma + p.det_sigma_per_m * d_ball
+        sigma = det + per_m * d_ball
         ball = BallSeen(visible=True, x=bx + sigma * z[3], y=by + sigma * z[4])
     else:
         ball = BallSeen()
 
     near = []
     i = 5
-    for t, m, ox, oy, *_ in states:
-        if t == team and m == n:
+    robot_range = p.robot_range
+    for st in states:
+        if st is me:
             continue
-        d = math.hypot(ox - x, oy - y)
-        if d <= p.robot_range:
-            sigma = p.det_sigma + p.det_sigma_per_m * d
-            near.append((d, t, ox + sigma * z[i], oy + sigma * z[i + 1]))
+        ox, oy = st[2], st[3]
+        d = hypot(ox - x, oy - y)
+        if d <= robot_range:
+            sigma = det + per_m * d
+            near.append((d, st[0], ox + sigma * z[i], oy + sigma * z[i + 1]))
         i += 2
     near.sort()
     return Sense(
