@@ -122,13 +122,13 @@ def parse_override(text: str) -> tuple[str, str, float]:
 class LinkEmulator:
     """Decides, frame by frame and in send order, whether a frame is dropped and how late it is."""
 
-    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "ideal")
+    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "_ideal")
 
     def __init__(self, model: LinkModel, rng: random.Random):
         self.model = model
         self._rng = rng
         self._bad = False
-        self.ideal = model.is_ideal()  # every frame on time: nothing to draw
+        self._ideal = model.is_ideal()
         self.frames = 0
         self.dropped = 0
         self.delays_ms: list[float] = []  # drawn delays of delivered frames (non-ideal links)
@@ -136,7 +136,7 @@ class LinkEmulator:
     def decide(self) -> float | None:
         """Delay in ms for the next frame, or None if it is lost."""
         self.frames += 1
-        if self.ideal:
+        if self._ideal:
             return 0.0  # no delay statistics to keep: every delay is 0
         m = self.model
         r = self._rng.random

@@ -322,16 +322,12 @@ class Inbound(Generic[M]):
                 self._rej.reject(self.key, "invalid", problem)
                 return False
         self.last_seen = tick
-        base = tick if now_tick is None else now_tick
-        em = self.emulator
-        if em.ideal:  # what decide() does for an ideal link, and a delay of 0 holds for `lag`
-            em.frames += 1
-            heapq.heappush(self._pending, (base + self.lag, tick, msg))
-            return True
-        delay = em.decide()
+        delay = self.emulator.decide()
         if delay is None:
             return True
-        hold = max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
+        base = tick if now_tick is None else now_tick
+        # A frame on time (every frame of an ideal link) is held for `lag`, which is what the formula gives for 0.
+        hold = self.lag if delay == 0.0 else max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
         heapq.heappush(self._pending, (base + hold, tick, msg))
         return True
 
