@@ -95,19 +95,26 @@ def build_parser() -> Parser:
 
     def add(name: str, help_text: str) -> argparse.ArgumentParser:
         return sub.add_parser(
-            name, help=help_text, description=help_text, epilog=EXAMPLES.get(name),
+            name,
+            help=help_text,
+            description=help_text,
+            epilog=EXAMPLES.get(name),
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
 
     m = add("match", "play one match, every process its own OS process, and print the score")
     _add_match_flags(m, required=True)
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
-    m.add_argument("--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand")
+    m.add_argument(
+        "--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand"
+    )
     m.add_argument("--listen", metavar="ENDPOINT", help="router endpoint (default: a unix socket in a temp dir)")
     m.add_argument("--match", metavar="ID", help="match id, i.e. key prefix arena/<ID>/ (default: a fresh one)")
     m.add_argument("--logs", metavar="DIR", help="keep every process's log in DIR")
     m.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
-    m.add_argument("--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up")
+    m.add_argument(
+        "--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up"
+    )
     m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
 
     r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
@@ -139,11 +146,15 @@ def build_parser() -> Parser:
 
     t = add("tournament", "round-robin of strategies: the paper's tables, charts and ratings")
     t.add_argument("--strategies", default="AD,AS,BD,BS", metavar="A,B,...", help="strategies (AD,AS,BD,BS)")
-    t.add_argument("--legs", type=int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)")
+    t.add_argument(
+        "--legs", type=int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
+    )
     t.add_argument("--half-time", type=float, default=300.0, metavar="SECONDS", help="simulated half length (300)")
     t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
-    t.add_argument("--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter")
+    t.add_argument(
+        "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
+    )
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
@@ -152,7 +163,8 @@ def build_parser() -> Parser:
 
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument(
-        "what", choices=["match", "record", "robot", "nav"],
+        "what",
+        choices=["match", "record", "robot", "nav"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios",
     )
@@ -212,7 +224,10 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=(), 
         link_overrides=overrides,
         realtime=realtime,
         record=record,
-        external=tuple(ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e)) for e in external),
+        external=tuple(
+            ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e))
+            for e in external
+        ),
     )
     cfg.validate()
     return cfg
@@ -279,7 +294,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     from arena.runtime.session import NetConfig
     from arena.tools import run as runner
 
-    logging.basicConfig(level=args.log_level, format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr)
+    logging.basicConfig(
+        level=args.log_level, format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr
+    )
     net = NetConfig(
         mode=args.mode,
         connect=(args.connect,) if args.connect else (),
@@ -380,8 +397,16 @@ def cmd_schemas(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    handlers = {"match": cmd_match, "run": cmd_run, "up": cmd_up, "bench": cmd_bench, "schemas": cmd_schemas,
-                "tournament": cmd_tournament, "review": cmd_review, "replay": cmd_replay}
+    handlers = {
+        "match": cmd_match,
+        "run": cmd_run,
+        "up": cmd_up,
+        "bench": cmd_bench,
+        "schemas": cmd_schemas,
+        "tournament": cmd_tournament,
+        "review": cmd_review,
+        "replay": cmd_replay,
+    }
     try:
         return handlers[args.command](args)
     except ConfigError as exc:

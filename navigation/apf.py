@@ -67,9 +67,7 @@ def potential(
     pos: Sequence[float], goal: Sequence[float], obstacles: Sequence[Sequence[float]], params: APFParams = DEFAULT
 ) -> float:
     """Total potential U_a + sum_j U_r,j [m^2/s]."""
-    return attractive_potential(pos, goal, params) + sum(
-        repulsive_potential(pos, o, params) for o in points(obstacles)
-    )
+    return attractive_potential(pos, goal, params) + sum(repulsive_potential(pos, o, params) for o in points(obstacles))
 
 
 def force(

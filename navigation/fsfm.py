@@ -218,9 +218,7 @@ def gain(d: float, phi: float, fis: FIS = FIS()) -> float:
     return num / den
 
 
-def relative_direction(
-    pos: Vec2, vel: Vec2, goal: Vec2, obstacle: Vec2, params: FSFMParams = DEFAULT
-) -> float:
+def relative_direction(pos: Vec2, vel: Vec2, goal: Vec2, obstacle: Vec2, params: FSFMParams = DEFAULT) -> float:
     """phi = wrap(gamma - front) [rad], with gamma from eq. 14 and front from eq. 13 (or the velocity)."""
     vx, vy = vel
     if params.front == "velocity" and math.hypot(vx, vy) >= params.min_speed_for_front:

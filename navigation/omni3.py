@@ -44,10 +44,13 @@ class Omni3Params:
 def inverse_matrix(params: Omni3Params = Omni3Params()) -> NDArray[np.float64]:
     """The 3x3 matrix of eq. 2 [rad/m, rad/m, rad]."""
     big_l = params.wheel_distance
-    return np.array(
-        [[0.0, -1.0, big_l], [-_S3, 0.5, big_l], [_S3, 0.5, big_l]],
-        dtype=np.float64,
-    ) / params.wheel_radius
+    return (
+        np.array(
+            [[0.0, -1.0, big_l], [-_S3, 0.5, big_l], [_S3, 0.5, big_l]],
+            dtype=np.float64,
+        )
+        / params.wheel_radius
+    )
 
 
 def forward_matrix(params: Omni3Params = Omni3Params()) -> NDArray[np.float64]:

@@ -60,9 +60,7 @@ def forward_matrix(params: Omni4Params = Omni4Params()) -> NDArray[np.float64]:
     return np.linalg.pinv(inverse_matrix(params))
 
 
-def wheel_linear_speeds(
-    vx: float, vy: float, omega: float, params: Omni4Params = Omni4Params()
-) -> NDArray[np.float64]:
+def wheel_linear_speeds(vx: float, vy: float, omega: float, params: Omni4Params = Omni4Params()) -> NDArray[np.float64]:
     """Eq. 4: v_i [m/s] for a robot-frame twist ([m/s], [m/s], [rad/s])."""
     return jacobian(params) @ np.array([vx, vy, omega], dtype=np.float64)
 

@@ -95,9 +95,7 @@ def obstacle_force_magnitude(d: float, k: float, params: SFMParams = DEFAULT) ->
     return k * (math.exp(overlap / params.sigma) + (overlap if overlap > 0.0 else 0.0))
 
 
-def obstacle_force(
-    pos: Sequence[float], obstacle: Sequence[float], k: float, params: SFMParams = DEFAULT
-) -> Vec2:
+def obstacle_force(pos: Sequence[float], obstacle: Sequence[float], k: float, params: SFMParams = DEFAULT) -> Vec2:
     """Eq. 5-7: F^o_j [N] on the robot at ``pos`` from the obstacle centre ``obstacle`` with gain ``k``."""
     dx, dy = pos[0] - obstacle[0], pos[1] - obstacle[1]
     d = math.hypot(dx, dy)

@@ -46,8 +46,14 @@ from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefC
 def check_cmd(cmd: Cmd, wheels: int) -> str | None:
     """Reject commands no robot could mean: non-finite numbers, a wheel count the model has not."""
     isfinite = math.isfinite
-    if cmd.mode == "body" and not cmd.wheels and isfinite(cmd.vx) and isfinite(cmd.vy) and isfinite(cmd.omega) \
-            and isfinite(cmd.kick_speed):
+    if (
+        cmd.mode == "body"
+        and not cmd.wheels
+        and isfinite(cmd.vx)
+        and isfinite(cmd.vy)
+        and isfinite(cmd.omega)
+        and isfinite(cmd.kick_speed)
+    ):
         return None  # the usual command, passed in one expression (six times a tick)
     for name in ("vx", "vy", "omega", "kick_speed"):
         if not math.isfinite(getattr(cmd, name)):
@@ -157,8 +163,14 @@ class EngineNode(Node):
             n = len(self.restarts.placed)
             self.restarts.apply_frame(frame)
             for tick, team, robot, x, y in self.restarts.placed[n:]:
-                self.log.info("tick %d: robot %s/%d too close to the ball at START, placed at (%.2f, %.2f)",
-                              tick, team, robot, x, y)
+                self.log.info(
+                    "tick %d: robot %s/%d too close to the ball at START, placed at (%.2f, %.2f)",
+                    tick,
+                    team,
+                    robot,
+                    x,
+                    y,
+                )
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor

@@ -100,7 +100,9 @@ class McapWriter:
         self._record(schema)
         return schema.id
 
-    def register_channel(self, topic: str, message_encoding: str, schema_id: int, metadata: dict[str, str] | None = None) -> int:
+    def register_channel(
+        self, topic: str, message_encoding: str, schema_id: int, metadata: dict[str, str] | None = None
+    ) -> int:
         channel = Channel(
             id=len(self._channels) + 1,
             topic=topic,
@@ -202,12 +204,16 @@ class McapWriter:
                 start = b.count
                 for r in records:
                     r.write(b)
-                groups.append(SummaryOffset(group_opcode=opcode, group_start=summary_start + start, group_length=b.count - start))
+                groups.append(
+                    SummaryOffset(group_opcode=opcode, group_start=summary_start + start, group_length=b.count - start)
+                )
         summary_offset_start = summary_start + b.count
         for g in groups:
             g.write(b)
         summary = b.end()
-        crc = zlib.crc32(_FOOTER_PREFIX.pack(Opcode.FOOTER, 20, summary_start, summary_offset_start), zlib.crc32(summary))
+        crc = zlib.crc32(
+            _FOOTER_PREFIX.pack(Opcode.FOOTER, 20, summary_start, summary_offset_start), zlib.crc32(summary)
+        )
         self._raw(summary)
         self._record(Footer(summary_start=summary_start, summary_offset_start=summary_offset_start, summary_crc=crc))
         self._raw(MAGIC)

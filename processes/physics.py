@@ -465,8 +465,12 @@ class Physics:
         """Another robot touches the held ball, or wants it (dribbler on) and is close."""
         bx, by, tick = s[self._ball_off], s[self._ball_off + 1], self.tick
         for r in self._robots:
-            if (r is not holder and r.dribbler and tick >= r.challenge_from
-                    and math.hypot(s[r.off] - bx, s[r.off + 1] - by) < self._challenge):
+            if (
+                r is not holder
+                and r.dribbler
+                and tick >= r.challenge_from
+                and math.hypot(s[r.off] - bx, s[r.off + 1] - by) < self._challenge
+            ):
                 return True
         for hit in self._space.shape_query(self._ball_shape):
             t = hit.shape.collision_type - _ROBOT_TYPE0
@@ -551,8 +555,14 @@ class Physics:
         b = self._ball_off
         self._events.append(
             BallEvent(
-                kind="TOUCH", tick=self.tick, team=r.team, robot=r.n,
-                x=s[b], y=s[b + 1], last_team=r.team, last_robot=r.n,
+                kind="TOUCH",
+                tick=self.tick,
+                team=r.team,
+                robot=r.n,
+                x=s[b],
+                y=s[b + 1],
+                last_team=r.team,
+                last_robot=r.n,
             )
         )
 
@@ -562,8 +572,14 @@ class Physics:
         last = self._last
         self._events.append(
             BallEvent(
-                kind=kind, tick=self.tick, team=team, robot=robot, x=x, y=y,
-                last_team=last.team if last else "", last_robot=last.n if last else -1,
+                kind=kind,
+                tick=self.tick,
+                team=team,
+                robot=robot,
+                x=x,
+                y=y,
+                last_team=last.team if last else "",
+                last_robot=last.n if last else -1,
             )
         )
 
@@ -760,15 +776,28 @@ class Physics:
         s, b, holder, last = self._fresh(), self._ball_off, self._holder, self._last
         robots = [
             RobotState(
-                team=r.team, robot=r.n, x=s[r.off], y=s[r.off + 1], theta=wrap_angle(s[r.off + 2]),
-                vx=s[r.off + 3], vy=s[r.off + 4], omega=s[r.off + 5], has_ball=r is holder,
+                team=r.team,
+                robot=r.n,
+                x=s[r.off],
+                y=s[r.off + 1],
+                theta=wrap_angle(s[r.off + 2]),
+                vx=s[r.off + 3],
+                vy=s[r.off + 4],
+                omega=s[r.off + 5],
+                has_ball=r is holder,
             )
             for r in self._robots
         ]
         return World(
-            tick=tick, t=tick * self._dt,
-            ball_x=s[b], ball_y=s[b + 1], ball_z=self._z,
-            ball_vx=s[b + 3], ball_vy=s[b + 4], ball_vz=self._vz,
+            tick=tick,
+            t=tick * self._dt,
+            ball_x=s[b],
+            ball_y=s[b + 1],
+            ball_z=self._z,
+            ball_vx=s[b + 3],
+            ball_vy=s[b + 4],
+            ball_vz=self._vz,
             robots=robots,
-            last_team=last.team if last else "", last_robot=last.n if last else -1,
+            last_team=last.team if last else "",
+            last_robot=last.n if last else -1,
         )

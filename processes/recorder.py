@@ -145,7 +145,9 @@ class McapSink:
     def add(self, topic: str, ns: int, payload: bytes) -> None:
         ch = self.channels.get(topic)
         if ch is None:  # a key this match's configuration does not know: keep it anyway
-            ch = self.channels[topic] = self.writer.register_channel(topic=topic, message_encoding="msgpack", schema_id=0)
+            ch = self.channels[topic] = self.writer.register_channel(
+                topic=topic, message_encoding="msgpack", schema_id=0
+            )
             self.counts[topic] = 0
         seq = self.counts[topic]
         self.counts[topic] = seq + 1
@@ -269,7 +271,9 @@ class RecorderNode(Node):
             self.rejections.reject(self.keys.tap(name), "unknown-process")
             return
         if batch.seq != self.batches[name]:
-            self.rejections.reject(self.keys.tap(name), "out-of-sequence", f"batch {batch.seq}, expected {self.batches[name]}")
+            self.rejections.reject(
+                self.keys.tap(name), "out-of-sequence", f"batch {batch.seq}, expected {self.batches[name]}"
+            )
         self.batches[name] = batch.seq + 1
         seq = self.sent[name]
         for f in batch.frames:
@@ -343,7 +347,11 @@ class RecorderNode(Node):
 
     # The Foxglove layer, derived from the frames as they are written.
     def _derivations(self) -> dict[str, object]:
-        out: dict[str, object] = {"world": self._scene_frame, "referee": self._referee_log, "engine/events": self._events_log}
+        out: dict[str, object] = {
+            "world": self._scene_frame,
+            "referee": self._referee_log,
+            "engine/events": self._events_log,
+        }
         for team in TEAMS:
             for n in range(self.cfg.robots):
                 out[f"team/{team}/order/{n}"] = self._role_of(team, n)

@@ -43,8 +43,21 @@ from arena.schemas.messages import BallEvent, RefCommand, Referee
 
 MSL_COMMANDS = frozenset(
     {
-        "START", "STOP", "KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL",
-        "GOAL", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME", "PARK",
+        "START",
+        "STOP",
+        "KICKOFF",
+        "FREEKICK",
+        "GOALKICK",
+        "THROWIN",
+        "CORNER",
+        "PENALTY",
+        "DROP_BALL",
+        "GOAL",
+        "FIRST_HALF",
+        "HALF_TIME",
+        "SECOND_HALF",
+        "END_GAME",
+        "PARK",
     }
 )
 TEAM_COMMANDS = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "GOAL"})  # need a team

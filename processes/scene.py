@@ -120,14 +120,18 @@ def field_primitives(cfg: MatchConfig) -> tuple[list[CubePrimitive], list[LinePr
         gx = side * hl
         for depth, width in ((f.penalty_area_depth, f.penalty_area_width), (f.goal_area_depth, f.goal_area_width)):
             ix = gx - side * depth
-            lines.append(_line([(gx, -width / 2), (ix, -width / 2), (ix, width / 2), (gx, width / 2)], strip, lw, WHITE))
+            lines.append(
+                _line([(gx, -width / 2), (ix, -width / 2), (ix, width / 2), (gx, width / 2)], strip, lw, WHITE)
+            )
         mark = gx - side * f.penalty_mark_distance
         cubes.append(CubePrimitive(pose=_pose(mark, 0.0, 0.0), size=Vector3(x=lw, y=lw, z=0.01), color=WHITE))
         # goal: two posts, the crossbar and a translucent net
         back = gx + side * f.goal_depth / 2.0
         for py in (-f.goal_width / 2.0 - POST / 2.0, f.goal_width / 2.0 + POST / 2.0):
             cubes.append(
-                CubePrimitive(pose=_pose(gx, py, f.goal_height / 2.0), size=Vector3(x=POST, y=POST, z=f.goal_height), color=WHITE)
+                CubePrimitive(
+                    pose=_pose(gx, py, f.goal_height / 2.0), size=Vector3(x=POST, y=POST, z=f.goal_height), color=WHITE
+                )
             )
         cubes.append(
             CubePrimitive(

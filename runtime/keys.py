@@ -44,10 +44,24 @@ KEYS: tuple[KeySpec, ...] = (
     KeySpec("sense", "robot/<team>/<n>/sense", m.Sense, "G_R_n", "engine", "robot n", "every tick (50 Hz)", "sensor"),
     KeySpec("cmd", "robot/<team>/<n>/cmd", m.Cmd, "R_n_G", "robot n", "engine", "every tick (50 Hz)", "sensor"),
     KeySpec(
-        "report", "team/<team>/report/<n>", m.Report, "R_n_B", "robot n", "base station", "every comm period (10 Hz)", "wifi"
+        "report",
+        "team/<team>/report/<n>",
+        m.Report,
+        "R_n_B",
+        "robot n",
+        "base station",
+        "every comm period (10 Hz)",
+        "wifi",
     ),
     KeySpec(
-        "order", "team/<team>/order/<n>", m.Order, "B_R_n", "base station", "robot n", "every comm period (10 Hz)", "wifi"
+        "order",
+        "team/<team>/order/<n>",
+        m.Order,
+        "B_R_n",
+        "base station",
+        "robot n",
+        "every comm period (10 Hz)",
+        "wifi",
     ),
     KeySpec(
         "referee",

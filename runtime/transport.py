@@ -57,11 +57,14 @@ class Transport(Protocol):
     def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
         """A put function for `key`. With `when_matched`, puts are skipped while no
         remote subscriber matches (for keys nobody in the lockstep waits on)."""
+
     def subscribe(self, key: str) -> Channel: ...
     def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
         """Run `callback(payload)` on the transport's own thread for every frame of `key`."""
+
     def wake(self, key: str) -> None:
         """Deliver WAKE to this process's own subscribers of `key` only."""
+
     def declare_alive(self, key: str) -> None: ...
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
     def serve(self, key: str, payload: bytes) -> None: ...
@@ -223,7 +226,9 @@ class MemoryBus:
 
     def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
         with self._lock:
-            targets = [(owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs]
+            targets = [
+                (owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs
+            ]
         for owner, ch in targets:
             if only is None or owner is only:
                 ch._q.put(payload)

@@ -87,7 +87,9 @@ class Sense(Base):
     vx: Annotated[float, Meta(description="[m/s] odometry, body frame")] = 0.0
     vy: Annotated[float, Meta(description="[m/s] odometry, body frame")] = 0.0
     omega: Annotated[float, Meta(description="[rad/s] odometry")] = 0.0
-    ball: Annotated[BallSeen, Meta(description="noisy, range-limited ball detection")] = msgspec.field(default_factory=BallSeen)
+    ball: Annotated[BallSeen, Meta(description="noisy, range-limited ball detection")] = msgspec.field(
+        default_factory=BallSeen
+    )
     robots: Annotated[list[RobotSeen], Meta(description="noisy, range-limited robot detections")] = []
     has_ball: Annotated[bool, Meta(description="the dribbler holds the ball")] = False
 
@@ -140,7 +142,9 @@ class Order(Base):
     spot_x: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
     spot_y: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
     attack_dir: Annotated[int, Meta(description="+1: this team attacks the +x goal now, -1: the -x goal")] = 1
-    strategy: Annotated[int, Meta(ge=1, le=3, description="S: 1 level, 2 offensive (losing), 3 defensive (winning)")] = 1
+    strategy: Annotated[
+        int, Meta(ge=1, le=3, description="S: 1 level, 2 offensive (losing), 3 defensive (winning)")
+    ] = 1
     role: Annotated[str, Meta(description="role for this robot: goalkeeper, defender, attacker")] = ""
     role_state: Annotated[int, Meta(description="Fig. 6 state 1-4, 0 for the goalkeeper")] = 0
     own: Annotated[list[TeamPose], Meta(description="P_A: fused poses of own robots")] = []
@@ -182,9 +186,7 @@ class BallEvent(Base):
 
     kind: Annotated[
         str,
-        Meta(
-            description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, FOUL_PUSHING, FOUL_DRIBBLING, ROBOT_DEAD"
-        ),
+        Meta(description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, FOUL_PUSHING, FOUL_DRIBBLING, ROBOT_DEAD"),
     ]
     tick: Annotated[int, Meta(description="tick at which it happened")]
     team: Annotated[
@@ -287,7 +289,16 @@ class TapBatch(Base):
 
 
 MESSAGE_TYPES: tuple[type[Base], ...] = (
-    FieldSpec, Sense, Cmd, Report, Order, Referee, EngineEvents, World, Summary, TapBatch
+    FieldSpec,
+    Sense,
+    Cmd,
+    Report,
+    Order,
+    Referee,
+    EngineEvents,
+    World,
+    Summary,
+    TapBatch,
 )
 
 _ENCODER = msgspec.msgpack.Encoder()

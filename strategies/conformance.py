@@ -63,8 +63,11 @@ def scripted_inputs(cfg: MatchConfig, seed: int, command: str = "START"):
             theta = 0.0 if team == "a" else math.pi
             seen = [RobotSeen(team=t, x=px, y=py) for (t, m), (px, py) in pos.items() if (t, m) != (team, n)]
             senses[team][n] = Sense(
-                tick=k, pose=Pose(x=x, y=y, theta=theta), ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
-                robots=seen, has_ball=False,
+                tick=k,
+                pose=Pose(x=x, y=y, theta=theta),
+                ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+                robots=seen,
+                has_ball=False,
             )
         yield ref, senses
 
@@ -107,7 +110,9 @@ def check_orders(strategy: Strategy, cfg: MatchConfig, seed: int = 1) -> None:
             assert sorted(by_robot) == list(range(cfg.robots)), f"tick {k}: team {team} orders for {sorted(by_robot)}"
             for n, o in by_robot.items():
                 assert isinstance(o, Order), f"tick {k}: order for {team}/{n} is a {type(o).__name__}"
-                assert o.tick == k and o.robot == n, f"tick {k}: order for {team}/{n} stamped tick {o.tick} robot {o.robot}"
+                assert o.tick == k and o.robot == n, (
+                    f"tick {k}: order for {team}/{n} stamped tick {o.tick} robot {o.robot}"
+                )
                 _roundtrip(o, Order)
 
 
@@ -132,7 +137,9 @@ def check_reports(strategy: Strategy, cfg: MatchConfig, seed: int = 1) -> None:
         for team, by_robot in reports.items():
             for n, rep in by_robot.items():
                 assert isinstance(rep, Report), f"tick {k}: report of {team}/{n} is a {type(rep).__name__}"
-                assert rep.tick == k and rep.robot == n, f"tick {k}: report of {team}/{n} stamped {rep.tick}/{rep.robot}"
+                assert rep.tick == k and rep.robot == n, (
+                    f"tick {k}: report of {team}/{n} stamped {rep.tick}/{rep.robot}"
+                )
                 _roundtrip(rep, Report)
 
 

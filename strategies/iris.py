@@ -149,14 +149,18 @@ class IrisParams:
     regroup_distance: float = 0.9  # [m] ... to this far from the ball (basic: aside, advance: goal-side)
     cover_depth: float = -2.5  # [m] along the attack direction: the defender's place while the team attacks
     mark_zone: float = 6.5  # [m] advance defense: an opponent this close to our goal (about our half) is marked (was 5)
-    block_zone: float = 6.5  # [m] advance defense: a carrier this close to our goal is blocked, not left to the attacker
+    block_zone: float = (
+        6.5  # [m] advance defense: a carrier this close to our goal is blocked, not left to the attacker
+    )
     # [1/s] advance defense: the blocker drives straight onto the kick line at this speed per metre off it
     # (the plain 1 m/s per metre lets a carrier turning or circling at 1.5 m/s open a post); higher gains
     # rush the carrier into pushing fouls and long shots
     block_gain: float = 3.0
     drop_back: float = 4.5  # [m] advance defense: with the ball this close to our goal the attacker marks too
     take_angle: float = 0.5  # [rad] advance defense: the blocker takes the ball only this close to the kick line
-    behind_penalty: float = 1.5  # [m] advance defense: extra way to the kick line for a robot not goal-side of the carrier
+    behind_penalty: float = (
+        1.5  # [m] advance defense: extra way to the kick line for a robot not goal-side of the carrier
+    )
     wall_margin: float = 0.2  # [m] advance defense: the set-piece wall stands this far beyond the 2 m the rules ask
     wall_exit_turn: float = 1.0  # [rad] ... a robot inside the 2 m circle leaves it at most this far off straight away
     pressure_range: float = 1.2  # [m] advance attack: a blocker this close leaves no room to go round it
@@ -169,7 +173,9 @@ class IrisParams:
     push_guard_range: float = 2.5  # [m] opponents closer than this (centre to centre) get the cap
     ball_contact_range: float = 0.4  # [m] held ball's centre to an opponent's centre: touching or nearly
     separate_speed: float = 0.5  # [m/s] a robot turning with the ball edges away from an opponent in contact
-    contact_range: float = 0.65  # [m] centre to centre: the footprints (0.45 m squares) may touch (corner to corner 0.64)
+    contact_range: float = (
+        0.65  # [m] centre to centre: the footprints (0.45 m squares) may touch (corner to corner 0.64)
+    )
     contact_push: float = 0.0  # [m/s] closing speed cap towards an opponent in contact
     heading_pid: PIDParams = PIDParams(k_p=6.0, k_i=0.0, k_d=2.0)  # paper 1 eq. 16 gains for 50 Hz
     skills: S.SkillParams = S.SkillParams()
@@ -180,7 +186,9 @@ class IrisParams:
         if self.navigator == "f-sfm":
             return FSFMParams(sfm=SFMParams(max_speed=self.cruise, robot_radius=0.5, sigma=0.3))
         defaults = PARAMS[self.navigator]()
-        return type(defaults)(**{**{f: getattr(defaults, f) for f in defaults.__dataclass_fields__}, "max_speed": self.cruise})
+        return type(defaults)(
+            **{**{f: getattr(defaults, f) for f in defaults.__dataclass_fields__}, "max_speed": self.cruise}
+        )
 
 
 class IrisTeam:
@@ -318,8 +326,13 @@ class IrisRobot:
             pose = self.view.pose or (0.0, 0.0, 0.0)
             return Report(tick=tick, robot=self.n, pose=Pose(x=pose[0], y=pose[1], theta=pose[2]), role=self.role)
         return Report(
-            tick=tick, robot=self.n, pose=sense.pose, ball=sense.ball, robots=sense.robots,
-            has_ball=sense.has_ball, role=self.role,
+            tick=tick,
+            robot=self.n,
+            pose=sense.pose,
+            ball=sense.ball,
+            robots=sense.robots,
+            has_ball=sense.has_ball,
+            role=self.role,
         )
 
     # -------------------------------------------------------------------- step
@@ -377,8 +390,12 @@ class IrisRobot:
                 if r == "attacker":
                     attackers.append((x, y))
         return _Plan(
-            role=self.role, area=areas.get(self.n, self._defense_area), areas=areas,
-            attackers=tuple(attackers), mates=tuple(mates), attacking=R.is_attacking(order.role_state),
+            role=self.role,
+            area=areas.get(self.n, self._defense_area),
+            areas=areas,
+            attackers=tuple(attackers),
+            mates=tuple(mates),
+            attacking=R.is_attacking(order.role_state),
         )
 
     # ------------------------------------------------------------- geometry
@@ -401,8 +418,17 @@ class IrisRobot:
 
     # --------------------------------------------------------------- motion
     def drive(
-        self, tick: int, target: Vec, heading: float, vmax: float, *, dribbler: bool = False, kick: float = 0.0,
-        avoid: bool = True, extra_obstacles: tuple[Vec, ...] = (), gain: float = 0.0,
+        self,
+        tick: int,
+        target: Vec,
+        heading: float,
+        vmax: float,
+        *,
+        dribbler: bool = False,
+        kick: float = 0.0,
+        avoid: bool = True,
+        extra_obstacles: tuple[Vec, ...] = (),
+        gain: float = 0.0,
     ) -> Cmd:
         """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots;
         `gain` [1/s]: drive straight at speed min(vmax, gain * distance) (without it the straight
@@ -488,9 +514,7 @@ class IrisRobot:
         bx, by = ball
         to_ball = math.atan2(by - y, bx - x)  # S.angle_to(pos, ball)
         d = hypot(x - bx, y - by)  # S.dist(pos, ball)
-        if d < self._near_ball and (
-            S.lined_up(pos, ball, target, sp.capture_lane) or abs(S.wrap(to_ball - th)) < 0.35
-        ):
+        if d < self._near_ball and (S.lined_up(pos, ball, target, sp.capture_lane) or abs(S.wrap(to_ball - th)) < 0.35):
             return self.drive(tick, ball, to_ball, p.approach_speed, dribbler=True, avoid=False)
         a = math.atan2(target[1] - by, target[0] - bx)  # S.angle_to(ball, target) ...
         off = sp.behind_ball  # ... for S.behind_point(ball, target, behind_ball)
@@ -521,8 +545,9 @@ class IrisRobot:
         if near is not None and S.dist(near, spot) < self.p.contact_range:
             a = S.angle_to(near, spot)
             spot = (x + 0.5 * math.cos(a), y + 0.5 * math.sin(a))
-        return self.drive(tick, spot, want, self.p.separate_speed if spot != (x, y) else 0.0, dribbler=True,
-                          kick=kick, avoid=False)
+        return self.drive(
+            tick, spot, want, self.p.separate_speed if spot != (x, y) else 0.0, dribbler=True, kick=kick, avoid=False
+        )
 
     def nearest_opponent(self, x: float, y: float) -> Vec | None:
         best, found = math.inf, None
@@ -663,8 +688,9 @@ class IrisRobot:
         bu = d * ball[0]
         us = {S.clamp(bu + k, max(lo + 1.0, 0.5), min(hi - 1.5, 4.5)) for k in (1.5, 3.0)}
         cands = [(d * u, yy) for u in sorted(us) for yy in (-1.5, 0.0, 1.5)]
-        pt = S.open_point(ball, cands, self.view.opponents, self.goal(order)[0], self.goal_half,
-                          self.p.skills.clear_margin)
+        pt = S.open_point(
+            ball, cands, self.view.opponents, self.goal(order)[0], self.goal_half, self.p.skills.clear_margin
+        )
         self._support = (self.order, pt)
         return pt
 
@@ -947,11 +973,19 @@ class IrisRobot:
                 # ball from goal-side; going round the ball to get behind it would open the line to our goal.
                 on_line = abs(S.wrap(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
                 if S.dist(pos, ball) < sp.take_distance and on_line:
-                    return self.drive(tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True,
-                                      avoid=False)
+                    return self.drive(
+                        tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True, avoid=False
+                    )
                 goal_side = S.dist(pos, own) < S.dist(carrier, own) - 0.2
-                return self.drive(tick, block, S.angle_to(block, ball), self.p.cruise, dribbler=True,
-                                  avoid=not goal_side, gain=self.p.block_gain)
+                return self.drive(
+                    tick,
+                    block,
+                    S.angle_to(block, ball),
+                    self.p.cruise,
+                    dribbler=True,
+                    avoid=not goal_side,
+                    gain=self.p.block_gain,
+                )
         else:
             self.mem.blocking = False
             if chaser:
@@ -975,9 +1009,7 @@ class IrisRobot:
 
         x, y, _ = self.view.pose  # type: ignore[misc]
         mine = (cost((x, y)) - (self.p.chase_hysteresis if self.mem.blocking else 0.0), self.n)
-        self.mem.blocking = all(
-            (cost((mx, my)), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0
-        )
+        self.mem.blocking = all((cost((mx, my)), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
         return self.mem.blocking
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
@@ -995,7 +1027,9 @@ class IrisRobot:
 
 def _make(name: str, alias: str, advance: bool, dynamic: bool) -> Strategy:
     params = IrisParams(advance=advance, dynamic=dynamic)
-    kind = ("advance" if advance else "basic") + " attack and defense, " + ("dynamic" if dynamic else "static") + " roles"
+    kind = (
+        ("advance" if advance else "basic") + " attack and defense, " + ("dynamic" if dynamic else "static") + " roles"
+    )
     return Strategy(
         name=name,
         make_team=lambda ctx: IrisTeam(ctx, params),

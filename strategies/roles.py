@@ -77,8 +77,14 @@ def referee_fields(team: str, referee, default_attack_dir: int) -> dict:
     Before the first frame: STOP, no spot, S1, and `default_attack_dir`.
     """
     if referee is None:
-        return {"command": "STOP", "command_team": "", "spot_x": 0.0, "spot_y": 0.0,
-                "attack_dir": default_attack_dir, "strategy": S_LEVEL}
+        return {
+            "command": "STOP",
+            "command_team": "",
+            "spot_x": 0.0,
+            "spot_y": 0.0,
+            "attack_dir": default_attack_dir,
+            "strategy": S_LEVEL,
+        }
     a = team == "a"
     own, opp = (referee.score_a, referee.score_b) if a else (referee.score_b, referee.score_a)
     return {
@@ -160,7 +166,9 @@ class RoleAssigner:
     def apply(self, n: int, inp: str) -> None:
         self.state[n] = transition(self.state[n], inp)
 
-    def update(self, possession: str, holder: int | None, u: dict[int, float], xy: dict[int, tuple[float, float]]) -> None:
+    def update(
+        self, possession: str, holder: int | None, u: dict[int, float], xy: dict[int, tuple[float, float]]
+    ) -> None:
         """One base-station step.
 
         possession: "own" (a robot of ours holds the ball: input b), "opponent"

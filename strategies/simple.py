@@ -84,7 +84,9 @@ class SimpleTeam:
                 self.ball = (rep.ball.x, rep.ball.y, rep.tick)
         c = referee_fields(self.team, referee, default_attack_dir=1)
         roles = self._roles()
-        own_poses = [TeamPose(robot=n, x=p[0], y=p[1], theta=p[2], age=tick - p[3]) for n, p in sorted(self.poses.items())]
+        own_poses = [
+            TeamPose(robot=n, x=p[0], y=p[1], theta=p[2], age=tick - p[3]) for n, p in sorted(self.poses.items())
+        ]
         bx, by, bt = self.ball if self.ball is not None else (0.0, 0.0, -1)
         return {
             n: Order(

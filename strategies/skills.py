@@ -111,8 +111,14 @@ def line_clear(a: Vec, b: Vec, robots: list[Vec], margin: float) -> bool:
 
 
 def best_aim(
-    ball: Vec, goal_x: float, goal_half: float, robots: list[Vec], margin: float, post_margin: float = 0.25,
-    heading: float | None = None, turn_cost: float = 0.3,
+    ball: Vec,
+    goal_x: float,
+    goal_half: float,
+    robots: list[Vec],
+    margin: float,
+    post_margin: float = 0.25,
+    heading: float | None = None,
+    turn_cost: float = 0.3,
 ) -> tuple[Vec, bool]:
     """Aim point on the goal line with the most room, and whether its line is clear.
 

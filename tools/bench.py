@@ -25,7 +25,9 @@ def bench_match(args: argparse.Namespace) -> int:
     runs = []
     for i in range(args.runs):
         cfg = MatchConfig(seed=1000 + i, robots=args.robots, half_time=args.half_time, link=args.link)
-        console.print(f"run {i + 1}/{args.runs}: 2 x {args.half_time:g} s, {args.robots}v{args.robots}, link {args.link} ...")
+        console.print(
+            f"run {i + 1}/{args.runs}: 2 x {args.half_time:g} s, {args.robots}v{args.robots}, link {args.link} ..."
+        )
         r = launcher.play_match(cfg)
         runs.append(r)
         console.print(f"  rtf {r['rtf']:.1f}x, {1000 * r['play_wall_seconds'] / max(1, r['ticks']):.3f} ms/tick")
@@ -143,8 +145,10 @@ def robot_step_us(strategy: str = "advance-dynamic", batches: int = 200, per_bat
     team = s.make_team(TeamContext(cfg=cfg, team="a", rng=random.Random(0)))
     inputs = list(conformance.scripted_inputs(cfg, seed=0))
     _, senses0 = inputs[0]
-    reports = {n: s.make_robot(RobotContext(cfg=cfg, team="a", n=n, rng=random.Random(0))).report(0, senses0["a"][n])
-               for n in range(cfg.robots)}
+    reports = {
+        n: s.make_robot(RobotContext(cfg=cfg, team="a", n=n, rng=random.Random(0))).report(0, senses0["a"][n])
+        for n in range(cfg.robots)
+    }
     orders = team.step(1, reports, inputs[10][0])
     robots = {n: s.make_robot(RobotContext(cfg=cfg, team="a", n=n, rng=random.Random(0))) for n in range(cfg.robots)}
     samples: list[float] = []

@@ -133,8 +133,14 @@ def up(path: str, timeout: float = 600.0) -> dict:
                 c.name = str(c.pid)
             try:
                 got = launcher.supervise(
-                    transport, collector, keys, cfg, named, [str(p) for p in cfg.processes()],
-                    launcher.Progress(cfg.total_ticks, False), timeout=timeout,
+                    transport,
+                    collector,
+                    keys,
+                    cfg,
+                    named,
+                    [str(p) for p in cfg.processes()],
+                    launcher.Progress(cfg.total_ticks, False),
+                    timeout=timeout,
                 )
             except launcher.MatchError as exc:
                 raise ComposeError(str(exc)) from None

@@ -63,7 +63,15 @@ class Child:
         return "\n".join("    " + line for line in text[-lines:])
 
 
-_PACKAGES = ("arena", "arena.runtime", "arena.processes", "arena.schemas", "arena.strategies", "arena.navigation", "arena.tools")
+_PACKAGES = (
+    "arena",
+    "arena.runtime",
+    "arena.processes",
+    "arena.schemas",
+    "arena.strategies",
+    "arena.navigation",
+    "arena.tools",
+)
 
 
 def compile_sources() -> None:
@@ -150,7 +158,8 @@ class Progress:
 
     def __enter__(self) -> Progress:
         if self.enabled:
-            from rich.progress import BarColumn, Progress as RichProgress, TextColumn, TimeRemainingColumn
+            from rich.progress import BarColumn, TextColumn, TimeRemainingColumn
+            from rich.progress import Progress as RichProgress
 
             self._bar = RichProgress(
                 TextColumn("[bold]match[/]"),

@@ -151,7 +151,9 @@ def match_facts(cfg: MatchConfig) -> MatchFacts:
     return measure(cfg, worlds, referee, extra, summaries["engine"].extra.get("distance_m", {}))
 
 
-def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], extra: dict, distance: dict) -> MatchFacts:
+def measure(
+    cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], extra: dict, distance: dict
+) -> MatchFacts:
     f, radius, dt = cfg.field, cfg.rules.progress_radius, cfg.timing.dt
     fence_x, fence_y = f.length / 2 + f.runoff, f.width / 2 + f.runoff
     half_len, half_wid, goal_half = f.length / 2, f.width / 2, f.goal_width / 2
@@ -279,8 +281,15 @@ def measure(cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], 
                         count[t]["shots"] += 1
                         if abs(y) < goal_half:
                             count[t]["on_target"] += 1
-                            open_shots.append({"team": t, "end": w.tick + shot_ticks, "outcome": "", "touch": "",
-                                               "dist": round(math.hypot(line_x - w.ball_x, w.ball_y), 2)})
+                            open_shots.append(
+                                {
+                                    "team": t,
+                                    "end": w.tick + shot_ticks,
+                                    "outcome": "",
+                                    "touch": "",
+                                    "dist": round(math.hypot(line_x - w.ball_x, w.ball_y), 2),
+                                }
+                            )
         pending = []
         for s in open_shots:
             if s["outcome"] == "" and w.tick < s["end"]:
@@ -347,15 +356,19 @@ def many(cfgs: list[MatchConfig], workers: int | None = None) -> list[MatchFacts
 def line(m: MatchFacts) -> str:
     """One match; "x/y" is team a / team b (saves and blocks: made by that team's robots)."""
     restarts = " ".join(f"{k} {m.events.get(k, 0)}" for k in RESTARTS if m.events.get(k))
-    out = (f"seed {m.seed:3d}  score {m.score[0]}:{m.score[1]}  END_GAME {m.events.get('END_GAME', 0)}  "
-           f"outside {m.outside}  stall {m.stall_s:.2f} s  stuck {m.stuck_s:.2f} s  {restarts}")
+    out = (
+        f"seed {m.seed:3d}  score {m.score[0]}:{m.score[1]}  END_GAME {m.events.get('END_GAME', 0)}  "
+        f"outside {m.outside}  stall {m.stall_s:.2f} s  stuck {m.stuck_s:.2f} s  {restarts}"
+    )
     if m.teams:
         a, b = m.teams
-        out += (f"\n          shots {a.shots}/{b.shots} on target {a.on_target}/{b.on_target} "
-                f"keeper saves {a.saves}/{b.saves} blocks {a.blocks}/{b.blocks}  "
-                f"contact {m.contact_s:.1f} pair-s overlap {m.overlap_s:.2f} pair-s (max {m.max_overlap_m * 100:.1f} cm)  "
-                f"by-fence stuck {a.stuck_s:.1f}/{b.stuck_s:.1f} robot-s corner {a.corner_s:.1f}/{b.corner_s:.1f} robot-s  "
-                f"pushing {a.pushing}/{b.pushing}")
+        out += (
+            f"\n          shots {a.shots}/{b.shots} on target {a.on_target}/{b.on_target} "
+            f"keeper saves {a.saves}/{b.saves} blocks {a.blocks}/{b.blocks}  "
+            f"contact {m.contact_s:.1f} pair-s overlap {m.overlap_s:.2f} pair-s (max {m.max_overlap_m * 100:.1f} cm)  "
+            f"by-fence stuck {a.stuck_s:.1f}/{b.stuck_s:.1f} robot-s corner {a.corner_s:.1f}/{b.corner_s:.1f} robot-s  "
+            f"pushing {a.pushing}/{b.pushing}"
+        )
     return out
 
 
@@ -363,18 +376,42 @@ def summary(facts: list[MatchFacts]) -> list[str]:
     """Totals over matches, per strategy (a strategy met on both sides counts both)."""
     goals = [sum(m.score) for m in facts]
     n = len(facts)
-    out = [f"{n} matches; goals per match {sum(goals) / n:.2f} (min {min(goals)}, max {max(goals)}); "
-           f"longest stall {max(m.stall_s for m in facts):.2f} s"]
+    out = [
+        f"{n} matches; goals per match {sum(goals) / n:.2f} (min {min(goals)}, max {max(goals)}); "
+        f"longest stall {max(m.stall_s for m in facts):.2f} s"
+    ]
     if not facts[0].teams:
         return out
     per: dict[str, dict[str, float]] = {}
     for m in facts:
         for k, t in enumerate(m.teams):
             other = m.teams[1 - k]
-            row = per.setdefault(t.strategy, {"sides": 0, "W": 0, "D": 0, "L": 0, "GF": 0, "GA": 0, "shots": 0,
-                                              "on_target": 0, "faced": 0, "saves": 0, "blocks": 0, "stuck": 0.0,
-                                              "longest": 0.0, "corner": 0.0, "conceded_stuck": 0, "pushing": 0,
-                                              "d1": 0.0, "d2": 0.0, "g_near": 0, "g_mid": 0, "g_far": 0})
+            row = per.setdefault(
+                t.strategy,
+                {
+                    "sides": 0,
+                    "W": 0,
+                    "D": 0,
+                    "L": 0,
+                    "GF": 0,
+                    "GA": 0,
+                    "shots": 0,
+                    "on_target": 0,
+                    "faced": 0,
+                    "saves": 0,
+                    "blocks": 0,
+                    "stuck": 0.0,
+                    "longest": 0.0,
+                    "corner": 0.0,
+                    "conceded_stuck": 0,
+                    "pushing": 0,
+                    "d1": 0.0,
+                    "d2": 0.0,
+                    "g_near": 0,
+                    "g_mid": 0,
+                    "g_far": 0,
+                },
+            )
             row["sides"] += 1
             row["W" if t.goals > other.goals else "D" if t.goals == other.goals else "L"] += 1
             row["GF"] += t.goals
@@ -394,28 +431,36 @@ def summary(facts: list[MatchFacts]) -> list[str]:
             if len(t.distance_m) > 2:
                 row["d1"] += t.distance_m[1]
                 row["d2"] += t.distance_m[2]
-    out.append("strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
-               "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2")
+    out.append(
+        "strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
+        "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2"
+    )
     from arena.tools.tournament import short
 
     for s, r in sorted(per.items()):
         s = short(s)
         k = r["sides"]
         ratio = f"{r['d1'] / r['d2']:.2f}" if r["d2"] > 0 else "-"
-        out.append(f"{s:8s}  {k:5d} {r['W']:2d} {r['D']:2d} {r['L']:2d} {r['GF']:3d} {r['GA']:3d}  {r['GF'] / k:10.2f}  "
-                   f"{r['shots']:5d}  {r['on_target']:9d}  {r['faced']:5d}  {r['saves']:5d}  {r['blocks']:6d}  "
-                   f"{r['stuck'] / k:12.1f}  {r['longest']:13.1f}  {r['corner'] / k:13.1f}  {r['conceded_stuck']:14d}  "
-                   f"{r['pushing']:7d}  {ratio:>13s}")
-    out.append(f"goals by strike distance to the goal centre (< {GOAL_NEAR:.1f} m / < {GOAL_FAR:.1f} m / farther"
-               " / not from a detected on-target shot):")
+        out.append(
+            f"{s:8s}  {k:5d} {r['W']:2d} {r['D']:2d} {r['L']:2d} {r['GF']:3d} {r['GA']:3d}  {r['GF'] / k:10.2f}  "
+            f"{r['shots']:5d}  {r['on_target']:9d}  {r['faced']:5d}  {r['saves']:5d}  {r['blocks']:6d}  "
+            f"{r['stuck'] / k:12.1f}  {r['longest']:13.1f}  {r['corner'] / k:13.1f}  {r['conceded_stuck']:14d}  "
+            f"{r['pushing']:7d}  {ratio:>13s}"
+        )
+    out.append(
+        f"goals by strike distance to the goal centre (< {GOAL_NEAR:.1f} m / < {GOAL_FAR:.1f} m / farther"
+        " / not from a detected on-target shot):"
+    )
     for s, r in sorted(per.items()):
         near, mid, far = r["g_near"], r["g_mid"], r["g_far"]
         out.append(f"  {short(s):8s} scored {near:3d} / {mid:3d} / {far:3d} / {r['GF'] - near - mid - far:3d}")
     contact = sum(m.contact_s for m in facts) / n
     overlap = sum(m.overlap_s for m in facts) / n
     deepest = max(m.max_overlap_m for m in facts)
-    out.append(f"robot-robot contact {contact:.1f} pair-s per match; overlap > {OVERLAP_DEPTH * 100:.0f} cm "
-               f"{overlap:.2f} pair-s per match; deepest overlap {deepest * 100:.1f} cm")
+    out.append(
+        f"robot-robot contact {contact:.1f} pair-s per match; overlap > {OVERLAP_DEPTH * 100:.0f} cm "
+        f"{overlap:.2f} pair-s per match; deepest overlap {deepest * 100:.1f} cm"
+    )
     return out
 
 
@@ -436,7 +481,15 @@ def round_robin(
     facts = many(cfgs, workers)
     results = [
         Result(
-            id=f"{i:03d}", first=fst, second=snd, leg=leg, home=h, away=a, seed=s, status="ok", score=list(m.score),
+            id=f"{i:03d}",
+            first=fst,
+            second=snd,
+            leg=leg,
+            home=h,
+            away=a,
+            seed=s,
+            status="ok",
+            score=list(m.score),
             distance_m={f"{side}/{k}": d for side, t in zip("ab", m.teams) for k, d in enumerate(t.distance_m)},
         )
         for i, ((fst, snd, leg, h, a, s), m) in enumerate(zip(fixtures, facts))
@@ -471,12 +524,16 @@ def main(argv: list[str] | None = None) -> int:
         print("team              W  D  L  GF  GA  GD   P   robot1 m  robot2 m  ratio")
         for row in standings(results, names):
             c = cover[row["team"]]
-            print(f"{short(row['team']):16s} {row['W']:2d} {row['D']:2d} {row['L']:2d} {row['GF']:3d} {row['GA']:3d} "
-                  f"{row['GD']:3d} {row['P']:3d}   {c['robot1_m']:7.1f}  {c['robot2_m']:7.1f}  {c['ratio']}")
+            print(
+                f"{short(row['team']):16s} {row['W']:2d} {row['D']:2d} {row['L']:2d} {row['GF']:3d} {row['GA']:3d} "
+                f"{row['GD']:3d} {row['P']:3d}   {c['robot1_m']:7.1f}  {c['robot2_m']:7.1f}  {c['ratio']}"
+            )
         print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s")
         return 0
-    cfgs = [MatchConfig(seed=s, half_time=args.half_time, home=args.home, away=args.away)
-            for s in range(args.first_seed, args.first_seed + args.seeds)]
+    cfgs = [
+        MatchConfig(seed=s, half_time=args.half_time, home=args.home, away=args.away)
+        for s in range(args.first_seed, args.first_seed + args.seeds)
+    ]
     facts = many(cfgs, args.workers)
     for m in facts:
         print(line(m))

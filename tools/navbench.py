@@ -248,7 +248,9 @@ def _resolve(data: dict[str, Any], name: str) -> BenchSpec:
         if s.name in schemes:
             raise ScenarioError(f"{name}: scheme {s.name!r} is defined twice")
         if s.method not in NAVIGATORS:
-            raise ScenarioError(f"{name}: scheme {s.name!r}: unknown method {s.method!r} (known: {', '.join(NAVIGATORS)})")
+            raise ScenarioError(
+                f"{name}: scheme {s.name!r}: unknown method {s.method!r} (known: {', '.join(NAVIGATORS)})"
+            )
         params = _override(PARAMS[s.method](), s.params, f"{name}: scheme {s.name!r} params")
         schemes[s.name] = Scheme(s.name, s.method, s.label or s.name, params)
 
@@ -418,8 +420,14 @@ class Trial:
     def outcome(self) -> tuple:
         """Everything but the wall-clock timings: what determinism compares."""
         return (
-            self.iterations, self.reached, self.collisions, self.min_clearance, self.path_length,
-            self.robot_xy.tobytes(), self.obstacles_xy.tobytes(), tuple(self.collision_xy),
+            self.iterations,
+            self.reached,
+            self.collisions,
+            self.min_clearance,
+            self.path_length,
+            self.robot_xy.tobytes(),
+            self.obstacles_xy.tobytes(),
+            tuple(self.collision_xy),
         )
 
 
@@ -716,25 +724,27 @@ def results_rows(r: Report) -> list[dict[str, Any]]:
         for scheme in sc.schemes:
             ts = r.runs[(sc.name, scheme.name)]
             ref = sc.spec.reference.get(scheme.name)
-            rows.append({
-                "scenario": sc.name,
-                "method": scheme.method,
-                "scheme": scheme.name,
-                "label": scheme.label,
-                "trials": len(ts),
-                "reached": sum(t.reached for t in ts),
-                "collision_free": sum(_free(t) for t in ts),
-                "safe": sum(_safe(t) for t in ts),
-                "safe_rate": round(sum(_safe(t) for t in ts) / len(ts), 4),
-                "collision_free_rate": round(sum(_free(t) for t in ts) / len(ts), 4),
-                "avg_iterations": _avg_iterations(ts),
-                "us_per_iteration": _median_us(n for t in ts for n in t.nav_ns),
-                "iteration_us": _median_us(n for t in ts for n in t.iter_ns),
-                "min_clearance_m": round(min(t.min_clearance for t in ts), 4),
-                "paper_avg_iterations": ref.iterations if ref else None,
-                "paper_collision_free": ref.free if ref else None,
-                "paper_safe_rate": round(ref.free / 10, 4) if ref else None,
-            })
+            rows.append(
+                {
+                    "scenario": sc.name,
+                    "method": scheme.method,
+                    "scheme": scheme.name,
+                    "label": scheme.label,
+                    "trials": len(ts),
+                    "reached": sum(t.reached for t in ts),
+                    "collision_free": sum(_free(t) for t in ts),
+                    "safe": sum(_safe(t) for t in ts),
+                    "safe_rate": round(sum(_safe(t) for t in ts) / len(ts), 4),
+                    "collision_free_rate": round(sum(_free(t) for t in ts) / len(ts), 4),
+                    "avg_iterations": _avg_iterations(ts),
+                    "us_per_iteration": _median_us(n for t in ts for n in t.nav_ns),
+                    "iteration_us": _median_us(n for t in ts for n in t.iter_ns),
+                    "min_clearance_m": round(min(t.min_clearance for t in ts), 4),
+                    "paper_avg_iterations": ref.iterations if ref else None,
+                    "paper_collision_free": ref.free if ref else None,
+                    "paper_safe_rate": round(ref.free / 10, 4) if ref else None,
+                }
+            )
     return rows
 
 
@@ -756,20 +766,22 @@ def method_rows(r: Report) -> list[dict[str, Any]]:
             if m not in pooled:
                 continue
             ts = pooled[m]
-            out.append({
-                "scenario": sc.name,
-                "method": m,
-                "trials": len(ts),
-                "safe": sum(_safe(t) for t in ts),
-                "collision_free": sum(_free(t) for t in ts),
-                "reached": sum(t.reached for t in ts),
-                "safe_rate": round(rates[m], 4),
-                "collision_free_rate": round(free[m], 4),
-                "avg_iterations": _avg_iterations(ts),
-                "paper_safe_rate": round(sum(paper[m]) / (10 * len(paper[m])), 4) if m in paper else None,
-                "order_fsfm_sfm_apf_holds": ordered,
-                "order_holds_collision_free": ordered_free,
-            })
+            out.append(
+                {
+                    "scenario": sc.name,
+                    "method": m,
+                    "trials": len(ts),
+                    "safe": sum(_safe(t) for t in ts),
+                    "collision_free": sum(_free(t) for t in ts),
+                    "reached": sum(t.reached for t in ts),
+                    "safe_rate": round(rates[m], 4),
+                    "collision_free_rate": round(free[m], 4),
+                    "avg_iterations": _avg_iterations(ts),
+                    "paper_safe_rate": round(sum(paper[m]) / (10 * len(paper[m])), 4) if m in paper else None,
+                    "order_fsfm_sfm_apf_holds": ordered,
+                    "order_holds_collision_free": ordered_free,
+                }
+            )
     return out
 
 
@@ -798,20 +810,22 @@ def minima_rows(r: Report) -> list[dict[str, Any]]:
     for lm in r.spec.local_minima:
         for method, _ in lm.methods:
             t = r.minima[(lm.name, method)]
-            rows.append({
-                "env": lm.name,
-                "method": method,
-                "reached": t.reached,
-                "path_length_m": round(t.path_length, 4),
-                "min_clearance_m": round(t.min_clearance, 4),
-                "min_centre_distance_m": round(t.min_centre_distance, 4),
-                "collisions": t.collisions,
-                "time_s": round(t.iterations * lm.spec.dt, 2),
-                "final_distance_to_goal_m": round(
-                    math.hypot(lm.spec.goal[0] - t.robot_xy[-1, 0], lm.spec.goal[1] - t.robot_xy[-1, 1]), 4
-                ),
-                "paper_path_length_m": lm.spec.reference.get("path_length_m") if method == "mapf" else None,
-            })
+            rows.append(
+                {
+                    "env": lm.name,
+                    "method": method,
+                    "reached": t.reached,
+                    "path_length_m": round(t.path_length, 4),
+                    "min_clearance_m": round(t.min_clearance, 4),
+                    "min_centre_distance_m": round(t.min_centre_distance, 4),
+                    "collisions": t.collisions,
+                    "time_s": round(t.iterations * lm.spec.dt, 2),
+                    "final_distance_to_goal_m": round(
+                        math.hypot(lm.spec.goal[0] - t.robot_xy[-1, 0], lm.spec.goal[1] - t.robot_xy[-1, 1]), 4
+                    ),
+                    "paper_path_length_m": lm.spec.reference.get("path_length_m") if method == "mapf" else None,
+                }
+            )
     return rows
 
 
@@ -829,25 +843,47 @@ def print_report(r: Report, console: Any = None) -> None:
     for sc in r.spec.scenarios:
         ref = f", paper 1 {sc.spec.paper}" if sc.spec.paper else ""
         t = Table(title=f"{sc.name}: {sc.spec.title or ''} ({r.trials} trials{ref})", title_justify="left")
-        for col, just in [("scheme", "left"), ("method", "left"), ("avg iter", "right"), ("paper", "right"),
-                          ("reached", "right"), ("collision-free", "right"), ("paper", "right"),
-                          ("safe %", "right"), ("paper %", "right"), ("step us", "right")]:
+        for col, just in [
+            ("scheme", "left"),
+            ("method", "left"),
+            ("avg iter", "right"),
+            ("paper", "right"),
+            ("reached", "right"),
+            ("collision-free", "right"),
+            ("paper", "right"),
+            ("safe %", "right"),
+            ("paper %", "right"),
+            ("step us", "right"),
+        ]:
             t.add_column(col, justify=just)
         for row in (x for x in rows if x["scenario"] == sc.name):
             pf = row["paper_collision_free"]
             t.add_row(
-                row["scheme"], row["label"], _fmt(row["avg_iterations"], "{:.1f}"), _fmt(row["paper_avg_iterations"], "{:g}"),
-                f"{row['reached']}/{row['trials']}", f"{row['collision_free']}/{row['trials']}",
-                "-" if pf is None else f"{pf}/10", f"{100 * row['safe_rate']:.0f}",
-                _fmt(row["paper_safe_rate"], "{:.0%}").rstrip("%"), _fmt(row["us_per_iteration"], "{:.1f}"),
+                row["scheme"],
+                row["label"],
+                _fmt(row["avg_iterations"], "{:.1f}"),
+                _fmt(row["paper_avg_iterations"], "{:g}"),
+                f"{row['reached']}/{row['trials']}",
+                f"{row['collision_free']}/{row['trials']}",
+                "-" if pf is None else f"{pf}/10",
+                f"{100 * row['safe_rate']:.0f}",
+                _fmt(row["paper_safe_rate"], "{:.0%}").rstrip("%"),
+                _fmt(row["us_per_iteration"], "{:.1f}"),
             )
         t.add_section()
         for mrow in (x for x in methods if x["scenario"] == sc.name):
             n = mrow["trials"]
             t.add_row(
-                "all", mrow["method"], _fmt(mrow["avg_iterations"], "{:.1f}"), "", f"{mrow['reached']}/{n}",
-                f"{mrow['collision_free']}/{n}", "", f"{100 * mrow['safe_rate']:.0f}",
-                _fmt(mrow["paper_safe_rate"], "{:.0%}").rstrip("%"), "",
+                "all",
+                mrow["method"],
+                _fmt(mrow["avg_iterations"], "{:.1f}"),
+                "",
+                f"{mrow['reached']}/{n}",
+                f"{mrow['collision_free']}/{n}",
+                "",
+                f"{100 * mrow['safe_rate']:.0f}",
+                _fmt(mrow["paper_safe_rate"], "{:.0%}").rstrip("%"),
+                "",
             )
         mine = [x for x in methods if x["scenario"] == sc.name]
         if mine and mine[0]["order_fsfm_sfm_apf_holds"] is not None:
@@ -868,23 +904,45 @@ def print_report(r: Report, console: Any = None) -> None:
             t.add_row(m, _fmt(tm["step_us_median"][m], "{:.2f}"), _fmt(tm["iteration_us_median"][m], "{:.1f}"))
     if "fis_overhead_step_percent" in tm:
         t.add_section()
-        t.add_row("F-SFM over SFM", f"{tm['fis_overhead_step_percent']:+.1f} %", f"{tm['fis_overhead_iteration_percent']:+.1f} %")
+        t.add_row(
+            "F-SFM over SFM",
+            f"{tm['fis_overhead_step_percent']:+.1f} %",
+            f"{tm['fis_overhead_iteration_percent']:+.1f} %",
+        )
         t.add_row("paper 1 (whole iteration)", "", f"{PAPER_SFM_MS} -> {PAPER_FSFM_MS} ms, +{PAPER_FIS_OVERHEAD} %")
     if "fsfm_within_budget" in tm:
-        t.caption = f"F-SFM step median {'within' if tm['fsfm_within_budget'] else 'OVER'} the {FSFM_BUDGET_US:g} us budget"
+        t.caption = (
+            f"F-SFM step median {'within' if tm['fsfm_within_budget'] else 'OVER'} the {FSFM_BUDGET_US:g} us budget"
+        )
     console.print(t)
 
     if r.spec.local_minima:
         t = Table(title="paper 3 local minima, E-puck (differential drive), one run each", title_justify="left")
-        for col in ("env", "method", "reached", "time [s]", "path [m]", "paper path [m]", "min clearance [m]",
-                    "min centre dist [m]", "final dist to goal [m]", "contacts"):
+        for col in (
+            "env",
+            "method",
+            "reached",
+            "time [s]",
+            "path [m]",
+            "paper path [m]",
+            "min clearance [m]",
+            "min centre dist [m]",
+            "final dist to goal [m]",
+            "contacts",
+        ):
             t.add_column(col, justify="left" if col in ("env", "method") else "right")
         for row in minima_rows(r):
             t.add_row(
-                row["env"], row["method"], "yes" if row["reached"] else "no", f"{row['time_s']:.1f}",
-                f"{row['path_length_m']:.3f}", _fmt(row["paper_path_length_m"], "{:.2f}"),
-                f"{row['min_clearance_m']:.3f}", f"{row['min_centre_distance_m']:.3f}",
-                f"{row['final_distance_to_goal_m']:.3f}", str(row["collisions"]),
+                row["env"],
+                row["method"],
+                "yes" if row["reached"] else "no",
+                f"{row['time_s']:.1f}",
+                f"{row['path_length_m']:.3f}",
+                _fmt(row["paper_path_length_m"], "{:.2f}"),
+                f"{row['min_clearance_m']:.3f}",
+                f"{row['min_centre_distance_m']:.3f}",
+                f"{row['final_distance_to_goal_m']:.3f}",
+                str(row["collisions"]),
             )
         console.print(t)
 
@@ -931,8 +989,9 @@ def write_plots(r: Report, out_dir: str | Path) -> list[Path]:
             ax.add_patch(Circle(tuple(t0.robot_xy[-1]), half, fc="none", ec="darkgoldenrod"))
             hits = [p for t in trials for p in t.collision_xy]
             if hits:
-                ax.scatter([p[0] for p in hits], [p[1] for p in hits], marker="x", color="red", s=30, zorder=5,
-                           label="contact")
+                ax.scatter(
+                    [p[0] for p in hits], [p[1] for p in hits], marker="x", color="red", s=30, zorder=5, label="contact"
+                )
             ax.plot(*sc.spec.start, "ko", ms=5)
             ax.plot(*sc.spec.target, marker="*", color="green", ms=14, ls="none", label="target")
             safe = sum(_safe(t) for t in trials)
@@ -958,15 +1017,20 @@ def write_plots(r: Report, out_dir: str | Path) -> list[Path]:
             half = lm.robot.size / 2
             for ox, oy in lm.spec.obstacles:
                 ax.add_patch(Circle((ox, oy), half, fc="tab:blue", alpha=0.5))
-                for method, params in lm.methods:
+                for _method, params in lm.methods:
                     r_safe = getattr(params, "safe_distance", None)
                     if r_safe:
                         ax.add_patch(Circle((ox, oy), r_safe, fc="none", ec="grey", ls=":"))
                         break
             for method, _ in lm.methods:
                 t = r.minima[(lm.name, method)]
-                ax.plot(t.robot_xy[:, 0], t.robot_xy[:, 1], color=METHOD_COLOURS.get(method, "k"), lw=1.6,
-                        label=f"{method}: {'reached' if t.reached else 'not reached'}, {t.path_length:.2f} m")
+                ax.plot(
+                    t.robot_xy[:, 0],
+                    t.robot_xy[:, 1],
+                    color=METHOD_COLOURS.get(method, "k"),
+                    lw=1.6,
+                    label=f"{method}: {'reached' if t.reached else 'not reached'}, {t.path_length:.2f} m",
+                )
             ax.plot(*lm.spec.start, "ko", ms=5)
             ax.plot(*lm.spec.goal, marker="*", color="green", ms=14, ls="none")
             ax.set_title(f"{lm.name}: {lm.spec.title}", fontsize=9)
@@ -1004,8 +1068,13 @@ def main(args: argparse.Namespace) -> int:
             raise ConfigError(f"--plots {args.plots}: exists and is not a directory")
     err = Console(stderr=True)
     with Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-        console=err, disable=not err.is_terminal, transient=True,
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=err,
+        disable=not err.is_terminal,
+        transient=True,
     ) as bar:
         task = bar.add_task("arena bench nav", total=work_units(spec, args.trials))
 

@@ -25,8 +25,14 @@ def print_match(result: dict, console: Console | None = None) -> None:
     for col in ("class", "sent", "dropped", "drop %", "delay mean ms", "delay p95 ms"):
         t.add_column(col, justify="right")
     for cls, s in sorted(result["links"].items()):
-        t.add_row(cls, str(s["sent"]), str(s["dropped"]), f"{100 * s['drop_rate']:.2f}",
-                  f"{s['delay_ms_mean']:.2f}", f"{s['delay_ms_p95']:.2f}")
+        t.add_row(
+            cls,
+            str(s["sent"]),
+            str(s["dropped"]),
+            f"{100 * s['drop_rate']:.2f}",
+            f"{s['delay_ms_mean']:.2f}",
+            f"{s['delay_ms_p95']:.2f}",
+        )
     console.print(t)
     d = Table(title="distance per robot [m]")
     d.add_column("robot")
@@ -43,4 +49,6 @@ def print_match(result: dict, console: Console | None = None) -> None:
     rec = result.get("recording")
     if rec:
         state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"
-        console.print(f"recorded {sum(rec['messages'].values())} messages to {rec['path']} ({state}): arena review {rec['path']}")
+        console.print(
+            f"recorded {sum(rec['messages'].values())} messages to {rec['path']} ({state}): arena review {rec['path']}"
+        )

@@ -93,7 +93,9 @@ def analyse(rec: Recording) -> dict:
             if c.name in RESTARTS:
                 restarts[f"{c.name} {c.team}".strip()] += 1
             if c.name == "GOAL":
-                goals.append({"tick": c.tick, "t": round(c.tick * dt, 2), "team": c.team, "score": [r.score_a, r.score_b]})
+                goals.append(
+                    {"tick": c.tick, "t": round(c.tick * dt, 2), "team": c.team, "score": [r.score_a, r.score_b]}
+                )
     # possession and distance from the ground truth
     holds = Counter()
     dist: dict[str, float] = {}
@@ -170,19 +172,27 @@ def analyse(rec: Recording) -> dict:
 def print_review(r: dict, console: Console | None = None) -> None:
     console = console or Console()
     a, b = r["score"]
-    console.print(f"[bold]{r['home']}[/] (a) [bold]{a} : {b}[/] [bold]{r['away']}[/] (b)   seed {r['seed']}, link {r['link']}")
-    console.print(f"{r['sim_seconds']:.1f} s of {r['planned_sim_seconds']:.1f} s recorded; git {r['git_revision'][:12]}")
+    console.print(
+        f"[bold]{r['home']}[/] (a) [bold]{a} : {b}[/] [bold]{r['away']}[/] (b)   seed {r['seed']}, link {r['link']}"
+    )
+    console.print(
+        f"{r['sim_seconds']:.1f} s of {r['planned_sim_seconds']:.1f} s recorded; git {r['git_revision'][:12]}"
+    )
     if r["truncated"]:
         console.print(f"[yellow]truncated recording: {r['truncation']}; reviewed up to {r['sim_seconds']:.1f} s[/]")
     elif not r["complete"]:
         console.print("[yellow]incomplete recording: the recorder missed some process's last batch[/]")
     if r["goals"]:
-        console.print("goals: " + ", ".join(f"{g['t']:.1f} s {g['team']} ({g['score'][0]}:{g['score'][1]})" for g in r["goals"]))
+        console.print(
+            "goals: " + ", ".join(f"{g['t']:.1f} s {g['team']} ({g['score'][0]}:{g['score'][1]})" for g in r["goals"])
+        )
     else:
         console.print("goals: none")
     console.print("restarts: " + (", ".join(f"{k} {v}" for k, v in r["restarts"].items()) or "none"))
     p = r["possession_percent"]
-    console.print(f"possession: a {p['a']:.1f} %, b {p['b']:.1f} % (ball loose {p['loose_percent_of_time']:.1f} % of the time)")
+    console.print(
+        f"possession: a {p['a']:.1f} %, b {p['b']:.1f} % (ball loose {p['loose_percent_of_time']:.1f} % of the time)"
+    )
     d = Table(title="distance per robot", caption=f"from the {r['distance_source']}")
     d.add_column("robot")
     d.add_column("[m]", justify="right")
@@ -196,7 +206,15 @@ def print_review(r: dict, console: Console | None = None) -> None:
             t.add_column(col, justify="right")
         for cls, s in links.items():
             dm = s["delay_ms"]
-            t.add_row(cls, str(s["frames"]), str(s["dropped"]), f"{s['drop_percent']:.2f}", f"{dm['p50']:.2f}", f"{dm['p95']:.2f}", f"{dm['p99']:.2f}")
+            t.add_row(
+                cls,
+                str(s["frames"]),
+                str(s["dropped"]),
+                f"{s['drop_percent']:.2f}",
+                f"{dm['p50']:.2f}",
+                f"{dm['p95']:.2f}",
+                f"{dm['p99']:.2f}",
+            )
         console.print(t)
     else:
         console.print("[yellow]links: no process summaries in the file[/]")
@@ -237,7 +255,15 @@ def _draw_field(ax, cfg, grass: bool = True) -> None:
             # the quarter of the corner circle that lies inside the field
             start = {(1, -1): 90, (1, 1): 180, (-1, 1): 270, (-1, -1): 0}[(side, 1 if cy > 0 else -1)]
             ax.add_patch(
-                Arc((gx, cy), 2 * f.corner_arc_radius, 2 * f.corner_arc_radius, theta1=start, theta2=start + 90, color="white", lw=1)
+                Arc(
+                    (gx, cy),
+                    2 * f.corner_arc_radius,
+                    2 * f.corner_arc_radius,
+                    theta1=start,
+                    theta2=start + 90,
+                    color="white",
+                    lw=1,
+                )
             )
     ax.set_xlim(-hl - f.runoff, hl + f.runoff)
     ax.set_ylim(-hw - f.runoff, hw + f.runoff)
@@ -307,7 +333,12 @@ def write_plots(rec: Recording, review: dict, out_dir: str) -> list[str]:
         times = [0.0] + [g["t"] for g in review["goals"]] + [end]
         scores = [0] + [g["score"][i] for g in review["goals"]] + [review["score"][i]]
         ax.step(
-            times, scores, where="post", color=TEAM_COLOURS[team], ls="-" if team == "a" else "--", lw=2,
+            times,
+            scores,
+            where="post",
+            color=TEAM_COLOURS[team],
+            ls="-" if team == "a" else "--",
+            lw=2,
             label=f"{team}: {review['home' if team == 'a' else 'away']}",
         )
     ax.axvline(cfg.half_time, color="grey", ls=":", lw=0.8)
@@ -353,7 +384,9 @@ def _animate(worlds: list[World], cfg, path: Path) -> str:
     _draw_field(ax, cfg)
     ax.set_axis_off()  # axes and ticks would cost most of the drawing time of every frame
     teams = [r.team for r in frames[0].robots]
-    robots = ax.scatter([0] * len(teams), [0] * len(teams), s=80, c=[TEAM_COLOURS[t] for t in teams], marker="s", edgecolors="black")
+    robots = ax.scatter(
+        [0] * len(teams), [0] * len(teams), s=80, c=[TEAM_COLOURS[t] for t in teams], marker="s", edgecolors="black"
+    )
     ball = ax.scatter([0], [0], s=30, c="orange", edgecolors="black", zorder=3)
     title = ax.set_title("")
 

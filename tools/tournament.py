@@ -140,8 +140,16 @@ def coverage(results: list[Result], teams: list[str]) -> dict[str, dict]:
     """Fig. 9: mean distance of robot 1 and robot 2 per match, and their ratio."""
     out = {}
     for t in teams:
-        d1 = [d for r in results if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 1)) is not None]
-        d2 = [d for r in results if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 2)) is not None]
+        d1 = [
+            d
+            for r in results
+            if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 1)) is not None
+        ]
+        d2 = [
+            d
+            for r in results
+            if r.status == "ok" and t in (r.home, r.away) and (d := r.robot_distance(t, 2)) is not None
+        ]
         m1 = sum(d1) / len(d1) if d1 else 0.0
         m2 = sum(d2) / len(d2) if d2 else 0.0
         out[t] = {"robot1_m": round(m1, 2), "robot2_m": round(m2, 2), "ratio": round(m1 / m2, 3) if m2 > 0 else None}
@@ -319,7 +327,12 @@ def report(results: list[Result], strategies: list[str], legs: int, out: Path, w
     rows3 = [[short(t)] + [cover[t][c] for c in cols3[1:]] for t in strategies]
     rows4 = [[short(r["team"]), r["rating"], r["ci95"][0], r["ci95"][1]] for r in rates]
     cols4 = ["team", "rating", "ci95_low", "ci95_high"]
-    for name, head, rows in (("table1", h1, rows1), ("table2", cols2, rows2), ("coverage", cols3, rows3), ("ratings", cols4, rows4)):
+    for name, head, rows in (
+        ("table1", h1, rows1),
+        ("table2", cols2, rows2),
+        ("coverage", cols3, rows3),
+        ("ratings", cols4, rows4),
+    ):
         write_atomic(out / f"{name}.csv", csv_text(head, rows))
     md = [
         f"# Tournament: {', '.join(short(s) for s in strategies)}, {legs} legs, seed {seed}",
@@ -382,9 +395,23 @@ class Runner:
     def command(self, fx: Fixture) -> list[str]:
         a = self.args
         argv = [
-            sys.executable, "-m", "arena", "match", "--home", fx.home, "--away", fx.away,
-            "--robots", str(a.robots), "--half-time", str(a.half_time), "--seed", str(fx.seed),
-            "--link", a.link, "--json",
+            sys.executable,
+            "-m",
+            "arena",
+            "match",
+            "--home",
+            fx.home,
+            "--away",
+            fx.away,
+            "--robots",
+            str(a.robots),
+            "--half-time",
+            str(a.half_time),
+            "--seed",
+            str(fx.seed),
+            "--link",
+            a.link,
+            "--json",
         ]
         for p in a.link_param:
             argv += ["--link-param", p]
@@ -400,7 +427,9 @@ class Runner:
                 return None
             t0 = time.monotonic()
             log = open(self.logs_dir / f"{fx.id}.log", "w")  # noqa: SIM115 - handed to the child
-            proc = subprocess.Popen(self.command(fx), stdout=subprocess.PIPE, stderr=log, text=True, start_new_session=True)
+            proc = subprocess.Popen(
+                self.command(fx), stdout=subprocess.PIPE, stderr=log, text=True, start_new_session=True
+            )
             with self._lock:
                 self._running.add(proc)
             try:
@@ -422,8 +451,15 @@ class Runner:
                     reason = "the match printed no JSON"
                     continue
                 r = Result(
-                    id=fx.id, status="ok", score=m["score"], distance_m=m["distance_m"], attempts=attempt,
-                    wall_seconds=round(time.monotonic() - t0, 2), rtf=m["rtf"], digest=m["digest"], **base,
+                    id=fx.id,
+                    status="ok",
+                    score=m["score"],
+                    distance_m=m["distance_m"],
+                    attempts=attempt,
+                    wall_seconds=round(time.monotonic() - t0, 2),
+                    rtf=m["rtf"],
+                    digest=m["digest"],
+                    **base,
                 )
                 write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
                 return r
@@ -477,8 +513,14 @@ def run(args) -> tuple[dict, bool]:
     console = Console(stderr=True)
     show = not args.json and sys.stderr.isatty()
     with Progress(
-        TextColumn("[bold]tournament[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-        TextColumn("{task.fields[last]}"), console=console, disable=not show, transient=False,
+        TextColumn("[bold]tournament[/]"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        TextColumn("{task.fields[last]}"),
+        console=console,
+        disable=not show,
+        transient=False,
     ) as bar:
         task = bar.add_task("t", total=len(fixtures), completed=len(results), last="")
         # SIGTERM (a service manager, `kill`) stops like Ctrl-C: the running
@@ -499,7 +541,9 @@ def run(args) -> tuple[dict, bool]:
                             continue
                         results[r.id] = r
                         last = (
-                            f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}" if r.status == "ok" else f"{r.id} failed"
+                            f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}"
+                            if r.status == "ok"
+                            else f"{r.id} failed"
                         )
                         bar.update(task, advance=1, last=last)
                         if not show and not args.json:
@@ -533,8 +577,10 @@ def print_summary(summary: dict) -> None:
         rr = rate[team]
         ratio = summary["coverage_ratio"][team]
         t.add_row(
-            short(team), *(str(row[k]) for k in ("W", "D", "L", "GF", "GA", "GD", "P")),
-            f"{rr['rating']:.0f} ({rr['ci95'][0]:.0f}..{rr['ci95'][1]:.0f})", "-" if ratio is None else f"{ratio:.2f}",
+            short(team),
+            *(str(row[k]) for k in ("W", "D", "L", "GF", "GA", "GD", "P")),
+            f"{rr['rating']:.0f} ({rr['ci95'][0]:.0f}..{rr['ci95'][1]:.0f})",
+            "-" if ratio is None else f"{ratio:.2f}",
         )
     c.print(t)
     for note in summary["notes"]:

@@ -22,8 +22,22 @@ REPO = Path(__file__).resolve().parents[2]
 def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", "4",
-        "--external", "a/1", "--match", "hil", "--listen", endpoint, "--json",
+        "match",
+        "--home",
+        "BS",
+        "--away",
+        "BS",
+        "--half-time",
+        "20",
+        "--seed",
+        "4",
+        "--external",
+        "a/1",
+        "--match",
+        "hil",
+        "--listen",
+        endpoint,
+        "--json",
     )
     reap.append(match)
     # The launcher says how to start the missing robot; start it exactly so,
@@ -50,8 +64,22 @@ def _client_of_a_match(tmp_path, reap, match_id: str, seed: int):
     """Start a 2 x 20 s BS v BS match on a socket in `tmp_path`; yield (the match process, a client session)."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--half-time", "20", "--seed", str(seed),
-        "--match", match_id, "--listen", endpoint, "--json", "--logs", str(tmp_path / "logs"),
+        "match",
+        "--home",
+        "BS",
+        "--away",
+        "BS",
+        "--half-time",
+        "20",
+        "--seed",
+        str(seed),
+        "--match",
+        match_id,
+        "--listen",
+        endpoint,
+        "--json",
+        "--logs",
+        str(tmp_path / "logs"),
     )
     reap.append(match)
     wait_for(lambda: Path(endpoint.split("/", 1)[1]).exists(), 30, "the router socket")
@@ -118,7 +146,8 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
         referee = session.declare_subscriber("arena/refnoise/referee", zenoh.handlers.FifoChannel(1000))
         # REMOTE: our own subscriber above does not hear the bad frames.
         pub = session.declare_publisher(
-            "arena/refnoise/referee", congestion_control=zenoh.CongestionControl.BLOCK,
+            "arena/refnoise/referee",
+            congestion_control=zenoh.CongestionControl.BLOCK,
             allowed_destination=zenoh.Locality.REMOTE,
         )
         wait_for(lambda: match.poll() is not None or referee.try_recv() is not None, 60, "the match to start")
@@ -130,8 +159,11 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
                 tick = decode(heard.payload.to_bytes()).tick
                 for t in (tick + 5, tick + 10):
                     pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="CELEBRATE")))  # not an MSL command
-                    pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="START",
-                                           commands=[RefCommand(name="CORNER")])))  # a corner for nobody
+                    pub.put(
+                        encode(
+                            Referee(tick=t, stage="FIRST_HALF", command="START", commands=[RefCommand(name="CORNER")])
+                        )
+                    )  # a corner for nobody
                     pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="START", command_team="c")))  # no team c
                 rounds += 1
             time.sleep(0.02)

@@ -10,7 +10,6 @@ import pytest
 from arena.runtime.config import MatchConfig
 from arena.runtime.links import PRESETS
 from arena.tools.inprocess import play_in_process
-
 from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 
 BASE = ("match", "--home", "basic-static", "--away", "basic-static", "--half-time", "30")
@@ -59,7 +58,12 @@ def test_acceptance_command_reports_the_contract(seed7):
     assert r["ticks"] == 3000 and r["sim_seconds"] == pytest.approx(60.0)
     assert r["rtf"] > 1 and r["wall_seconds"] > r["play_wall_seconds"] > 0
     kinds = [(p["kind"], p["team"], p["robot"]) for p in r["processes"]]
-    assert kinds[:4] == [("engine", None, None), ("referee", None, None), ("basestation", "a", None), ("basestation", "b", None)]
+    assert kinds[:4] == [
+        ("engine", None, None),
+        ("referee", None, None),
+        ("basestation", "a", None),
+        ("basestation", "b", None),
+    ]
     assert sorted(k for k in kinds if k[0] == "robot") == [("robot", t, n) for t in "ab" for n in range(3)]
     assert len({p["pid"] for p in r["processes"]}) == 10
     for name in ("KICKOFF", "HALF_TIME", "SECOND_HALF", "END_GAME"):

@@ -58,7 +58,9 @@ def test_the_recording_reads_back_with_crcs_and_every_key_counts_what_was_sent(r
 def test_a_recorded_match_is_the_same_match(recorded):
     """Every process computes what it computes unrecorded (the in-process run, same seed)."""
     _, result = recorded
-    plain, _ = play_in_process(MatchConfig(seed=SEED, home="basic-static", away="advance-dynamic", half_time=8, link="wifi"), watch=())
+    plain, _ = play_in_process(
+        MatchConfig(seed=SEED, home="basic-static", away="advance-dynamic", half_time=8, link="wifi"), watch=()
+    )
     assert result["process_digests"] == {name: s.digest for name, s in plain.items()}
 
 
@@ -145,8 +147,24 @@ def test_a_recorder_started_by_hand_fetches_the_configuration(tmp_path, reap):
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     launcher_side = tmp_path / "launcher-side.mcap"
     match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--half-time", "5", "--seed", "6",
-        "--record", str(launcher_side), "--external", "recorder", "--match", "rec-hil", "--listen", endpoint, "--json",
+        "match",
+        "--home",
+        "BS",
+        "--away",
+        "BS",
+        "--half-time",
+        "5",
+        "--seed",
+        "6",
+        "--record",
+        str(launcher_side),
+        "--external",
+        "recorder",
+        "--match",
+        "rec-hil",
+        "--listen",
+        endpoint,
+        "--json",
     )
     reap.append(match)
     line = wait_for(lambda: match.stderr.readline(), 30, "the launcher's instructions")
@@ -173,7 +191,9 @@ def test_mcap_core_reads_the_recording(recorded, tmp_path):
     path, _ = recorded
     install = subprocess.run(
         ["npm", "install", "--no-audit", "--no-fund", "--prefix", str(tmp_path), "@mcap/core@2", "@mcap/support@1"],
-        capture_output=True, text=True, timeout=600,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert install.returncode == 0, install.stderr[-2000:]
     script = tmp_path / "mcap_check.mjs"

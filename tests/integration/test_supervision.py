@@ -19,7 +19,7 @@ def arena_children(pid: int) -> set[int]:
 
 
 def all_ten(pid: int) -> set[int]:
-    return wait_for(lambda: (k if len(k := arena_children(pid)) == 10 else None), 60, "ten live processes")
+    return wait_for(lambda: k if len(k := arena_children(pid)) == 10 else None, 60, "ten live processes")
 
 
 def test_two_matches_at_once_do_not_hear_each_other(reap):

@@ -24,8 +24,11 @@ def test_interrupt_then_resume(tmp_path, reap, sig):
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
-    wait_for(lambda: not any(os.path.exists(f"/proc/{k}") and "arena" in cmdline(k) for k in kids), 20,
-             "the running match to be stopped with the tournament")
+    wait_for(
+        lambda: not any(os.path.exists(f"/proc/{k}") and "arena" in cmdline(k) for k in kids),
+        20,
+        "the running match to be stopped with the tournament",
+    )
     assert "--resume" in err and "Traceback" not in err
     kept = sorted(p.name for p in matches.glob("*.json"))
     assert 1 <= len(kept) < 3
@@ -41,5 +44,13 @@ def test_interrupt_then_resume(tmp_path, reap, sig):
     assert sum(r["GF"] for r in table.values()) == sum(r["GA"] for r in table.values())
     saved = json.loads((out / "tournament.json").read_text())
     assert saved["table"] == summary["table"]
-    for name in ("report.md", "table1.csv", "table2.csv", "coverage.csv", "ratings.csv", "goal_difference.png", "coverage.png"):
+    for name in (
+        "report.md",
+        "table1.csv",
+        "table2.csv",
+        "coverage.csv",
+        "ratings.csv",
+        "goal_difference.png",
+        "coverage.png",
+    ):
         assert (out / name).stat().st_size > 0, name

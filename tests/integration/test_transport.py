@@ -27,9 +27,10 @@ def test_a_callback_thread_keeps_its_python_thread_state(tmp_path):
             done.set()
 
     endpoint = f"unixsock-stream/{tmp_path}/s.sock"
-    with open_session(NetConfig(mode="peer", listen=(endpoint,))) as receiver, open_session(
-        NetConfig(mode="peer", connect=(endpoint,))
-    ) as sender:
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as receiver,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as sender,
+    ):
         rx, tx = ZenohTransport(receiver), ZenohTransport(sender)
         rx.subscribe_callback("arena/t/x", on_frame)
         put = tx.publisher("arena/t/x")

@@ -33,12 +33,26 @@ def test_bad_config_is_rejected_with_a_reason(data, message):
 
 def test_processes_of_a_match():
     names = [str(p) for p in MatchConfig(robots=2).processes()]
-    assert names == ["engine", "referee", "basestation/a", "basestation/b", "robot/a/0", "robot/a/1", "robot/b/0", "robot/b/1"]
+    assert names == [
+        "engine",
+        "referee",
+        "basestation/a",
+        "basestation/b",
+        "robot/a/0",
+        "robot/a/1",
+        "robot/b/0",
+        "robot/b/1",
+    ]
 
 
 @pytest.mark.parametrize(
     ("text", "pid"),
-    [("a/1", ProcessId("robot", "a", 1)), ("robot/b/0", ProcessId("robot", "b", 0)), ("basestation/a", ProcessId("basestation", "a")), ("engine", ProcessId("engine"))],
+    [
+        ("a/1", ProcessId("robot", "a", 1)),
+        ("robot/b/0", ProcessId("robot", "b", 0)),
+        ("basestation/a", ProcessId("basestation", "a")),
+        ("engine", ProcessId("engine")),
+    ],
 )
 def test_process_names(text, pid):
     assert ProcessId.parse(text) == pid

@@ -48,7 +48,11 @@ def _pid_reference(state: pid.PIDState, beta: float, theta: float, p: pid.PIDPar
 
 def test_pid_update_is_bit_identical_to_eq_16():
     rng = random.Random(3)
-    params = (pid.PIDParams(), pid.PIDParams(k_p=6.0, k_i=0.0, k_d=2.0), pid.PIDParams(max_output=2.0, max_integral=0.5))
+    params = (
+        pid.PIDParams(),
+        pid.PIDParams(k_p=6.0, k_i=0.0, k_d=2.0),
+        pid.PIDParams(max_output=2.0, max_integral=0.5),
+    )
     for p in params:
         a = b = pid.PIDState()
         for _ in range(5000):
@@ -63,13 +67,23 @@ def test_robot_view_merges_the_order_with_own_detections():
     cfg = MatchConfig()
     view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams())
     order = Order(
-        tick=10, robot=1, command="START", attack_dir=1,
+        tick=10,
+        robot=1,
+        command="START",
+        attack_dir=1,
         own=[TeamPose(robot=0, x=-5.5, y=0.0), TeamPose(robot=1, x=0.0, y=0.0), TeamPose(robot=2, x=2.0, y=1.0)],
-        opponents=[TeamPose(robot=-1, x=1.0, y=0.0, age=0), TeamPose(robot=-1, x=3.0, y=-2.0, age=0),
-                   TeamPose(robot=-1, x=4.0, y=2.0, age=500)],
+        opponents=[
+            TeamPose(robot=-1, x=1.0, y=0.0, age=0),
+            TeamPose(robot=-1, x=3.0, y=-2.0, age=0),
+            TeamPose(robot=-1, x=4.0, y=2.0, age=500),
+        ],
     )
-    sense = Sense(tick=12, pose=Pose(x=0.0, y=0.0, theta=0.0), ball=BallSeen(visible=False),
-                  robots=[RobotSeen(team="b", x=1.1, y=0.1), RobotSeen(team="a", x=2.1, y=1.0)])
+    sense = Sense(
+        tick=12,
+        pose=Pose(x=0.0, y=0.0, theta=0.0),
+        ball=BallSeen(visible=False),
+        robots=[RobotSeen(team="b", x=1.1, y=0.1), RobotSeen(team="a", x=2.1, y=1.0)],
+    )
     view.update(12, sense, order)
     assert view.opponents == [(1.1, 0.1), (3.0, -2.0)]  # (1, 0) is the own detection; (4, 2) is too old
     assert view.mate_obstacles == [(2.1, 1.0), (-5.5, 0.0)]  # (2, 1) is the own detection

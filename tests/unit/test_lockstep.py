@@ -44,7 +44,7 @@ class ScriptedLink(LinkEmulator):
 
 
 class Harness:
-    def __init__(self, model=LinkModel(), schedule=EVERY_TICK, lag=1, timeout=5.0, emulator=None):
+    def __init__(self, model=None, schedule=EVERY_TICK, lag=1, timeout=5.0, emulator=None):
         self.bus = MemoryBus()
         self.rx = MemoryTransport(self.bus)
         self.tx = MemoryTransport(self.bus)
@@ -53,9 +53,18 @@ class Harness:
         self.gone: set[str] = set()
         self.wd = Watchdog(self.rx, timeout)
         self.inbound = Inbound(
-            key=KEY, msg_type=Cmd, channel=self.rx.subscribe(KEY), schedule=schedule, lag=lag,
-            link_class="sensor", sender="robot/a/1", emulator=emulator or LinkEmulator(model, random.Random(1)),
-            dt=0.02, rejections=self.rej, watchdog=self.wd, is_dead=self.gone.__contains__,
+            key=KEY,
+            msg_type=Cmd,
+            channel=self.rx.subscribe(KEY),
+            schedule=schedule,
+            lag=lag,
+            link_class="sensor",
+            sender="robot/a/1",
+            emulator=emulator or LinkEmulator(model or LinkModel(), random.Random(1)),
+            dt=0.02,
+            rejections=self.rej,
+            watchdog=self.wd,
+            is_dead=self.gone.__contains__,
             on_dead=self.dead.__setitem__,
         )
         self.put = self.tx.publisher(KEY)

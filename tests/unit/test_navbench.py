@@ -51,7 +51,13 @@ def test_the_builtin_file_holds_the_papers_experiments(spec):
     assert [m.name for m in spec.local_minima] == ["SAROG", "GNRON"]
     schemes = {s.name: s for s in spec.scenarios[0].schemes}
     assert [schemes[n].method for n in ("#1", "#2", "#3", "#4", "#5", "#6", "MAPF")] == [
-        "sfm", "sfm", "apf", "apf", "f-sfm", "f-sfm", "mapf"
+        "sfm",
+        "sfm",
+        "apf",
+        "apf",
+        "f-sfm",
+        "f-sfm",
+        "mapf",
     ]
     assert (schemes["#1"].params.k, schemes["#2"].params.k) == (100.0, 300.0)
     assert (schemes["#3"].params.k_r, schemes["#4"].params.k_r) == (100.0, 300.0)
@@ -81,7 +87,7 @@ def test_a_user_file_adds_a_scenario_without_code(tmp_path):
 
 
 def test_user_defaults_override_the_builtin_ones_key_by_key(tmp_path):
-    text = '[defaults]\nrobot_params = { max_accel = 4.0 }\n[defaults.noise]\nsensor = false\n' + MINI
+    text = "[defaults]\nrobot_params = { max_accel = 4.0 }\n[defaults.noise]\nsensor = false\n" + MINI
     (sc,) = nb.load(write(tmp_path, text)).scenarios
     assert sc.robot.max_accel == 4.0 and sc.robot.mass == 20.0
     assert not sc.spec.noise.sensor and sc.spec.noise.obstacle_start_sigma == 0.1
@@ -103,9 +109,16 @@ def test_user_defaults_override_the_builtin_ones_key_by_key(tmp_path):
         (MINI + '[[scheme]]\nname = "#1"\nmethod = "sfm"\nparams = { kk = 1.0 }\n', "unknown parameter 'kk'"),
         (MINI + '[[scheme]]\nname = "#1"\nmethod = "rrt"\n', "unknown method 'rrt'"),
         (MINI + '[[scheme]]\nname = "#1"\nmethod = "sfm"\nparams = { k = "big" }\n', "expected float"),
-        (MINI.replace("time_limit = 6.0", "time_limit = 6.0\nrobot_params = { wings = 2 }"), "unknown parameter 'wings'"),
-        (MINI.replace("obstacles = [", "obstacles = [{ start = [0.0, 1.0], velocity = [1.0, 0.0], pursue_speed = 1.0 }, "),
-         "both velocity and pursue_speed"),
+        (
+            MINI.replace("time_limit = 6.0", "time_limit = 6.0\nrobot_params = { wings = 2 }"),
+            "unknown parameter 'wings'",
+        ),
+        (
+            MINI.replace(
+                "obstacles = [", "obstacles = [{ start = [0.0, 1.0], velocity = [1.0, 0.0], pursue_speed = 1.0 }, "
+            ),
+            "both velocity and pursue_speed",
+        ),
     ],
 )
 def test_a_malformed_file_gives_one_clear_line(tmp_path, text, needle):
@@ -173,9 +186,11 @@ def test_every_scheme_meets_the_same_obstacles_in_a_trial(spec):
 
 def test_contacts_are_the_engines_collisions(tmp_path):
     """An APF that never repels drives into the obstacle on its path; one far off the path is never touched."""
-    text = MINI.replace('schemes = ["#1", "#5"]', 'schemes = ["blind"]').replace(
-        "{ start = [0.0, 0.3] }", "{ start = [0.0, 0.0] }"
-    ).replace("{ start = [0.5, -2.0], velocity = [0.0, 1.0] }", "{ start = [0.0, 3.5] }")
+    text = (
+        MINI.replace('schemes = ["#1", "#5"]', 'schemes = ["blind"]')
+        .replace("{ start = [0.0, 0.3] }", "{ start = [0.0, 0.0] }")
+        .replace("{ start = [0.5, -2.0], velocity = [0.0, 1.0] }", "{ start = [0.0, 3.5] }")
+    )
     text = "[defaults.noise]\nsensor = false\nobstacle_start_sigma = 0.0\n" + text
     text += '[[scheme]]\nname = "blind"\nmethod = "apf"\nparams = { safe_distance = 0.001 }\n'
     (sc,) = nb.load(write(tmp_path, text)).scenarios

@@ -65,7 +65,14 @@ def run_diffdrive(module, params, obstacle, goal, steps, start=(0.0, 0.0, 0.0), 
 
 @pytest.mark.parametrize(
     ("angle", "want"),
-    [(0.0, 0.0), (math.pi, math.pi), (-math.pi, math.pi), (3 * math.pi, math.pi), (2 * math.pi + 0.1, 0.1), (-0.1, -0.1)],
+    [
+        (0.0, 0.0),
+        (math.pi, math.pi),
+        (-math.pi, math.pi),
+        (3 * math.pi, math.pi),
+        (2 * math.pi + 0.1, 0.1),
+        (-0.1, -0.1),
+    ],
 )
 def test_wrap_angle_to_half_open_interval(angle, want):
     assert wrap_angle(angle) == pytest.approx(want)
@@ -167,7 +174,9 @@ def test_gnron_apf_stalls_short_of_goal_mapf_reaches_it():
 
 
 @pytest.mark.parametrize(
-    ("name", "module", "params"), [("apf", apf, apf.APFParams()), ("mapf", mapf, mapf.ENVIRONMENT_1)], ids=["apf", "mapf"]
+    ("name", "module", "params"),
+    [("apf", apf, apf.APFParams()), ("mapf", mapf, mapf.ENVIRONMENT_1)],
+    ids=["apf", "mapf"],
 )
 def test_sarog_exact_alignment_is_an_equilibrium_for_a_point_mass(name, module, params):
     # Paper 3 environment 1 (robot (0,0), obstacle (0.9,0), goal (1.5,0)). On the line the
@@ -180,7 +189,9 @@ def test_sarog_exact_alignment_is_an_equilibrium_for_a_point_mass(name, module, 
 
 
 @pytest.mark.parametrize(
-    ("name", "module", "params"), [("apf", apf, apf.APFParams()), ("mapf", mapf, mapf.ENVIRONMENT_1)], ids=["apf", "mapf"]
+    ("name", "module", "params"),
+    [("apf", apf, apf.APFParams()), ("mapf", mapf, mapf.ENVIRONMENT_1)],
+    ids=["apf", "mapf"],
 )
 def test_sarog_differential_drive_goes_round_the_obstacle(name, module, params):
     # The same alignment with paper 3's whole loop (eq. 9, 11, 13, 8 and Table I gains): when
@@ -544,6 +555,8 @@ def test_navigator_heads_for_the_goal_in_free_space(name):
 @pytest.mark.parametrize("name", NAMES)
 def test_navigator_reaches_goal_past_an_offset_obstacle(name):
     obstacles = [(2.0, 0.15)]
-    q, min_d, reached = run_point_mass(NAVIGATORS[name], PARAMS[name](), (0.0, 0.0), (4.0, 0.0), obstacles, 1000, tol=0.05)
+    q, min_d, reached = run_point_mass(
+        NAVIGATORS[name], PARAMS[name](), (0.0, 0.0), (4.0, 0.0), obstacles, 1000, tol=0.05
+    )
     assert reached is not None, f"{name} ended at {q}"
     assert min_d > 0.25, name

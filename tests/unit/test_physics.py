@@ -177,8 +177,12 @@ def test_long_random_run_keeps_ball_inside_fence_and_robots_apart():
                     a = math.atan2(by - y, bx - x) - th
                     c = cmd(vx=4.0 * math.cos(a), vy=4.0 * math.sin(a), omega=3.0 * wrap_angle(a), dribbler=True)
                 else:
-                    c = cmd(vx=rnd.uniform(-6, 6), vy=rnd.uniform(-6, 6), omega=rnd.uniform(-7, 7),
-                            dribbler=rnd.random() < 0.3)
+                    c = cmd(
+                        vx=rnd.uniform(-6, 6),
+                        vy=rnd.uniform(-6, 6),
+                        omega=rnd.uniform(-7, 7),
+                        dribbler=rnd.random() < 0.3,
+                    )
                 if rnd.random() < 0.2:
                     c.kick_speed = rnd.uniform(1.0, 10.0)
                     c.kick_lob = rnd.random() < 0.3
@@ -193,7 +197,7 @@ def test_long_random_run_keeps_ball_inside_fence_and_robots_apart():
         poses = [ph.robot_pose(t, n) for t, n in ids]
         for i, (x, y, _) in enumerate(poses):
             assert abs(x) <= xf - R.size / 2 + 0.01 and abs(y) <= yf - R.size / 2 + 0.01, f"tick {tick}: robot {ids[i]}"
-            for x2, y2, _ in poses[i + 1:]:
+            for x2, y2, _ in poses[i + 1 :]:
                 assert math.hypot(x - x2, y - y2) >= R.size - 0.02, f"tick {tick}: robots overlap"
 
 
@@ -511,7 +515,7 @@ def test_kickoff_positions(robots, attack_dir_a, kicking):
             assert math.hypot(x, y) >= F.center_circle_radius + R.size / 2
     pts = list(poses.values())
     for i, (x, y) in enumerate(pts):
-        for x2, y2 in pts[i + 1:]:
+        for x2, y2 in pts[i + 1 :]:
             assert math.hypot(x - x2, y - y2) > R.size * 1.5
 
 
@@ -526,9 +530,14 @@ def test_two_instances_with_the_same_commands_agree_at_every_tick():
     for tick in range(1, 801):
         if tick % 5 == 1:
             cmds = {
-                r: cmd(vx=rnd.uniform(-5, 5), vy=rnd.uniform(-5, 5), omega=rnd.uniform(-6, 6),
-                       dribbler=rnd.random() < 0.5, kick_speed=rnd.choice([0.0, 0.0, 0.0, 6.0]),
-                       kick_lob=rnd.random() < 0.5)
+                r: cmd(
+                    vx=rnd.uniform(-5, 5),
+                    vy=rnd.uniform(-5, 5),
+                    omega=rnd.uniform(-6, 6),
+                    dribbler=rnd.random() < 0.5,
+                    kick_speed=rnd.choice([0.0, 0.0, 0.0, 6.0]),
+                    kick_lob=rnd.random() < 0.5,
+                )
                 for r in ids
             }
             for ph in worlds:

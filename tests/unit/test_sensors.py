@@ -5,10 +5,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import random
-
-import numpy as np
 import statistics
 
+import numpy as np
 import pytest
 
 from arena.processes.physics import Physics

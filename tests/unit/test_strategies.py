@@ -45,7 +45,9 @@ class _CreepRobot:
         return Report(tick=tick, robot=self.n, pose=pose)
 
 
-PLUGIN = Strategy(name="creep", make_team=_StandTeam, make_robot=_CreepRobot, aliases=("CR",), description="test plugin")
+PLUGIN = Strategy(
+    name="creep", make_team=_StandTeam, make_robot=_CreepRobot, aliases=("CR",), description="test plugin"
+)
 
 
 @pytest.mark.parametrize("name", sorted(registry.all_strategies()))
@@ -100,7 +102,12 @@ def test_a_plugin_entry_point_is_found_and_plays(monkeypatch):
 
 def test_paper_names_and_chase_are_registered():
     names = registry.all_strategies()
-    for name, alias in (("basic-static", "BS"), ("basic-dynamic", "BD"), ("advance-static", "AS"), ("advance-dynamic", "AD")):
+    for name, alias in (
+        ("basic-static", "BS"),
+        ("basic-dynamic", "BD"),
+        ("advance-static", "AS"),
+        ("advance-dynamic", "AD"),
+    ):
         assert registry.resolve_name(alias) == name
         assert names[name].make_robot.__module__.endswith("iris")
     assert "chase" in names
@@ -129,7 +136,9 @@ def test_fig6_transition(state, inp, want):
     assert R.transition(state, inp) == want
 
 
-@pytest.mark.parametrize(("own", "opp", "want"), [(0, 0, R.S_LEVEL), (2, 2, R.S_LEVEL), (0, 1, R.S_OFFENSIVE), (3, 1, R.S_DEFENSIVE)])
+@pytest.mark.parametrize(
+    ("own", "opp", "want"), [(0, 0, R.S_LEVEL), (2, 2, R.S_LEVEL), (0, 1, R.S_OFFENSIVE), (3, 1, R.S_DEFENSIVE)]
+)
 def test_strategy_choice(own, opp, want):
     assert R.choose_strategy(own, opp) == want
 
@@ -232,8 +241,16 @@ def test_holder_and_poses_come_from_reports():
 
 def test_robot_view_uses_its_own_ball_else_the_base_station_model():
     v = RobotView("a", 1, SensorParams(), 0.02)
-    order = Order(tick=10, robot=1, ball_valid=True, ball_x=3.0, ball_y=-1.0, ball_age=2,
-                  opponents=[TeamPose(robot=-1, x=4.0, y=0.0)], own=[TeamPose(robot=2, x=-2.0, y=0.0, role="defender")])
+    order = Order(
+        tick=10,
+        robot=1,
+        ball_valid=True,
+        ball_x=3.0,
+        ball_y=-1.0,
+        ball_age=2,
+        opponents=[TeamPose(robot=-1, x=4.0, y=0.0)],
+        own=[TeamPose(robot=2, x=-2.0, y=0.0, role="defender")],
+    )
     sense = Sense(tick=12, pose=Pose(x=0.0, y=0.0, theta=0.0), ball=BallSeen(visible=True, x=1.0, y=0.5))
     v.update(12, sense, order)
     assert v.ball == (1.0, 0.5) and v.ball_age == 0
@@ -241,8 +258,15 @@ def test_robot_view_uses_its_own_ball_else_the_base_station_model():
     blind = Sense(tick=13, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=[RobotSeen(team="b", x=4.1, y=0.0)])
     v.update(13, blind, order)
     assert v.ball == (1.0, 0.5) and v.ball_age == 1  # own sighting 1 tick old beats the order's 5
-    fresh = Order(tick=38, robot=1, ball_valid=True, ball_x=3.0, ball_y=-1.0, ball_age=0,
-                  opponents=[TeamPose(robot=-1, x=4.0, y=0.0)])
+    fresh = Order(
+        tick=38,
+        robot=1,
+        ball_valid=True,
+        ball_x=3.0,
+        ball_y=-1.0,
+        ball_age=0,
+        opponents=[TeamPose(robot=-1, x=4.0, y=0.0)],
+    )
     v.update(40, blind, fresh)
     assert v.ball == (3.0, -1.0) and v.ball_age == 2  # own sighting (27 ticks) older than the base station's
     assert v.opponents == [(4.1, 0.0)]  # the order's P_B entry is explained by an own detection

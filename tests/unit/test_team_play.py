@@ -97,8 +97,12 @@ def _body_to_field(c: Cmd, theta: float) -> tuple[float, float]:
 def test_advance_defender_blocks_the_kick_line_one_metre_from_the_carrier():
     robot = _robot("AD", n=2)
     carrier, ball = (-1.0, 0.0), (-1.35, 0.0)  # opponent dribbling towards our goal at -x
-    sense = Sense(tick=10, pose=Pose(x=-3.0, y=0.8, theta=0.0), ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
-                  robots=[RobotSeen(team="b", x=carrier[0], y=carrier[1])])
+    sense = Sense(
+        tick=10,
+        pose=Pose(x=-3.0, y=0.8, theta=0.0),
+        ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+        robots=[RobotSeen(team="b", x=carrier[0], y=carrier[1])],
+    )
     own = [TeamPose(robot=1, x=2.0, y=0.0, role="attacker"), TeamPose(robot=2, x=-3.0, y=0.8, role="defender")]
     cmd = None
     for t in range(10, 14):
@@ -120,9 +124,14 @@ def _holding(name: str, pos: tuple[float, float], opponents: list[tuple[float, f
     cmd = Cmd(tick=0)
     for t in range(tick, tick + 50):
         ball = (pos[0] + REACH * math.cos(theta), pos[1] + REACH * math.sin(theta))
-        sense = Sense(tick=t, pose=Pose(x=pos[0], y=pos[1], theta=theta), omega=cmd.omega,
-                      ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
-                      robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents], has_ball=True)
+        sense = Sense(
+            tick=t,
+            pose=Pose(x=pos[0], y=pos[1], theta=theta),
+            omega=cmd.omega,
+            ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+            robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents],
+            has_ball=True,
+        )
         cmd = robot.step(t, sense, order)
         if cmd.kick_speed > 0.0:
             return cmd
@@ -148,17 +157,27 @@ def test_a_robot_that_loses_the_ball_steps_off_it_with_the_dribbler_off():
     ball = BallSeen(visible=True, x=REACH, y=0.0)
     tackler = [RobotSeen(team="b", x=REACH + 0.45, y=0.0)]
     own = [TeamPose(robot=1, x=0.0, y=0.0, role="attacker")]
-    robot.step(30, Sense(tick=30, pose=pose, ball=ball, robots=tackler, has_ball=True),
-               _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own))
-    cmd = robot.step(31, Sense(tick=31, pose=pose, ball=ball, robots=tackler, has_ball=False),
-                     _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own))
+    robot.step(
+        30,
+        Sense(tick=30, pose=pose, ball=ball, robots=tackler, has_ball=True),
+        _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own),
+    )
+    cmd = robot.step(
+        31,
+        Sense(tick=31, pose=pose, ball=ball, robots=tackler, has_ball=False),
+        _order(29, 1, "attacker", R.ATTACKING_ATTACKER, own=own),
+    )
     assert not cmd.dribbler and cmd.vx < 0.0  # backs straight off the ball instead of wrestling for it
 
 
 def test_the_push_guard_stops_a_robot_from_shoving_an_opponent():
     robot = _robot("AD")
-    sense = Sense(tick=5, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=[RobotSeen(team="b", x=0.55, y=0.0)],
-                  ball=BallSeen(visible=True, x=-3.0, y=0.0))
+    sense = Sense(
+        tick=5,
+        pose=Pose(x=0.0, y=0.0, theta=0.0),
+        robots=[RobotSeen(team="b", x=0.55, y=0.0)],
+        ball=BallSeen(visible=True, x=-3.0, y=0.0),
+    )
     robot.step(5, sense, _order(4, 1, "attacker", R.ATTACKING_ATTACKER))
     cmd = robot.drive(5, (3.0, 0.0), 0.0, 2.5, avoid=False)  # straight through the opponent in contact
     assert cmd.vx <= 1e-9
@@ -189,7 +208,7 @@ def test_the_loser_of_a_challenge_cannot_win_the_ball_straight_back():
     quiet = math.ceil(NO_CHALLENGE_S / CFG.timing.dt)
     assert first <= 2
     # a, the loser, still touches the ball with its dribbler on, but b keeps it until a may challenge again
-    assert all(h == ("b", 0) for h in holders[first:quiet - 1]), holders
+    assert all(h == ("b", 0) for h in holders[first : quiet - 1]), holders
 
 
 # ------------------------------------------------- advance defense (issue 4, goal rates)
@@ -211,10 +230,23 @@ def test_block_point_is_on_the_ball_kick_line_one_metre_from_the_carrier():
 def _defending_view(robot, pose, ball, opponents, own, tick=10):
     cmd = None
     for t in range(tick, tick + 4):
-        sense = Sense(tick=t, pose=Pose(x=pose[0], y=pose[1], theta=0.0), ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
-                      robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents])
-        cmd = robot.step(t, sense, _order(tick - 1, robot.n, robot.role or "defender",
-                                          R.DEFENDING_DEFENDER if robot.n == 2 else R.DEFENDING_ATTACKER, own=own))
+        sense = Sense(
+            tick=t,
+            pose=Pose(x=pose[0], y=pose[1], theta=0.0),
+            ball=BallSeen(visible=True, x=ball[0], y=ball[1]),
+            robots=[RobotSeen(team="b", x=x, y=y) for x, y in opponents],
+        )
+        cmd = robot.step(
+            t,
+            sense,
+            _order(
+                tick - 1,
+                robot.n,
+                robot.role or "defender",
+                R.DEFENDING_DEFENDER if robot.n == 2 else R.DEFENDING_ATTACKER,
+                own=own,
+            ),
+        )
     return cmd
 
 
@@ -253,8 +285,17 @@ def test_advance_defense_walls_the_kick_line_at_an_opponent_free_kick():
     own = [TeamPose(robot=1, x=-3.0, y=0.0, role="attacker"), TeamPose(robot=2, x=1.0, y=0.0, role="defender")]
     robot = _robot("AD", n=1)
     sense = Sense(tick=5, pose=Pose(x=-3.0, y=0.0, theta=0.0), ball=BallSeen(visible=True, x=spot[0], y=spot[1]))
-    fk = Order(tick=4, robot=1, command="FREEKICK", command_team="b", spot_x=spot[0], spot_y=spot[1], attack_dir=1,
-               role="attacker", own=own)
+    fk = Order(
+        tick=4,
+        robot=1,
+        command="FREEKICK",
+        command_team="b",
+        spot_x=spot[0],
+        spot_y=spot[1],
+        attack_dir=1,
+        role="attacker",
+        own=own,
+    )
     wall = robot.setpiece_defense(fk, spot) if robot.step(5, sense, fk) is not None else None
     assert S.segment_distance(wall, spot, (-6.0, 0.0))[0] == pytest.approx(0.0, abs=1e-9)  # on the kick line
     assert S.dist(wall, spot) == pytest.approx(2.2)  # as near as the rules allow, and a little more

@@ -21,8 +21,16 @@ AD, AS, BD, BS = "advance-dynamic", "advance-static", "basic-dynamic", "basic-st
 def match(home, away, h, a, leg=1, dist=None):
     first, second = sorted((home, away))
     return Result(
-        id=f"{home}-{away}-{leg}", first=first, second=second, leg=leg, home=home, away=away, seed=leg,
-        status="ok", score=[h, a], distance_m=dist or {},
+        id=f"{home}-{away}-{leg}",
+        first=first,
+        second=second,
+        leg=leg,
+        home=home,
+        away=away,
+        seed=leg,
+        status="ok",
+        score=[h, a],
+        distance_m=dist or {},
     )
 
 
@@ -125,8 +133,8 @@ def test_every_rating_lies_inside_its_own_interval():
         (BD, BS): (1, 3, 6),
     }
     results = []
-    for (a, b), (w, d, l) in wdl.items():
-        scores = [(1, 0)] * w + [(1, 1)] * d + [(0, 1)] * l
+    for (a, b), (w, d, lost) in wdl.items():
+        scores = [(1, 0)] * w + [(1, 1)] * d + [(0, 1)] * lost
         results += [match(a, b, h, g, leg=i) if i % 2 else match(b, a, g, h, leg=i) for i, (h, g) in enumerate(scores)]
     rows, _ = ratings(results, [AD, AS, BD, BS])
     for r in rows:

@@ -32,8 +32,15 @@ class WallTeam:
             attack = referee.attack_dir_a if self.team == "a" else -referee.attack_dir_a
         bx, by = self.ball or (0.0, 0.0)
         return {
-            n: Order(tick=tick, robot=n, command=command, attack_dir=attack, ball_valid=self.ball is not None,
-                     ball_x=bx, ball_y=by)
+            n: Order(
+                tick=tick,
+                robot=n,
+                command=command,
+                attack_dir=attack,
+                ball_valid=self.ball is not None,
+                ball_x=bx,
+                ball_y=by,
+            )
             for n in range(self.robots)
         }
 
@@ -65,5 +72,10 @@ class WallRobot:
         return Report(tick=tick, robot=self.n, pose=sense.pose, ball=sense.ball, robots=sense.robots)
 
 
-STRATEGY = Strategy(name="wall", make_team=WallTeam, make_robot=WallRobot, aliases=("W",),
-                    description="example plugin: a wall between the ball and the own goal")
+STRATEGY = Strategy(
+    name="wall",
+    make_team=WallTeam,
+    make_robot=WallRobot,
+    aliases=("W",),
+    description="example plugin: a wall between the ball and the own goal",
+)
