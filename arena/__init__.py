@@ -1,8 +1,8 @@
 """soccer-arena: wheeled-robot soccer as separate OS processes over zenoh.
 
-The repository keeps `runtime/`, `processes/`, `schemas/`, `tools/` and
-`strategies/` at its top; they install as `arena.runtime`, `arena.processes`,
-and so on (see pyproject.toml).
+Every top-level folder of the repository installs under this one import root:
+`arena.x.y` is `x/y.py` (`arena.sim.physics` is sim/physics.py); see
+pyproject.toml and docs/architecture.md for the package map.
 """
 
 __version__ = "0.1.0"

@@ -251,7 +251,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     record = record_path(args.record) if args.record else ""
     cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
     if args.match:
-        from arena.runtime.keys import check_match_id
+        from arena.schemas.keys import check_match_id
 
         try:
             check_match_id(args.match)
@@ -314,7 +314,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.record and args.kind not in ("engine", "recorder"):
             raise ConfigError(f"--record does not apply to {args.kind}")
         record = record_path(args.record) if args.record and args.kind == "recorder" else None
-        from arena.runtime.keys import check_match_id
+        from arena.schemas.keys import check_match_id
 
         check_match_id(args.match)
     except (ConfigError, ValueError) as exc:

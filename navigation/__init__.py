@@ -27,7 +27,8 @@ The contract is spelled out in :mod:`.base`. Heading and wheels:
 :mod:`.pid` (paper 1 eq. 15-16), :mod:`.omni3` (paper 1 eq. 1-2),
 :mod:`.omni4` (paper 2 eq. 3-4), :mod:`.diffdrive` (paper 3 eq. 8, 9, 11, 13),
 :mod:`.saturation` (direction-keeping wheel-speed limit), :mod:`.frames`.
-See docs/navigation.md.
+See docs/navigation.md. Imports nothing of arena but itself; used by `arena.sim`,
+`arena.strategies` and `arena.tools`.
 """
 
 from __future__ import annotations

@@ -1,5 +1,9 @@
-"""One module per process kind, all shaped the same: a `Node` subclass whose
-`loop()` holds the logic; argument parsing stays in arena/cli.py."""
+"""The process kinds and nothing else: one module per kind (engine, referee,
+basestation, robot, recorder), all shaped the same: a `Node` subclass with its
+wiring, `act` and its loops; argument parsing stays in arena/cli.py. The
+library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
+`arena.strategies`, `arena.runtime`, `arena.schemas`. Only `arena.tools` and
+`arena.cli` import this package."""
 
 from __future__ import annotations
 

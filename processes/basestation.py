@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 
-from arena.processes.referee_box import check_referee
+from arena.rules.referee_box import check_referee
 from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
 from arena.strategies import registry

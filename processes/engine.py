@@ -31,16 +31,16 @@ import time
 
 import numpy as np
 
-from arena.processes import setpieces
-from arena.processes.drive import Drive
-from arena.processes.physics import Physics
-from arena.processes.referee_box import check_referee
-from arena.processes.sensors import NormalStream, sense
+from arena.rules import setpieces
+from arena.rules.referee_box import check_referee
 from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
 from arena.runtime.node import Node
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
+from arena.sim.drive import Drive
+from arena.sim.physics import Physics
+from arena.sim.sensors import NormalStream, sense
 
 
 def check_cmd(cmd: Cmd, wheels: int) -> str | None:

@@ -10,7 +10,7 @@ collects the batches on `arena/<m>/tap/**` and writes:
   a schema record named after the key's message type (schema encoding `""`:
   msgpack is self-describing; the types' JSON Schemas are in the `schemas`
   metadata, for information);
-* `/scene` and `/referee_log`, the Foxglove layer (processes/scene.py);
+* `/scene` and `/referee_log`, the Foxglove layer (recording/scene.py);
 * metadata `arena` (configuration, seed, strategies, git revision), `versions`,
   `schemas`, one `summary/<process>` per process Summary, and `recording`
   (complete or not).
@@ -27,7 +27,7 @@ so after SIGKILL the file is readable up to the last whole chunk.
 
 Cost: the recorder is never on the lockstep's critical path (nobody waits for
 it), so it runs at a lower CPU priority (`NICE`) and catches up in the gaps
-the lockstep leaves; its work per message is kept small (processes/mcap_out.py).
+the lockstep leaves; its work per message is kept small (recording/writer.py).
 """
 
 from __future__ import annotations
@@ -45,11 +45,11 @@ from typing import IO
 
 import msgspec
 
-from arena.processes import scene
-from arena.processes.mcap_out import McapWriter
+from arena.recording import scene
+from arena.recording.writer import McapWriter
 from arena.runtime.config import TEAMS, ConfigError
-from arena.runtime.keys import KEYS
 from arena.runtime.node import Node
+from arena.schemas.keys import KEYS
 from arena.schemas.messages import EngineEvents, Referee, Summary, TapBatch, World
 
 FORMAT = "1"  # version of the layout described in docs/recording.md

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-from arena.processes.referee_box import RefereeBox
+from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
 

@@ -94,7 +94,7 @@ EPUCK = RobotParams(
     kick_max_speed=0.0,  # [m/s] no kicker
 )
 """The E-puck of paper 3 (`arena bench nav`). Its model "diff" is the engine's
-differential drive (`processes/drive.py`); `MatchConfig.validate` still
+differential drive (`sim/drive.py`); `MatchConfig.validate` still
 accepts only the soccer robots omni4 and omni3 for matches."""
 
 

@@ -26,12 +26,12 @@ from typing import Any, TypeVar
 
 from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.keys import KEY_BY_NAME, Keys
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
 from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
+from arena.schemas.keys import KEY_BY_NAME, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 

@@ -3,7 +3,7 @@
 Multicast scouting is off unless asked for, and every session has explicit
 endpoints, so twenty matches on one machine, or CI next to other zenoh
 processes on port 7447, never hear each other. On top of that every match has
-its own key prefix (runtime/keys.py).
+its own key prefix (schemas/keys.py).
 
 Topology used by `arena match`: a router listens on a per-match endpoint (a
 unix socket in the match's temp dir, or a TCP port); every process opens a

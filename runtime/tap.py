@@ -26,9 +26,8 @@ from collections.abc import Callable
 from typing import Any
 
 from arena.runtime.lockstep import Outbound
+from arena.schemas.keys import TAP_PERIOD
 from arena.schemas.messages import TapBatch, TapFrame, encode
-
-TAP_PERIOD = 50  # [ticks] one batch per process every 1 s of simulated time (at 20 ms ticks)
 
 
 class Tap:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 
-from arena.processes import setpieces
+from arena.rules import setpieces
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.strategies.base import RobotContext, Strategy, TeamContext

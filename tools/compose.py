@@ -21,9 +21,9 @@ from pathlib import Path
 import yaml
 
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.keys import Keys
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
+from arena.schemas.keys import Keys
 from arena.tools import launcher
 
 _VAR = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)(?::?-([^}]*))?\}")

@@ -11,8 +11,8 @@ import threading
 
 from arena.processes import node_class
 from arena.runtime.config import MatchConfig
-from arena.runtime.keys import Keys
 from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.schemas.keys import Keys
 from arena.schemas.messages import Summary
 
 

@@ -28,9 +28,9 @@ from pathlib import Path
 import msgspec
 
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.keys import Keys
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
+from arena.schemas.keys import Keys
 from arena.schemas.messages import Referee, Summary
 
 _PR_SET_PDEATHSIG = 1

@@ -15,8 +15,8 @@
   minimum clearance.
 
 Everything is stepped in this process through the engine's own robot model:
-`processes/physics.py` (pymunk bodies driven through `processes/drive.py`'s
-wheels, the same code a match runs) and `processes/sensors.py` for perception.
+`sim/physics.py` (pymunk bodies driven through `sim/drive.py`'s
+wheels, the same code a match runs) and `sim/sensors.py` for perception.
 The robot is team a's robot 0; the obstacles are team b's robots, opponents of
 the same model, driven by scripted commands. A collision is the engine's own
 robot-robot contact event (FOUL_PUSHING with the pushing threshold at -inf, so
@@ -49,13 +49,13 @@ import numpy as np
 
 from arena.navigation import NAVIGATORS, PARAMS, diffdrive, pid
 from arena.navigation.frames import field_to_robot, robot_to_field
-from arena.processes.drive import Drive
-from arena.processes.physics import Physics
-from arena.processes.sensors import sense
 from arena.runtime import config as runtime_config
 from arena.runtime.config import ConfigError, MatchConfig, RobotParams, RulesParams, SensorParams, TimingParams
 from arena.runtime.seeds import derive
 from arena.schemas.messages import Cmd
+from arena.sim.drive import Drive
+from arena.sim.physics import Physics
+from arena.sim.sensors import sense
 
 BUILTIN = "navbench.toml"  # package data of arena.tools
 METHODS = ("apf", "sfm", "f-sfm", "mapf")
@@ -76,7 +76,7 @@ class ScenarioError(ConfigError):
 class NoiseSpec(msgspec.Struct, forbid_unknown_fields=True, frozen=True):
     obstacle_start_sigma: float = 0.0  # [m]
     obstacle_speed_sigma: float = 0.0  # [m/s]
-    sensor: bool = False  # perception through processes/sensors.py with SensorParams()
+    sensor: bool = False  # perception through sim/sensors.py with SensorParams()
 
 
 class ObstacleSpec(msgspec.Struct, forbid_unknown_fields=True, frozen=True):

@@ -33,10 +33,10 @@ from dataclasses import dataclass, field
 import msgspec
 
 from arena.processes import node_class
+from arena.recording.reader import Recording, RecordingError, load
 from arena.runtime.config import ConfigError, ProcessId
-from arena.runtime.keys import Keys
 from arena.runtime.transport import MemoryBus, MemoryTransport
-from arena.tools.recording import Recording, RecordingError, load
+from arena.schemas.keys import Keys
 
 REPLAY_TIMEOUT = 600.0  # [s] wall: give up on a replay that does not finish (a bug, never a slow file)
 

@@ -1,6 +1,6 @@
 """`arena review FILE.mcap`: what happened in a recorded match.
 
-Everything comes from the recording itself (tools/recording.py):
+Everything comes from the recording itself (recording/reader.py):
 
 * teams, strategies, seed: the `arena` metadata (the match configuration);
 * score, goal timeline, restarts by type: the `referee` frames;
@@ -30,8 +30,8 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from arena.recording.reader import Recording, RecordingError, load
 from arena.schemas.messages import Referee, World
-from arena.tools.recording import Recording, RecordingError, load
 
 POSSESSION_RADIUS = 0.5  # [m] robot centre to ball centre: within this the nearest robot's team has the ball
 RESTARTS = ("KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL")  # MSL RefBox

@@ -23,10 +23,10 @@ import zenoh
 
 from arena.processes import node_class
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.keys import Keys
 from arena.runtime.node import StartupError
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
+from arena.schemas.keys import Keys
 
 
 def _sigterm(signum, frame):  # noqa: ARG001 - signal handler signature

@@ -6,8 +6,8 @@ import pytest
 
 from arena.runtime import seeds
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.keys import KEYS, Keys
 from arena.schemas import contract
+from arena.schemas.keys import KEYS, Keys
 from arena.strategies import registry
 
 

@@ -1,4 +1,4 @@
-"""The engine's wheel model (processes/drive.py): both command forms through the same wheels."""
+"""The engine's wheel model (sim/drive.py): both command forms through the same wheels."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import random
 import pytest
 
 from arena.navigation import omni3, omni4
-from arena.processes.drive import Drive
 from arena.processes.engine import check_cmd
 from arena.runtime.config import ROBOTINO, RobotParams
 from arena.schemas.messages import Cmd
+from arena.sim.drive import Drive
 
 IRIS = RobotParams()
 

@@ -1,4 +1,4 @@
-"""The engine's differential-drive model (processes/drive.py, model "diff"): paper 3 eq. 13 in the engine."""
+"""The engine's differential-drive model (sim/drive.py, model "diff"): paper 3 eq. 13 in the engine."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import math
 import pytest
 
 from arena.navigation import diffdrive
-from arena.processes.drive import Drive
 from arena.processes.engine import check_cmd
-from arena.processes.physics import Physics
 from arena.runtime.config import EPUCK, ROBOTINO, MatchConfig, RobotParams
 from arena.schemas.messages import Cmd
+from arena.sim.drive import Drive
+from arena.sim.physics import Physics
 
 P = diffdrive.DiffDriveParams(wheel_radius=EPUCK.wheel_radius, axle_length=2 * EPUCK.wheel_base)
 

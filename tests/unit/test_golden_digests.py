@@ -6,14 +6,13 @@ The reference is tests/golden/digests.json, written by tests/golden/make_digests
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.golden.make_digests import CONFIGS, digests
+
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
-sys.path.insert(0, str(GOLDEN))
-from make_digests import CONFIGS, digests  # noqa: E402
 
 REFERENCE = json.loads((GOLDEN / "digests.json").read_text())
 

@@ -1,4 +1,4 @@
-"""Unit tests of the engine's pymunk world (processes/physics.py), real pymunk."""
+"""Unit tests of the engine's pymunk world (sim/physics.py), real pymunk."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import random
 
 import pytest
 
-from arena.processes.drive import Drive
-from arena.processes.physics import PIN_TOLERANCE, Physics, wrap_angle
 from arena.runtime.config import ROBOTINO, MatchConfig
 from arena.schemas.messages import BallEvent, Cmd
+from arena.sim.drive import Drive
+from arena.sim.physics import PIN_TOLERANCE, Physics, wrap_angle
 
 CFG = MatchConfig()
 F, R, B = CFG.field, CFG.robot, CFG.ball

@@ -15,16 +15,16 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
-from arena.processes import scene
 from arena.processes.recorder import data_topics
+from arena.recording import scene
+from arena.recording.reader import RecordingError, load
 from arena.runtime.config import MatchConfig
-from arena.runtime.keys import KEYS
 from arena.runtime.tap import Tap
+from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
 from arena.strategies import registry
 from arena.tools import replay, review
 from arena.tools.inprocess import play_in_process
-from arena.tools.recording import RecordingError, load
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
 
@@ -66,10 +66,10 @@ def test_tap_cuts_batches_on_tick_boundaries_with_a_watermark():
 def test_outbound_taps_only_when_the_match_records(recording):
     from arena.processes.robot import RobotNode
     from arena.runtime.config import ProcessId
-    from arena.runtime.keys import Keys
     from arena.runtime.lockstep import Outbound
     from arena.runtime.tap import TappedOutbound
     from arena.runtime.transport import MemoryBus, MemoryTransport
+    from arena.schemas.keys import Keys
 
     cfg = MatchConfig(record="/nonexistent/x.mcap" if recording else "")
     node = RobotNode(ProcessId("robot", "a", 1), cfg, MemoryTransport(MemoryBus()), Keys("t"))

@@ -9,7 +9,7 @@ import dataclasses
 
 import pytest
 
-from arena.processes.referee_box import (
+from arena.rules.referee_box import (
     Clock,
     Observed,
     RefereeBox,

@@ -14,10 +14,10 @@ import math
 import pytest
 
 from arena.processes.engine import Restarts
-from arena.processes.physics import Physics
-from arena.processes.referee_box import RefereeBox
+from arena.rules.referee_box import RefereeBox
 from arena.runtime.config import MatchConfig, RulesParams
 from arena.schemas.messages import Cmd, RefCommand
+from arena.sim.physics import Physics
 
 CFG = MatchConfig(half_time=20.0, robots=3)
 F = CFG.field

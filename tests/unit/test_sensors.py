@@ -1,4 +1,4 @@
-"""Unit tests of the robots' LIDAR-like sensor (processes/sensors.py)."""
+"""Unit tests of the robots' LIDAR-like sensor (sim/sensors.py)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import statistics
 import numpy as np
 import pytest
 
-from arena.processes.physics import Physics
-from arena.processes.sensors import sense
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd
+from arena.sim.physics import Physics
+from arena.sim.sensors import sense
 
 CFG = MatchConfig(robots=2)
 P = CFG.sensor
@@ -136,7 +136,7 @@ def test_seeded_reproducibility_and_no_global_random():
 @pytest.mark.parametrize("block", [1, 7, 13, 4096])
 def test_normal_stream_gives_the_generators_normals_in_order(block):
     """The engine draws sensor noise in blocks; the numbers must be the ones drawn one call at a time."""
-    from arena.processes.sensors import NormalStream
+    from arena.sim.sensors import NormalStream
 
     stream, ref = NormalStream(np.random.default_rng(3), block), np.random.default_rng(3)
     for n in [13, 13, 1, 0, 5000, 2, 4096, 13] * 3:
@@ -144,7 +144,7 @@ def test_normal_stream_gives_the_generators_normals_in_order(block):
 
 
 def test_sense_is_the_same_with_a_normal_stream():
-    from arena.processes.sensors import NormalStream
+    from arena.sim.sensors import NormalStream
 
     ph = make()
     stream, gen = NormalStream(np.random.default_rng(9)), np.random.default_rng(9)

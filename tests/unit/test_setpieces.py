@@ -1,4 +1,4 @@
-"""Set-piece geometry (processes/setpieces.py): ball spots, who keeps away, where a robot is put."""
+"""Set-piece geometry (rules/setpieces.py): ball spots, who keeps away, where a robot is put."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from arena.processes import setpieces as sp
+from arena.rules import setpieces as sp
 from arena.runtime.config import MatchConfig
 
 CFG = MatchConfig()

@@ -9,9 +9,9 @@ import random
 
 import pytest
 
-from arena.processes.physics import NO_CHALLENGE_S, Physics
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RobotSeen, Sense, TeamPose
+from arena.sim.physics import NO_CHALLENGE_S, Physics
 from arena.strategies import registry
 from arena.strategies import roles as R
 from arena.strategies import skills as S

@@ -37,7 +37,7 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from arena.processes import setpieces as sp
+from arena.rules import setpieces as sp
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee
 

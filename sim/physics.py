@@ -90,9 +90,9 @@ from dataclasses import dataclass
 import pymunk
 from pymunk import batch as pmbatch
 
-from arena.processes.drive import Drive
 from arena.runtime.config import TEAMS, FieldParams, MatchConfig
 from arena.schemas.messages import BallEvent, Cmd, RobotState, World
+from arena.sim.drive import Drive
 
 GRAVITY = 9.81  # [m/s^2] for the ball's height
 FENCE_RADIUS = 0.05  # [m] half-thickness of the fence segments

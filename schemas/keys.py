@@ -88,6 +88,7 @@ CONFIG = "config"  # queryable: the match configuration as JSON
 ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
 COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
+TAP_PERIOD = 50  # [ticks] one tap batch per process every 1 s of simulated time (at 20 ms ticks)
 
 
 class Keys:

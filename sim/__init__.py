@@ -1,0 +1,5 @@
+"""The simulated world the engine owns: pymunk physics (physics.py), wheel
+drive (drive.py) and the robots' noisy sensors (sensors.py). No transport and
+no clock: the engine process calls it once per tick. May import
+`arena.navigation`, `arena.runtime` and `arena.schemas`; imported by
+`arena.processes` and `arena.tools`."""
