@@ -15,7 +15,7 @@
   minimum clearance.
 
 Everything is stepped in this process through the engine's own robot model:
-`sim/physics.py` (pymunk bodies driven through `sim/drive.py`'s
+`sim/physics/` (pymunk bodies driven through `sim/drive.py`'s
 wheels, the same code a match runs) and `sim/sensors.py` for perception.
 The robot is team a's robot 0; the obstacles are team b's robots, opponents of
 the same model, driven by scripted commands. A collision is the engine's own

@@ -1,4 +1,4 @@
-"""Unit tests of the engine's pymunk world (sim/physics.py), real pymunk."""
+"""Unit tests of the engine's pymunk world (sim/physics/), real pymunk."""
 
 from __future__ import annotations
 

@@ -1,0 +1,77 @@
+"""The physics package's constants, collision categories and per-robot record.
+
+Collision categories and types: the ball collides with fence, goals and
+robots according to its height (ball.py's shape filter); robot i has
+collision type `_ROBOT_TYPE0 + i`, so that a contact names its robot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pymunk
+from pymunk import batch as pmbatch
+
+from arena.schemas.messages import Cmd
+
+GRAVITY = 9.81  # [m/s^2] for the ball's height
+FENCE_RADIUS = 0.05  # [m] half-thickness of the fence segments
+POST_RADIUS = 0.05  # [m] goal post radius
+NET_RADIUS = 0.02  # [m] half-thickness of the net segments
+ROBOT_CORNER = 0.01  # [m] corner rounding of the robot footprint (keeps contacts stable)
+ROBOT_FRICTION = 0.5  # [-] robot against robot, goal and fence (product rule)
+WALL_FRICTION = 0.5  # [-]
+COLLISION_SLOP = 0.002  # [m] overlap pymunk tolerates before pushing shapes apart
+SOLVER_ITERATIONS = 10  # [-] pymunk solver iterations per substep
+
+DRIBBLE_REACH = 0.10  # [m] ball surface to front face, still in reach
+DRIBBLE_SLACK = 0.02  # [m] tolerated penetration of the ball into the front face
+DRIBBLE_HALF_WIDTH = 0.15  # [m] lateral offset of the ball centre still "in front"
+CATCH_MAX_Z = 0.11  # [m] a ball higher than this cannot be captured or kicked
+HOLD_GAP = 0.005  # [m] held ball's surface to the front face
+CHALLENGE_DIST = 0.20  # [m] challenger's footprint edge to the ball's surface
+BOUNCE_STOP = 0.5  # [m/s] vertical speed below which a landing ball stops bouncing
+NO_CATCH_S = 0.25  # [s] after its own kick or a lost challenge a dribbler cannot capture
+NO_CHALLENGE_S = 0.16  # [s] after a lost challenge a robot cannot challenge the new holder (no 1-tick ping-pong)
+PIN_TOLERANCE = 1e-3  # [m] a pinned ball moved farther than this is put back
+
+_CAT_FENCE = 0b0001
+_CAT_GOAL = 0b0010
+_CAT_ROBOT = 0b0100
+_CAT_BALL = 0b1000
+_BALL_TYPE = 1  # collision type of the ball; robot i has collision type _ROBOT_TYPE0 + i
+_ROBOT_TYPE0 = 2
+
+_ALL_FIELDS = (
+    pmbatch.BodyFields.POSITION
+    | pmbatch.BodyFields.ANGLE
+    | pmbatch.BodyFields.VELOCITY
+    | pmbatch.BodyFields.ANGULAR_VELOCITY
+)
+_STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
+
+
+def wrap_angle(a: float) -> float:
+    """Angle wrapped to (-pi, pi] [rad]."""
+    a = math.remainder(a, math.tau)
+    return math.pi if a <= -math.pi else a
+
+
+@dataclass(eq=False)
+class RobotBody:
+    team: str
+    n: int
+    body: pymunk.Body
+    ctrl: pymunk.Body  # kinematic: its velocity is the commanded velocity
+    hold: pymunk.PivotJoint  # ball to front face, in the space while holding
+    off: int = 0  # offset of this body in the batch snapshot
+    cmd: Cmd | None = None
+    twist: tuple[float, float, float] = (0.0, 0.0, 0.0)  # body frame, what `cmd` gives within the limits
+    kick_armed: bool = False
+    dribbler: bool = False
+    dist: float = 0.0  # [m] travelled
+    catch_from: int = 0  # first tick at which the dribbler may capture the ball again
+    challenge_from: int = 0  # first tick at which it may challenge a holder again
+    ctrl_set: tuple[float, float, float] = (0.0, 0.0, 0.0)  # last control velocity written
+    carry_from: tuple[float, float] = (0.0, 0.0)  # [m] its centre when its dribbler took the ball

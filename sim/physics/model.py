@@ -1,0 +1,177 @@
+"""`Physics`: one match's pymunk world, stepped one control tick at a time.
+
+The class is assembled from one mixin per concern (world.py, ball.py,
+possession.py, events.py, state.py); this module holds its state, the
+commands and the step. A command (`Cmd`) goes through the robot model's
+wheels (`sim/drive.py`: IRIS omni4, paper 2 eq. 3-4, or Robotino omni3,
+paper 1 eq. 1-2): a body twist (mode "body") or wheel speeds (mode
+"wheels", forward kinematics) become a body twist within the wheel-speed
+saturation, max_speed and max_omega, turned into the field frame once per
+tick with the heading at mid-tick.
+
+Over 150 lines for one reason: `__init__` declares the state of every
+mixin in one place, so that it reads as one list.
+"""
+
+from __future__ import annotations
+
+import math
+
+from pymunk import batch as pmbatch
+
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import BallEvent, Cmd
+from arena.sim.drive import Drive
+from arena.sim.physics.ball import BallFlight
+from arena.sim.physics.bodies import (
+    _ALL_FIELDS,
+    CHALLENGE_DIST,
+    HOLD_GAP,
+    NO_CATCH_S,
+    NO_CHALLENGE_S,
+    PIN_TOLERANCE,
+    RobotBody,
+)
+from arena.sim.physics.events import Events
+from arena.sim.physics.possession import Possession
+from arena.sim.physics.state import State
+from arena.sim.physics.world import WorldBuilding
+
+
+class Physics(WorldBuilding, BallFlight, Possession, Events, State):
+    """The pymunk world of one match; see the package docstring for the model.
+
+    Attributes set by the engine: `attack_dir_a` (+1: team a attacks the +x
+    goal, -1: the -x goal) and `no_progress_s` [s]. `tick` counts completed
+    steps; `step()` moves the world from `tick` to `tick + 1`. `in_play` is
+    switched by `stop_play` and `start_play`.
+    """
+
+    def __init__(self, cfg: MatchConfig, no_progress_s: float | None = None) -> None:
+        self.cfg = cfg
+        self.attack_dir_a = 1
+        self.no_progress_s = cfg.rules.no_progress_s if no_progress_s is None else no_progress_s
+        self.in_play = True
+        self.tick = 0
+        f, rp, bp = cfg.field, cfg.robot, cfg.ball
+        self._dt = cfg.timing.dt
+        self._substeps = cfg.timing.substeps
+        self._h = self._dt / self._substeps  # [s] substep
+        self._half_len = f.length / 2
+        self._half_wid = f.width / 2
+        self._half_goal = f.goal_width / 2
+        self._goal_height = f.goal_height
+        self._robot_height = rp.height
+        self._ball_r = bp.radius
+        self._ball_e = bp.restitution
+        self._face = rp.size / 2 + bp.radius  # [m] robot centre to a touching ball's centre
+        self._hold_dist = self._face + HOLD_GAP
+        self._challenge = rp.size / 2 + bp.radius + CHALLENGE_DIST  # [m] centre to centre
+        self._no_catch_ticks = math.ceil(NO_CATCH_S / self._dt)
+        self._no_challenge_ticks = math.ceil(NO_CHALLENGE_S / self._dt)
+        self._drive = Drive(rp)
+        self._push_speed = cfg.rules.push_speed  # [m/s]
+        self._dribble_limit = cfg.rules.dribble_limit  # [m]
+        self._progress_radius = cfg.rules.progress_radius  # [m]
+
+        self._build_world(f, rp, bp)
+
+        # ball state beyond pymunk
+        self._z = 0.0  # [m]
+        self._vz = 0.0  # [m/s]
+        self._airborne = False
+        self._holder: RobotBody | None = None
+        self._dead = False  # after a goal, until placed
+        self._out = False  # wholly over a line, until back inside the lines
+        self._cross_high = False  # centre crossed the goal line at z >= goal height
+        self._prev_ax = 0.0  # [m] |x| of the ball at the previous airborne substep
+        self._idle_ticks = 0
+        self._idle_fired = False
+        self._anchor: tuple[float, float] | None = None  # [m] centre of the no-progress circle
+        self._last: RobotBody | None = None
+        self._touch_armed = False  # the next touch is reported even by the last toucher
+        self._carry_fouled = False  # FOUL_DRIBBLING reported for the current possession
+        self._pin: tuple[float, float] | None = None
+        self._contacts: list[int] = []
+        self._impacts: list[tuple[int, float, float]] = []  # offender, contact x, y [m]
+        self._events: list[BallEvent] = []
+        self._refresh()
+
+    def set_command(self, team: str, n: int, cmd: Cmd) -> None:
+        """Store robot n's latest command; it is applied from the next step on.
+
+        A kick fires at most once per call (when the ball is, or becomes, in reach).
+        """
+        r = self._by_id[(team, n)]
+        r.cmd = cmd
+        r.twist = self._drive.twist(cmd)
+        r.kick_armed = cmd.kick_speed > 0.0
+        r.dribbler = cmd.dribbler
+
+    def step(self) -> list[BallEvent]:
+        """Advance one control tick (`substeps` pymunk steps); return this tick's events."""
+        if self._dirty:
+            self._refresh()
+        self.tick += 1
+        self._events = events = []
+        s = self._snap
+        self._apply_commands(s)
+        space, buf, h = self._space, self._buf, self._h
+        robots = self._robots
+        for _ in range(self._substeps):
+            space.step(h)
+            buf.clear()
+            pmbatch.get_space_bodies(space, _ALL_FIELDS, buf)
+            new = memoryview(buf.float_buf()).cast("d").tolist()
+            for r in robots:
+                o = r.off
+                r.dist += math.hypot(new[o] - s[o], new[o + 1] - s[o + 1])
+            s = new
+            if self._airborne:
+                self._fly(s)
+            if self._contacts:
+                self._handle_contacts(s)
+            if self._impacts:
+                self._handle_impacts()
+        self._snap = s
+        if self._dirty:
+            self._refresh()
+        self._after_tick()
+        return events
+
+    def _apply_commands(self, s: list[float]) -> None:
+        half_dt = self._dt / 2
+        for r in self._robots:
+            o = r.off
+            if r.cmd is not None:
+                vx, vy, w = r.twist
+                theta = s[o + 2] + half_dt * s[o + 5]
+                c, sn = math.cos(theta), math.sin(theta)
+                target = (c * vx - sn * vy, sn * vx + c * vy, w)
+            else:
+                target = (0.0, 0.0, 0.0)
+            if target != r.ctrl_set:
+                r.ctrl.velocity = target[0], target[1]
+                r.ctrl.angular_velocity = target[2]
+                r.ctrl_set = target
+            if self._holder is r and not r.dribbler:
+                self._release()
+            holder = self._holder
+            free = not self._dead and self._pin is None
+            if r.kick_armed and free and (holder is r or (holder is None and self._in_reach(r, s))):
+                self._kick(r, s)
+            elif self._can_capture(r) and self._in_reach(r, s):
+                self._capture(r, s)
+
+    def _after_tick(self) -> None:
+        """End of a tick: a pinned ball put back, the holder checked, the lines watched."""
+        s = self._snap
+        pin = self._pin
+        if pin is not None:
+            b = self._ball_off
+            if self._holder is not None or math.hypot(s[b] - pin[0], s[b + 1] - pin[1]) > PIN_TOLERANCE:
+                self.place_ball(*pin)
+                s = self._fresh()
+        if self._holder is not None:
+            self._check_holder(self._holder, s)
+        self._line_events(s)
