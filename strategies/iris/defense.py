@@ -1,0 +1,146 @@
+"""Without the ball: basic and advance defense (Fig. 7b).
+
+- basic defense: the robot whose area holds the ball tries to catch it and
+  grab it from the opponent (`get_ball`), the others wait at home;
+- advance defense (Fig. 7b): the outfield robot that gets onto the kick line
+  soonest (`is_blocker`) meets an opponent carrying the ball within
+  `block_zone` of our goal on its estimated kick line (the ball's line to our
+  goal centre), 1 m from it, retreating with it down to 3 m from our goal
+  centre and then following the ball (`arena.strategies.skills.block_point`), tracking the
+  line at `block_gain`, and takes the ball within 0.5 m from the kick line;
+  the other marks the opponent nearest our goal goal-side when it is within
+  `mark_zone` of our goal (man-to-man marking, the paper's stated approach;
+  the attacker only while the ball is within `drop_back` of our goal); at
+  the opponents' free kicks, throw-ins, corners and kick-offs one robot
+  walls the kick line 2.2 m from the spot and the other marks
+  (`setpiece_defense`).
+"""
+
+from __future__ import annotations
+
+import math
+from math import hypot
+
+from arena.schemas.messages import Cmd, Order
+from arena.strategies import skills as S
+from arena.strategies.iris.params import Vec
+
+
+class DefenseMixin:
+    """Mixin of `IrisRobot`: defense."""
+
+    def without_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
+        view, p = self.view, self.p
+        x, y, _ = view.pose  # type: ignore[misc]
+        pos = (x, y)
+        goal = self.goal(order)
+        if (tick - self.mem.lost_at) * self._dt < p.regroup and self.carrier(ball) is not None:
+            # Lost the ball to a tackle: step back instead of wrestling for it, then challenge again;
+            # basic: aside; advance: goal-side, onto the carrier's kick line (Fig. 7b).
+            if S.dist(pos, ball) < self.p.regroup_clear:  # first get the body off the ball, straight back
+                a = S.angle_to(ball, pos)
+                back = (x + 0.5 * math.cos(a), y + 0.5 * math.sin(a))
+            elif self.p.advance:
+                back = S.behind_point(ball, goal, self.p.regroup_distance)
+            else:
+                back = S.aside_point(ball, self.own_goal(order), pos, self.p.regroup_distance)
+            return self.drive(tick, back, S.angle_to(pos, ball), self.p.cruise, avoid=False)
+        attacking = self.plan.attacking  # type: ignore[union-attr]
+        if attacking:
+            bx, by = ball
+            for mx, my, _ in view.mates.values():
+                if hypot(mx - bx, my - by) < 0.4:  # a teammate has the ball
+                    if p.advance and self.role == "attacker":
+                        home = self.support_point(order, ball)
+                    else:
+                        home = self.home(order, ball)
+                    return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
+        chaser = self.is_chaser(order, ball)
+        if p.advance and not attacking:
+            cmd = self.advance_defense(tick, order, ball, pos, chaser)
+            if cmd is not None:
+                return cmd
+        if chaser:
+            return self.get_ball(tick, ball, goal)
+        home = self.home(order, ball)
+        return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
+
+    def advance_defense(self, tick: int, order: Order, ball: Vec, pos: Vec, chaser: bool) -> Cmd | None:
+        """Paper 2, Fig. 7b, for an outfield robot while the team defends; None: play the ball as usual.
+
+        An opponent carrying the ball within `block_zone` of our goal is met by
+        the robot that gets onto its kick line soonest (`is_blocker`) on that
+        line (the ball's line to our goal centre), `block_distance` (1 m) from
+        the carrier and no closer than `retreat_radius` (3 m) to our goal
+        centre, facing the ball (`arena.strategies.skills.block_point`); within
+        `take_distance` (0.5 m) of the ball it takes it, straight from the kick
+        line (within `take_angle` of it). It drives there straight once goal-side of the carrier
+        (steering round it only to get goal-side) and with the tracking gain
+        `block_gain`, so that it stays on the line while the carrier turns to
+        aim or circles. The other outfield robot marks the most dangerous
+        other opponent goal-side (man-to-man marking, `arena.strategies.skills.mark_point`),
+        which also cuts the pass to it: the defender always, the attacker while
+        the ball is within `drop_back` of our goal (both field robots defend
+        when the team has lost the ball deep in its half; paper 2: "defender
+        robots ... will always block opposing attacker to score goal").
+        """
+        sp = self.p.skills
+        own = self.own_goal(order)
+        carrier = self.carrier(ball)
+        if carrier is not None and S.dist(carrier, own) < self.p.block_zone:
+            block = S.block_point(carrier, own, sp, ball)
+            if self.is_blocker(block, carrier, own):
+                # Within take_distance of the ball, take it, but only from the kick line: straight at the
+                # ball from goal-side; going round the ball to get behind it would open the line to our goal.
+                on_line = abs(S.wrap(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
+                if S.dist(pos, ball) < sp.take_distance and on_line:
+                    return self.drive(
+                        tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True, avoid=False
+                    )
+                goal_side = S.dist(pos, own) < S.dist(carrier, own) - 0.2
+                return self.drive(
+                    tick,
+                    block,
+                    S.angle_to(block, ball),
+                    self.p.cruise,
+                    dribbler=True,
+                    avoid=not goal_side,
+                    gain=self.p.block_gain,
+                )
+        else:
+            self.mem.blocking = False
+            if chaser:
+                return None
+        if self.role == "attacker" and S.dist(ball, own) > self.p.drop_back:
+            return None
+        target = self.marking_target(order, carrier if carrier is not None else ball)
+        if target is None:
+            return None
+        mark = S.mark_point(target, own, sp.mark_distance)
+        return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
+
+    def is_blocker(self, block: Vec, carrier: Vec, own: Vec) -> bool:
+        """Advance defense: of our outfield robots, the one that gets onto the kick line soonest blocks:
+        the nearest to the block point, counting `behind_penalty` more for a robot not goal-side of the
+        carrier (it has to go round it) and `chase_hysteresis` less for the current blocker."""
+        limit = S.dist(carrier, own) - 0.2
+
+        def cost(pt: Vec) -> float:
+            return S.dist(pt, block) + (self.p.behind_penalty if S.dist(pt, own) > limit else 0.0)
+
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        mine = (cost((x, y)) - (self.p.chase_hysteresis if self.mem.blocking else 0.0), self.n)
+        self.mem.blocking = all((cost((mx, my)), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
+        return self.mem.blocking
+
+    def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
+        """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""
+        own = self.own_goal(order)
+        best, found = self.p.mark_zone, None
+        for o in self.view.opponents:
+            if S.dist(o, carrier) < 0.3:
+                continue
+            d = S.dist(o, own)
+            if d < best:
+                best, found = d, o
+        return found

@@ -1,0 +1,38 @@
+"""What an IRIS robot remembers between ticks (`Memory`), and what follows from one order alone (`Plan`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from arena.strategies.iris.params import Vec
+
+
+@dataclass
+class Memory:
+    command: str = ""
+    command_since: int = 0  # [tick] when the command in force changed
+    chasing: bool = False
+    carry_from: Vec | None = None  # [m] where this robot took the ball
+    hold_since: int = 0  # [tick] when it took the ball
+    passed_at: int = -(1 << 30)  # [tick] of its latest pass
+    kicked_at: int = -(1 << 30)  # [tick] of its latest kick command
+    lost_at: int = -(1 << 30)  # [tick] when it last lost the ball (not by its own kick)
+    circle_rot: float = 0.0  # advance attack: the way round the opponent it is circling (+1 ccw, -1 cw)
+    circle_tick: int = -(1 << 30)  # [tick] of the latest circling step
+    shot_until: int = -(1 << 30)  # [tick] a decided shot is carried through until then
+    shot_aim: Vec = (0.0, 0.0)  # [m]
+    blocking: bool = False  # advance defense: this robot is the one blocking the carrier
+    pid_integral: float = 0.0  # [rad] heading PID state (paper 1 eq. 16): the sum of errors ...
+    pid_error: float | None = None  # [rad] ... and the latest error (None before the first step)
+
+
+@dataclass(slots=True)
+class Plan:
+    """What follows from one order alone: roles, areas, teammates (worked out once per order; never changed)."""
+
+    role: str
+    area: tuple[float, float]  # (u_min, u_max) [m] of this robot
+    areas: dict[int, tuple[float, float]]  # of every outfield teammate with a role
+    attackers: tuple[Vec, ...]  # positions [m] of the teammates that are attackers, by robot number
+    mates: tuple[Vec, ...]  # positions [m] of the outfield teammates, by robot number
+    attacking: bool  # Fig. 6: the team is in attacking mode

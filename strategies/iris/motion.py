@@ -1,0 +1,131 @@
+"""Motion: driving to a target round the robots, and the push guard.
+
+* every motion goes through a navigator of :mod:`arena.navigation` (F-SFM by
+  default, paper 1 eq. 3-14) with the robots within `obstacle_range` as
+  obstacles, so that robots steer round each other; the heading uses the PID
+  of paper 1 eq. 15-16 (:mod:`arena.navigation.pid`), capped below the
+  dribbler's 3 rad/s while holding the ball. The closing speed towards an
+  opponent, of the robot and of a ball it holds, is capped to what the drive
+  can brake to `push_guard` before contact, and to `contact_push` (0) in
+  contact (`guard_push`): no pushing fouls, no shoving, no driving the ball
+  into an opponent.
+"""
+
+from __future__ import annotations
+
+import math
+from math import cos, hypot, sin
+
+from arena.navigation.pid import update as pid_update
+from arena.schemas.messages import Cmd, Order
+from arena.strategies import skills as S
+from arena.strategies.iris.params import Vec
+
+
+class MotionMixin:
+    """Mixin of `IrisRobot`: going somewhere."""
+
+    def goal(self, order: Order) -> Vec:
+        return order.attack_dir * self.half_length, 0.0
+
+    def own_goal(self, order: Order) -> Vec:
+        return -order.attack_dir * self.half_length, 0.0
+
+    def u(self, order: Order, x: float) -> float:
+        return order.attack_dir * x
+
+    def inside(self, pt: Vec, margin: float = 0.3) -> Vec:
+        """pt clamped to the field plus `margin` [m] of run-off."""
+        hx, hy = self.half_length + margin, self.half_width + margin
+        return S.clamp(pt[0], -hx, hx), S.clamp(pt[1], -hy, hy)
+
+    def my_area(self, order: Order) -> tuple[float, float]:
+        return self.plan.area  # type: ignore[union-attr]
+
+    def drive(
+        self,
+        tick: int,
+        target: Vec,
+        heading: float,
+        vmax: float,
+        *,
+        dribbler: bool = False,
+        kick: float = 0.0,
+        avoid: bool = True,
+        extra_obstacles: tuple[Vec, ...] = (),
+        gain: float = 0.0,
+    ) -> Cmd:
+        """Go to `target` [m] facing `heading` [rad] at most at vmax [m/s], steering round robots;
+        `gain` [1/s]: drive straight at speed min(vmax, gain * distance) (without it the straight
+        speed is the distance per second, capped by `k_pos`)."""
+        view, p = self.view, self.p
+        x, y, th = view.pose  # type: ignore[misc]
+        # target = self.inside(target), inlined
+        gx, gy, hx, hy = target[0], target[1], self._drive_hx, self._drive_hy
+        gx = -hx if gx < -hx else hx if gx > hx else gx
+        gy = -hy if gy < -hy else hy if gy > hy else gy
+        tx, ty = gx - x, gy - y
+        d = hypot(tx, ty)
+        vx, vy = tx, ty  # straight at it, at 1 m/s per metre to go (capped below)
+        if gain and d > 1e-9:  # straight at it at gain * distance (a tracking robot: blocker, marker)
+            k = gain * d
+            k = (k if k < vmax else vmax) / d  # min(vmax, gain * d) / d
+            vx, vy = tx * k, ty * k
+        if avoid and d > p.direct_range:
+            near = p.obstacle_range
+            obstacles = []  # every other robot (view.others(): opponents, then teammates) and the extras within reach
+            for group in (view.opponents, view.mate_obstacles, extra_obstacles):
+                for o in group:
+                    dx, dy = o[0] - x, o[1] - y
+                    if -near < dx < near and -near < dy < near and hypot(dx, dy) < near:
+                        obstacles.append(o)
+            if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
+                vx, vy = self.nav((x, y), view.vel, (gx, gy), obstacles, self.nav_params)
+        speed = hypot(vx, vy)
+        cap = (gain or p.k_pos) * d
+        cap = cap if cap < vmax else vmax  # min(vmax, (gain or k_pos) * d)
+        if speed > cap and speed > 0.0:
+            vx, vy = vx * cap / speed, vy * cap / speed
+        c, s = cos(th), sin(th)
+        vx, vy = self.guard_push(x, y, vx, vy, p.contact_range)
+        has_ball = view.has_ball
+        if has_ball:  # the held ball is part of the body: do not push it into an opponent either
+            reach = self.ball_reach
+            vx, vy = self.guard_push(x + reach * c, y + reach * s, vx, vy, p.ball_contact_range)
+        mem = self.mem
+        omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
+        limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
+        omega = -limit if omega < -limit else limit if omega > limit else omega
+        return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
+
+    def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:
+        """Cap the closing speed towards every nearby opponent, so that contact is never a pushing foul.
+
+        (x, y) is the point that must not push: the robot's centre (contact at
+        `contact_range`) or the centre of the ball it holds (`ball_contact_range`).
+        The cap is what the drive can still brake from before the bodies meet:
+        v <= sqrt(push_guard^2 + 2 brake (d - contact)) at distance d [m], so
+        that the robot arrives at `push_guard` or slower whatever its
+        acceleration limit; in contact (d < contact) it is `contact_push`: a
+        robot does not shove an opponent along (MSL: charging), so a carrier
+        that shields the ball with its body can turn away, and a holder does
+        not drive the ball into an opponent (which would knock it loose).
+        """
+        rng, brake2, guard2, contact_push = self._guard
+        if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
+            return vx, vy
+        for ox, oy in self.view.opponents:
+            dx, dy = ox - x, oy - y
+            if abs(dx) > rng or abs(dy) > rng:
+                continue
+            d = hypot(dx, dy)
+            if 1e-6 < d < rng:
+                ex, ey = dx / d, dy / d
+                closing = vx * ex + vy * ey
+                if closing <= contact_push:
+                    continue
+                cap = contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
+                if closing > cap:
+                    vx -= (closing - cap) * ex
+                    vy -= (closing - cap) * ey
+        return vx, vy

@@ -1,0 +1,64 @@
+"""Where an outfield robot stands when it does not play the ball: its home in its area, and the advance attacker's
+support point (open for a pass and a shot).
+"""
+
+from __future__ import annotations
+
+import math
+
+from arena.schemas.messages import Order
+from arena.strategies import roles as R
+from arena.strategies import skills as S
+from arena.strategies.iris.params import Vec
+
+
+class PositionsMixin:
+    """Mixin of `IrisRobot`: positions off the ball."""
+
+    def home(self, order: Order, ball: Vec) -> Vec:
+        """Where a robot waits while it does not go for the ball, by role and team mode.
+
+        Attacker: in attacking mode up the field, on the other side from the
+        ball, to receive the ball; in defending mode just ahead of the ball, in
+        its area, ready for a counter-attack. Defender: in attacking mode at
+        `cover_depth` in its own half, following the ball's y a little; in
+        defending mode between the ball and our goal, at most 3.2 m out.
+        S2 (losing) pushes everyone 1 m up, S3 (winning) 1 m back.
+        """
+        lo, hi = self.plan.area  # type: ignore[union-attr]
+        d = order.attack_dir
+        bu = d * ball[0]
+        shift = 1.0 if order.strategy == R.S_OFFENSIVE else -1.0 if order.strategy == R.S_DEFENSIVE else 0.0
+        attacking = self.plan.attacking  # type: ignore[union-attr]
+        if self.role == "attacker":
+            if attacking:
+                u = S.clamp(bu + 2.5 + shift, max(lo + 1.5, 1.0), hi - 2.0)
+                yy = -1.5 if ball[1] > 0.5 else 1.5 if ball[1] < -0.5 else (1.5 if self.n % 2 else -1.5)
+                return d * u, yy
+            u = S.clamp(bu + 1.5 + shift, lo + 0.5, hi - 1.5)
+            yy = S.clamp(-0.5 * ball[1] + (1.0 if ball[1] <= 0 else -1.0), -2.5, 2.5)
+            return d * u, yy
+        if attacking:  # cover behind the play, little moved by the ball: the defender's area is its own half
+            u = S.clamp(self.p.cover_depth + shift, lo + 1.5, hi - 0.3)
+            return d * u, 0.25 * ball[1]
+        own = self.own_goal(order)
+        r = min(3.2 + max(shift, 0.0), 0.5 * S.dist(own, ball) + 1.0)
+        a = S.angle_to(own, ball)
+        hx, hy = own[0] + r * math.cos(a), own[1] + r * math.sin(a)
+        u = S.clamp(d * hx, lo + 1.0, hi - 0.3)
+        return d * u, hy
+
+    def support_point(self, order: Order, ball: Vec) -> Vec:
+        """Advance attack: get open for a pass and a shot (`arena.strategies.skills.open_point`), worked out once per order."""
+        if self._support is not None and self._support[0] is self.order:
+            return self._support[1]
+        lo, hi = self.my_area(order)
+        d = order.attack_dir
+        bu = d * ball[0]
+        us = {S.clamp(bu + k, max(lo + 1.0, 0.5), min(hi - 1.5, 4.5)) for k in (1.5, 3.0)}
+        cands = [(d * u, yy) for u in sorted(us) for yy in (-1.5, 0.0, 1.5)]
+        pt = S.open_point(
+            ball, cands, self.view.opponents, self.goal(order)[0], self.goal_half, self.p.skills.clear_margin
+        )
+        self._support = (self.order, pt)
+        return pt

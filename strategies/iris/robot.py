@@ -1,0 +1,138 @@
+"""The IRIS robot brain: memory, the plan of an order, and the step that picks a behaviour.
+
+Robot (`IrisRobot`), every tick, from its own `Sense` and the latest `Order`
+(:class:`arena.strategies.world.RobotView`; robots never see ground truth): the
+referee first (setpieces.py), then the goalkeeper (keeper.py), then the
+outfield robot with the ball (handling.py, attack.py) or without it
+(defense.py, positions.py).
+"""
+
+from __future__ import annotations
+
+from arena.navigation import get
+from arena.schemas.messages import Cmd, Order, Pose, Report, Sense
+from arena.strategies import roles as R
+from arena.strategies.base import RobotContext
+from arena.strategies.iris.attack import AttackMixin
+from arena.strategies.iris.defense import DefenseMixin
+from arena.strategies.iris.handling import HandlingMixin
+from arena.strategies.iris.keeper import KeeperMixin
+from arena.strategies.iris.memory import Memory, Plan
+from arena.strategies.iris.motion import MotionMixin
+from arena.strategies.iris.params import PLAY, SET_PIECES, IrisParams, Vec
+from arena.strategies.iris.positions import PositionsMixin
+from arena.strategies.iris.setpieces import SetPieceMixin
+from arena.strategies.world import RobotView
+
+
+class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMixin, SetPieceMixin, PositionsMixin):
+    """Robot brain: perception, skills and the referee, for every role."""
+
+    def __init__(self, ctx: RobotContext, p: IrisParams):
+        cfg = ctx.cfg
+        self.cfg = cfg
+        self.team = ctx.team
+        self.n = ctx.n
+        self.p = p
+        self.half_length = cfg.field.length / 2.0
+        self.half_width = cfg.field.width / 2.0
+        self.goal_half = cfg.field.goal_width / 2.0
+        self.view = RobotView(ctx.team, ctx.n, cfg.sensor, cfg.timing.dt, p.fusion)
+        self.nav = get(p.navigator)
+        self.nav_params = p.nav_params()
+        self.area_params = R.AreaParams(field_length=cfg.field.length, overlap=p.overlap)
+        self.mem = Memory()
+        self.role = "goalkeeper" if ctx.n == 0 else ""
+        self.order: Order | None = None
+        self.plan: Plan | None = None
+        self._support: tuple[Order | None, Vec] | None = None
+        self._planned: Order | None = None
+        self._ticks_2s = int(2.0 / cfg.timing.dt)
+        self.tick = 0
+        self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
+        self._commit_ticks = int(round(p.shot_commit / cfg.timing.dt))
+        # Constants of the per-tick path, worked out once.
+        self._dt = cfg.timing.dt  # [s]
+        self._defense_area = self.area_params.defense
+        self._areas: dict[tuple, dict[int, tuple[float, float]]] = {}  # R.areas by the roles it was given
+        self._drive_hx = self.half_length + 0.3  # [m] `inside` with its default margin, for `drive`
+        self._drive_hy = self.half_width + 0.3  # [m]
+        self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
+        self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
+        self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
+
+    def report(self, tick: int, sense: Sense | None) -> Report:
+        if sense is None:
+            pose = self.view.pose or (0.0, 0.0, 0.0)
+            return Report(tick=tick, robot=self.n, pose=Pose(x=pose[0], y=pose[1], theta=pose[2]), role=self.role)
+        return Report(
+            tick=tick,
+            robot=self.n,
+            pose=sense.pose,
+            ball=sense.ball,
+            robots=sense.robots,
+            has_ball=sense.has_ball,
+            role=self.role,
+        )
+
+    def step(self, tick: int, sense: Sense | None, order: Order | None) -> Cmd:
+        view = self.view
+        view.update(tick, sense, order)
+        self.order = order
+        self.tick = tick
+        if order is None or sense is None or view.pose is None:
+            return Cmd(tick=tick)
+        mem = self.mem
+        command = order.command
+        if command != mem.command:
+            mem.command, mem.command_since = command, tick
+        self.role = order.role or self.role or "defender"
+        if order is not self._planned:
+            self.plan = self.make_plan(order)
+            self._planned = order
+        has_ball = view.has_ball
+        if not has_ball:
+            if mem.carry_from is not None and tick - mem.kicked_at > 2:
+                mem.lost_at = tick
+            mem.carry_from = None
+        elif mem.carry_from is None:
+            mem.carry_from = (view.pose[0], view.pose[1])
+            mem.hold_since = tick
+        if command in SET_PIECES:
+            return self.position_for_restart(tick, order)
+        if command != PLAY:
+            return Cmd(tick=tick)
+        ball = view.ball
+        if ball is None:
+            return Cmd(tick=tick, omega=1.0)  # look round for the ball
+        if self.keep_setpiece_distance(tick, order, ball):
+            return self.position_for_restart(tick, order)
+        if self.role == "goalkeeper":
+            return self.goalkeeper(tick, order, ball)
+        if has_ball:
+            return self.with_ball(tick, order, ball)
+        return self.without_ball(tick, order, ball)
+
+    def make_plan(self, order: Order) -> Plan:
+        roles = {n: r for n, (_, _, r) in self.view.mates.items() if n != 0 and r in ("attacker", "defender")}
+        if self.n != 0:
+            roles[self.n] = self.role
+        key = tuple(roles.items())  # the areas follow from the roles alone: worked out once per set of roles
+        areas = self._areas.get(key)
+        if areas is None:
+            areas = self._areas[key] = R.areas(roles, self.area_params)
+        attackers: list[Vec] = []
+        mates: list[Vec] = []
+        for n, (x, y, r) in sorted(self.view.mates.items()):
+            if n != 0:
+                mates.append((x, y))
+                if r == "attacker":
+                    attackers.append((x, y))
+        return Plan(
+            role=self.role,
+            area=areas.get(self.n, self._defense_area),
+            areas=areas,
+            attackers=tuple(attackers),
+            mates=tuple(mates),
+            attacking=R.is_attacking(order.role_state),
+        )

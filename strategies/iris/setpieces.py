@@ -1,0 +1,102 @@
+"""The referee's set pieces: positioning for a restart, the wall and the mark, and keeping the distance.
+
+* referee: stands still on STOP-like commands, positions for set pieces
+  (own team: one robot goes behind the ball; opponents keep `setpiece_distance`
+  from the spot) and plays on START;
+"""
+
+from __future__ import annotations
+
+import math
+
+from arena.schemas.messages import Cmd, Order
+from arena.strategies import skills as S
+from arena.strategies.iris.params import WALL_PIECES, Vec
+
+
+class SetPieceMixin:
+    """Mixin of `IrisRobot`: set pieces."""
+
+    def position_for_restart(self, tick: int, order: Order) -> Cmd:
+        spot = (order.spot_x, order.spot_y)
+        goal = self.goal(order)
+        if self.role == "goalkeeper":
+            own = self.own_goal(order)
+            target = (own[0] + order.attack_dir * self.p.skills.keeper_depth, 0.0)
+            return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise)
+        ours = order.command_team in (self.team, "")
+        if ours and self.is_taker(order, spot):
+            behind = order.command_team == self.team and order.command == "DROP_BALL"
+            gap = self.p.setpiece_behind if order.command_team == self.team or behind else 1.0
+            target = S.behind_point(spot, goal, gap)
+            return self.drive(tick, target, S.angle_to(target, goal), self.p.cruise, extra_obstacles=(spot,))
+        if self.p.advance and order.command_team not in (self.team, "") and order.command in WALL_PIECES:
+            target = self.setpiece_defense(order, spot)
+            if target is not None:
+                x, y, _ = self.view.pose  # type: ignore[misc]
+                keep = self.p.setpiece_distance + self.p.wall_margin
+                if S.dist((x, y), spot) < keep - 0.1:
+                    # Inside the 2 m circle: out of it first, away from the spot but turned (by up to
+                    # `wall_exit_turn`) towards the target, so that it leaves on the way round to it.
+                    a = S.angle_to(spot, (x, y)) if S.dist((x, y), spot) > 1e-6 else S.angle_to(spot, target)
+                    turn = S.wrap(S.angle_to(spot, target) - a)
+                    a += S.clamp(turn, -self.p.wall_exit_turn, self.p.wall_exit_turn)
+                    target = (spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a))
+                return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise, extra_obstacles=(spot,))
+        home = self.home(order, spot)
+        keep = self.p.setpiece_distance + 0.2 if order.command_team != self.team else 1.2
+        if S.dist(home, spot) < keep:
+            a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, self.own_goal(order))
+            home = self.inside((spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a)), margin=-0.2)
+        return self.drive(tick, home, S.angle_to(home, spot), self.p.cruise, extra_obstacles=(spot,))
+
+    def setpiece_defense(self, order: Order, spot: Vec) -> Vec | None:
+        """Advance defense at the opponents' set piece: Fig. 7b before the ball is in play.
+
+        The outfield robot nearer the wall point stands on the kick line from
+        the spot to our goal centre, `setpiece_distance` + `wall_margin` from
+        the spot (the block of Fig. 7b at the distance the rules allow, never
+        nearer our goal centre than `retreat_radius` less 1 m); the other marks the
+        opponent nearest our goal other than the taker goal-side
+        (`arena.strategies.skills.mark_point`), kept out of the 2 m circle too. None: no mark
+        for it (it takes its usual place).
+        """
+        own = self.own_goal(order)
+        keep = self.p.setpiece_distance + self.p.wall_margin
+        d = S.dist(spot, own)
+        r = max(min(self.p.skills.retreat_radius - 1.0, d), d - keep)
+        a = S.angle_to(own, spot)
+        wall = self.inside((own[0] + r * math.cos(a), own[1] + r * math.sin(a)), margin=-0.3)
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        mine = (S.dist((x, y), wall), self.n)
+        walls = all((S.dist((mx, my), wall), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
+        if walls:
+            return wall
+        best, found = self.p.mark_zone + 1.0, None
+        for o in self.view.opponents:
+            dd = S.dist(o, own)
+            if S.dist(o, spot) > 1.0 and dd < best:
+                best, found = dd, o
+        if found is None:
+            return None
+        mark = S.mark_point(found, own, self.p.skills.mark_distance)
+        if S.dist(mark, spot) < keep:
+            b = S.angle_to(spot, mark)
+            mark = (spot[0] + keep * math.cos(b), spot[1] + keep * math.sin(b))
+        return self.inside(mark, margin=-0.3)
+
+    def is_taker(self, order: Order, spot: Vec) -> bool:
+        """The outfield robot of ours nearest the spot takes the set piece (robot number breaks ties)."""
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        mine = (S.dist((x, y), spot), self.n)
+        for n, (mx, my, _) in self.view.mates.items():
+            if n != 0 and (S.dist((mx, my), spot), n) < mine:
+                return False
+        return True
+
+    def keep_setpiece_distance(self, tick: int, order: Order, ball: Vec) -> bool:
+        """After the opponents' set-piece START: stay away until the ball has moved or 2 s passed."""
+        if order.command_team in (self.team, "") or self.role == "goalkeeper":
+            return False
+        fresh = tick - self.mem.command_since < self._ticks_2s
+        return fresh and S.dist(ball, (order.spot_x, order.spot_y)) < 0.3

@@ -1,0 +1,84 @@
+"""The IRIS base station brain.
+
+Base station (`IrisTeam`), every comm period:
+
+* fuses the reports into P_A, P_B, P_ball (eq. 5, :mod:`arena.strategies.world`);
+* chooses S1/S2/S3 from the score (eq. 5, :func:`arena.strategies.roles.choose_strategy`);
+* decides possession (inputs b and b-bar) and runs the role FSM of Fig. 6 with
+  the areas and n_d = ceil(n/2) of eq. 6 (:mod:`arena.strategies.roles`); static roles never
+  swap, dynamic roles swap with inputs a and d;
+* relays the referee command C and sends one `Order` per robot.
+"""
+
+from __future__ import annotations
+
+import math
+
+from arena.schemas.messages import Order, Referee, Report, TeamPose
+from arena.strategies import roles as R
+from arena.strategies import skills as S
+from arena.strategies.base import TeamContext
+from arena.strategies.iris.params import PLAY, SET_PIECES, IrisParams
+from arena.strategies.world import TeamModel
+
+
+class IrisTeam:
+    """Base station brain: eq. 5 fusion, S1/S2/S3, Fig. 6 roles with the areas of eq. 6."""
+
+    def __init__(self, ctx: TeamContext, p: IrisParams):
+        self.cfg = ctx.cfg
+        self.team = ctx.team
+        self.p = p
+        self.model = TeamModel(ctx.team, ctx.cfg.robots, ctx.cfg.sensor, ctx.cfg.timing.dt, p.fusion)
+        self.area_params = R.AreaParams(field_length=ctx.cfg.field.length, overlap=p.overlap)
+        self.roles = R.RoleAssigner(ctx.cfg.robots, p.dynamic, self.area_params)
+
+    def possession(self, tick: int) -> tuple[str, int | None]:
+        holder = self.model.holder()
+        if holder is not None:
+            return "own", holder
+        ball = self.model.ball_xy(tick)
+        if ball is None:
+            return "", None
+        opp = min((S.dist(o.xy, ball) for o in self.model.opponents), default=math.inf)
+        own = min((S.dist((x, y), ball) for x, y, _, _ in self.model.own.values()), default=math.inf)
+        if opp < self.p.possession_radius and opp < own:
+            return "opponent", None
+        return "", None
+
+    def step(self, tick: int, reports: dict[int, Report], referee: Referee | None) -> dict[int, Order]:
+        self.model.update(tick, reports)
+        c = R.referee_fields(self.team, referee, default_attack_dir=1 if self.team == "a" else -1)
+        command, cteam, attack_dir = c["command"], c["command_team"], c["attack_dir"]
+        possession, holder = self.possession(tick)
+        if command == PLAY:
+            xy = {n: (v[0], v[1]) for n, v in self.model.own.items()}
+            u = {n: attack_dir * v[0] for n, v in xy.items()}
+            self.roles.update(possession, holder, u, xy)
+        elif command in SET_PIECES and cteam:
+            # A set piece gives the ball to one side: its team attacks (b), the other defends (b-bar).
+            self.roles.update("own" if cteam == self.team else "opponent", None, {}, {})
+        role_of = {0: "goalkeeper", **self.roles.roles()}
+        own_poses = [
+            TeamPose(robot=n, x=v[0], y=v[1], theta=v[2], age=tick - v[3], role=role_of.get(n, ""))
+            for n, v in sorted(self.model.own.items())
+        ]
+        opponents = [TeamPose(robot=-1, x=o.x, y=o.y, age=tick - o.tick) for o in self.model.opponents]
+        ball = self.model.ball_xy(tick)
+        ball_age = self.model.ball.age(tick) if ball is not None else 0
+        return {
+            n: Order(
+                tick=tick,
+                robot=n,
+                **c,
+                role=role_of.get(n, "defender"),
+                role_state=self.roles.state.get(n, 0),
+                own=own_poses,
+                opponents=opponents,
+                ball_valid=ball is not None,
+                ball_x=ball[0] if ball is not None else 0.0,
+                ball_y=ball[1] if ball is not None else 0.0,
+                ball_age=ball_age,
+            )
+            for n in range(self.cfg.robots)
+        }
