@@ -44,7 +44,7 @@ EXAMPLES = {
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
-  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench.toml)""",
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench/navbench.toml)""",
     "review": """examples:
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
@@ -176,7 +176,9 @@ def build_parser() -> Parser:
     b.add_argument("--json", action="store_true")
     b.add_argument("--trials", type=int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)")
     b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
-    b.add_argument("--scenarios", metavar="FILE", help="nav: scenario file (default: the built-in tools/navbench.toml)")
+    b.add_argument(
+        "--scenarios", metavar="FILE", help="nav: scenario file (default: the built-in tools/navbench/navbench.toml)"
+    )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
 
@@ -372,7 +374,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.what == "nav":
         from arena.tools import navbench
 
-        return navbench.main(args)
+        return navbench.main(
+            scenarios=args.scenarios,
+            only=args.only or (),
+            trials=args.trials,
+            seed=args.seed,
+            plots=args.plots,
+            as_json=args.json,
+        )
     return bench.bench_match(args)
 
 

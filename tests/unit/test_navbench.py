@@ -1,4 +1,4 @@
-"""`arena bench nav` (tools/navbench.py): scenario files, determinism, paper 3's local minima, output shape.
+"""`arena bench nav` (tools/navbench/): scenario files, determinism, paper 3's local minima, output shape.
 
 Safe rates are measurements, reported by the benchmark and docs/navigation.md;
 they are not asserted here. What is asserted is what the issue claims as fact
