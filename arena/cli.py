@@ -21,7 +21,8 @@ EXAMPLES = {
   arena match --home AD --away BS --link congested-wifi --link-param wifi.latency_ms=30
   arena match --home BS --away BS --external a/1      # start robot a/1 by hand (HIL)
   arena match --home BS --away BS --realtime --half-time 5
-  arena match --home BS --away AD --half-time 60 --record match.mcap   # then: arena review match.mcap""",
+  arena match --home BS --away AD --half-time 60 --record match.mcap   # then: arena review match.mcap
+  arena match --home BS --away BS --half-time 10 --strict   # any crashed process ends the match, exit 1""",
     "run": """examples:
   # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
   arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
@@ -116,6 +117,12 @@ def build_parser() -> Parser:
         "--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up"
     )
     m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
+    m.add_argument(
+        "--strict",
+        action="store_true",
+        help="stop the match at the first failed process and exit 1 (CI, strategy development); "
+        "by default a crashed robot or base station is a fault and its team plays on short-handed",
+    )
 
     r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
     r.add_argument("kind", choices=[*KINDS, "router"], help="process kind")
@@ -235,15 +242,24 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=(), 
     return cfg
 
 
-def emit_match(result: dict, as_json: bool) -> int:
-    """Print a match result (arena match, arena up): one JSON object, or the tables."""
-    from arena.tools import report
+def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
+    """Print a match result (arena match, arena up): one JSON object, or the tables.
+
+    Faults and keys with two senders are also printed on stderr, one line
+    each. A void match (tools/faults.py) exits 1 with one line naming the cause.
+    """
+    from arena.tools import faults, report
 
     if as_json:
         result.pop("referee_log", None)
         print(json.dumps(result, indent=2))
     else:
         report.print_match(result)
+    for line in faults.warnings(result):
+        print(f"{prog}: warning: {line}", file=sys.stderr)
+    if result.get("outcome") == "void":
+        print(f"{prog}: void: {'; '.join(result['outcome_reasons'])}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -273,6 +289,7 @@ def cmd_match(args: argparse.Namespace) -> int:
             progress=show,
             log_dir=args.logs,
             announce=lambda text: print(text, file=sys.stderr, flush=True),
+            strict=args.strict,
         )
     except launcher.MatchError as exc:
         print(f"arena match: error: {exc}", file=sys.stderr)
@@ -335,7 +352,7 @@ def cmd_up(args: argparse.Namespace) -> int:
     except compose.ComposeError as exc:
         print(f"arena up: error: {exc}", file=sys.stderr)
         return 2 if exc.bad_input else 1
-    return emit_match(result, args.json)
+    return emit_match(result, args.json, "arena up")
 
 
 def cmd_tournament(args: argparse.Namespace) -> int:

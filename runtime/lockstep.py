@@ -48,6 +48,7 @@ import msgspec
 from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.messages import Base
+from arena.schemas.validate import nonfinite, safe_default
 
 M = TypeVar("M", bound=Base)
 
@@ -81,13 +82,22 @@ EVERY_TICK = Schedule(1, 0)
 
 
 class Rejections:
-    """Counts malformed or out-of-sequence inputs, logs the first ones of each kind."""
+    """Counts malformed, out-of-sequence and invalid inputs, logs the first ones of each kind.
+
+    `conflicts` counts, per key, frames for a tick that already had a
+    different accepted frame on that key: two senders on one key.
+    """
 
     LOG_FIRST = 5
 
     def __init__(self, log: logging.Logger):
         self.log = log
         self.by_reason: Counter[str] = Counter()
+        self.conflicts: Counter[str] = Counter()
+
+    def conflict(self, key: str, tick: int) -> None:
+        self.conflicts[key] += 1
+        self.reject(key, "conflict", f"a second, different frame for tick {tick}")
 
     @property
     def total(self) -> int:
@@ -292,6 +302,9 @@ class Inbound(Generic[M]):
         self.woken = False  # reactive mode: a WAKE came (a peer's token vanished)
         self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
         self.latest: M | None = None  # the last delivered message
+        self._last_raw: bytes = b""  # payload of the last accepted frame (conflict detection)
+        self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
+        self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
 
     # ------------------------------------------------------------------ intake
     def _accept(self, raw: bytes, now_tick: int | None) -> bool:
@@ -311,25 +324,56 @@ class Inbound(Generic[M]):
         if self.strict:  # lockstep: exactly the next scheduled tick
             expected = self.last_seen + 1 if self._every_tick else self.schedule.first_after(self.last_seen)
             if tick != expected:
-                self._rej.reject(self.key, "out-of-sequence", f"tick {tick}, expected {expected}")
+                if tick == self.last_seen and raw != self._last_raw:
+                    self._conflict(raw, msg)
+                else:
+                    self._rej.reject(self.key, "out-of-sequence", f"tick {tick}, expected {expected}")
                 return False
         elif tick <= self.last_seen:
-            self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {self.last_seen}")
+            if tick == self.last_seen and raw != self._last_raw:
+                self._conflict(raw, msg)
+            else:
+                self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {self.last_seen}")
             return False
-        if self._check is not None:
+        self._last_raw = raw
+        self._stand_in = False
+        # In sequence: the link advances whatever the content. A frame that fails
+        # validation is counted and replaced by the key's safe default
+        # (schemas/validate.py), so nobody waits for a frame that will never come.
+        problem = nonfinite(raw, msg)
+        if problem is None and self._check is not None:
             problem = self._check(msg)
-            if problem:
-                self._rej.reject(self.key, "invalid", problem)
-                return False
+        if problem:
+            self._rej.reject(self.key, "invalid", problem)
+            msg = safe_default(msg, self._prev)  # type: ignore[assignment]
+            self._stand_in = True
+        if msg is not None:
+            self._prev = msg
         self.last_seen = tick
         delay = self.emulator.decide()
-        if delay is None:
+        if delay is None or msg is None:
             return True
         base = tick if now_tick is None else now_tick
         # A frame on time (every frame of an ideal link) is held for `lag`, which is what the formula gives for 0.
         hold = self.lag if delay == 0.0 else max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
         heapq.heappush(self._pending, (base + hold, tick, msg))
         return True
+
+    def _conflict(self, raw: bytes, msg: M) -> None:
+        """A second, different frame for the tick just accepted: two senders on one key.
+
+        Counted. If the accepted one was invalid (a safe default stands in for
+        it) and this one is valid and not yet delivered, this one takes its place.
+        """
+        self._rej.conflict(self.key, msg.tick)  # type: ignore[attr-defined]
+        if not self._stand_in or nonfinite(raw, msg) or (self._check is not None and self._check(msg)):
+            return
+        for i, (at, tick, _) in enumerate(self._pending):
+            if tick == msg.tick:  # type: ignore[attr-defined]
+                self._pending[i] = (at, tick, msg)  # same order keys: still a heap
+                self._prev = msg
+                self._stand_in = False
+                return
 
     def ready(self, k: int) -> bool:
         """Every frame sent at or before k - lag is in (or the sender is dead)."""

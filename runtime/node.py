@@ -60,6 +60,7 @@ class Node:
         self.inbound: list[Inbound[Any]] = []
         self.gone: set[str] = set()  # peers whose liveliness token vanished
         self.dead: dict[str, str] = {}  # peers we stopped waiting for, with the reason
+        self.dead_at: dict[str, int] = {}  # ... and our tick when we did
         self._alive: set[str] = set()
         self._alive_cond = threading.Condition()
         self._work_s: list[float] = []  # wall seconds of own work per tick (perf statistics only)
@@ -136,6 +137,7 @@ class Node:
     def _record_dead(self, peer: str, why: str) -> None:
         if peer not in self.dead:
             self.dead[peer] = why
+            self.dead_at[peer] = self.last_tick
             self.log.error("treating %s as dead: %s", peer, why)
             self.on_peer_dead(peer)
 
@@ -282,4 +284,6 @@ class Node:
             cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
             extra=self.summary_extra(),
             sent_by_key={o.rel.decode(): o.sent for o in self.outbound},
+            conflicts={self.keys.rel(k): n for k, n in sorted(self.rejections.conflicts.items())},
+            dead_at=dict(sorted(self.dead_at.items())),
         )

@@ -248,7 +248,7 @@ class Summary(Base):
     pid: Annotated[int, Meta(description="OS process id")]
     digest: Annotated[str, Meta(description="hex BLAKE2b of every (key, payload) it sent, in order")]
     sent: Annotated[int, Meta(description="frames sent")]
-    rejected: Annotated[int, Meta(description="malformed or out-of-sequence inputs")]
+    rejected: Annotated[int, Meta(description="malformed, out-of-sequence, conflicting or invalid inputs")]
     rejected_reasons: dict[str, int] = {}
     links: Annotated[
         dict[str, dict[str, float]],
@@ -262,6 +262,13 @@ class Summary(Base):
     extra: Annotated[dict[str, object], Meta(description="kind-specific results (score, events, distances)")] = {}
     sent_by_key: Annotated[
         dict[str, int], Meta(description="frames sent per key, the key without the `arena/<match>/` prefix")
+    ] = {}
+    conflicts: Annotated[
+        dict[str, int],
+        Meta(description="per inbound key (no prefix): frames for a tick that already had a different frame"),
+    ] = {}
+    dead_at: Annotated[
+        dict[str, int], Meta(description="per peer in `dead`: this process's tick when it stopped waiting for it")
     ] = {}
 
 

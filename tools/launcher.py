@@ -32,6 +32,8 @@ from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Referee, Summary
+from arena.tools.faults import VOIDING, exit_reason
+from arena.tools.faults import outcome as match_outcome
 
 _PR_SET_PDEATHSIG = 1
 
@@ -189,6 +191,10 @@ class Collected:
     pids: dict[str, int] = field(default_factory=dict)
     started: float = 0.0
     ended: float = 0.0
+    crashed: dict[str, str] = field(default_factory=dict)  # name -> why (exit code)
+    lost: dict[str, str] = field(default_factory=dict)  # liveliness gone before the summary
+    missing: dict[str, str] = field(default_factory=dict)  # no summary within the bound
+    void: str = ""  # why the match is void, found while supervising
 
 
 def open_collector(transport: ZenohTransport, keys: Keys):
@@ -196,6 +202,26 @@ def open_collector(transport: ZenohTransport, keys: Keys):
     channel = transport.subscribe(keys.summary_all())
     transport.declare_alive(keys.collector())
     return channel
+
+
+# [s] a process whose liveliness token vanished, or that exited, gets this long
+# for its summary to arrive (a summary is re-sent for up to 5 s until acked).
+SUMMARY_GRACE = 6.0
+# [s] once every other process has finished, the last ones must finish within this.
+FINISH_GRACE = 10.0
+
+
+def supervision_deadline(cfg: MatchConfig) -> float:
+    """[s] wall: the longest a whole match may take before the launcher gives up.
+
+    Start-up (`startup_timeout`), the match at a real-time factor of at least
+    0.2 in lockstep (1 in real time), one last-resort watchdog wait
+    (`wait_timeout`) and the summaries' grace. 2 x 60 s in lockstep: 30 + 600 +
+    60 + 16 = 706 s; the typical match takes a tenth of that.
+    """
+    t = cfg.timing
+    play = cfg.total_ticks * t.dt * (1.0 if cfg.realtime else 5.0)
+    return t.startup_timeout + play + t.wait_timeout + SUMMARY_GRACE + FINISH_GRACE
 
 
 def supervise(
@@ -207,17 +233,47 @@ def supervise(
     expected: list[str],
     progress: Progress,
     timeout: float | None = None,
+    strict: bool = False,
 ) -> Collected:
-    """Wait for every expected summary; abort on a failed child or Ctrl-C."""
+    """Wait for every expected summary, within bounds; note every failure by name.
+
+    `strict`: the first child to fail ends the match (MatchError), as for CI.
+    Otherwise a failed team process or recorder is a fault and the match plays
+    on; a failed engine or referee makes it void at once (tools/faults.py).
+    """
     decode_summary = msgspec.msgpack.Decoder(Summary).decode
     decode_ref = msgspec.msgpack.Decoder(Referee).decode
     sums = collector
     refs = transport.subscribe(keys.key("referee")) if progress.enabled else None
     got = Collected(started=time.monotonic())
-    deadline = None if timeout is None else got.started + timeout
+    deadline = got.started + (timeout if timeout is not None else supervision_deadline(cfg))
     waiting = set(expected)
+    gone_at: dict[str, float] = {}  # liveliness token vanished (wall time)
+
+    def on_alive(key: str, alive: bool) -> None:
+        peer = key.split("/alive/", 1)[-1]
+        if alive:
+            gone_at.pop(peer, None)
+        elif peer not in got.summaries:
+            gone_at.setdefault(peer, time.monotonic())
+
+    transport.watch_alive(keys.alive_all(), on_alive)
+    by_name = {c.name: c for c in children}
+    exit_seen: dict[str, float] = {}
+    engine_done = last_summary = 0.0
+
+    def fail(name: str, why: str, into: dict[str, str]) -> None:
+        c = by_name.get(name)
+        if strict:
+            pid = f" (pid {c.popen.pid})" if c is not None else ""
+            raise MatchError(f"{name}{pid} {why}:\n{c.tail() if c else ''}")
+        into[name] = why
+        waiting.discard(name)
+        if name.split("/")[0] in VOIDING and not got.void:
+            got.void = f"{name} {why}"
+
     with progress:
-        while waiting - set(got.summaries):
+        while waiting - set(got.summaries) and not got.void:
             raw = sums.try_recv()
             if raw is not None:
                 try:
@@ -226,9 +282,9 @@ def supervise(
                     continue  # not ours to judge; the rest of the match goes on
                 if s.process not in got.summaries:
                     got.summaries[s.process] = s
-                    # A peer the others treated as dead (hung, unreachable) will
-                    # not report; the match is over without it.
-                    waiting -= set(s.dead)
+                    last_summary = time.monotonic()
+                    if s.process == "engine":
+                        engine_done = time.monotonic()
                 transport.publisher(keys.ack(s.process))(b"ack")
                 continue
             if refs is not None:
@@ -240,26 +296,43 @@ def supervise(
                         progress.update(decode_ref(last))
                     except (msgspec.DecodeError, msgspec.ValidationError):
                         pass
-            for c in children:
-                if c.name not in waiting:
-                    continue
-                code = c.popen.poll()
-                if code is not None and code != 0 and c.name not in got.summaries:
-                    raise MatchError(f"{c.name} (pid {c.popen.pid}) exited with code {code}:\n{c.tail()}")
-                if code == 0 and c.name not in got.summaries:
-                    # Give its summary a moment to arrive before calling it lost.
-                    c_deadline = getattr(c, "_exit_seen", None)
-                    if c_deadline is None:
-                        c._exit_seen = time.monotonic()  # type: ignore[attr-defined]
-                    elif time.monotonic() - c_deadline > 5.0:
-                        raise MatchError(f"{c.name} (pid {c.popen.pid}) exited without a summary:\n{c.tail()}")
-            if deadline is not None and time.monotonic() > deadline:
+            now = time.monotonic()
+            for name in sorted(waiting - set(got.summaries)):
+                c = by_name.get(name)
+                code = c.popen.poll() if c is not None else None
+                if code is not None:
+                    seen = exit_seen.setdefault(name, now)
+                    if code != 0:
+                        fail(name, exit_reason(code), got.crashed)
+                    elif now - seen > SUMMARY_GRACE:
+                        fail(name, "exited without a summary", got.crashed)
+                elif name in gone_at and now - gone_at[name] > SUMMARY_GRACE:
+                    what = "stopped responding" if c is not None else "left"
+                    fail(name, f"{what}: its liveliness token vanished before its summary", got.lost)
+            left = waiting - set(got.summaries)
+            if engine_done and left and not got.void:
+                # The engine has played its last tick. A process that alone is still
+                # missing has every input it will ever get; several may wait on each
+                # other, at worst for one last-resort watchdog wait.
+                bound = FINISH_GRACE if len(left) == 1 else cfg.timing.wait_timeout + FINISH_GRACE
+                if now - max(engine_done, last_summary) > bound:
+                    for name in sorted(left):
+                        fail(name, f"sent no summary within {bound:g} s of the match's end", got.missing)
+            if now > deadline and not got.void:
                 missing = sorted(waiting - set(got.summaries))
-                raise MatchError(f"match timed out after {timeout:g} s waiting for: {', '.join(missing)}")
+                if strict or timeout is not None:
+                    waited = deadline - got.started
+                    raise MatchError(f"match timed out after {waited:g} s waiting for: {', '.join(missing)}")
+                got.void = f"no result within the supervision deadline ({deadline - got.started:g} s)"
+                for name in missing:
+                    got.missing[name] = "no summary by the supervision deadline"
             # Nothing to do while the match plays but show progress and notice a
             # failed child: a slow poll leaves the two cores to the match. The
             # summaries all come within a few ms of each other: poll fast then.
             time.sleep(0.01 if got.summaries else 0.1)
+    for name in list(gone_at):
+        if name not in got.summaries and name not in got.lost and name not in got.crashed and name in expected:
+            got.lost[name] = "stopped responding: its liveliness token vanished before its summary"
     got.ended = time.monotonic()
     return got
 
@@ -329,7 +402,15 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
     # Simulation speed is measured by the engine from its start barrier to its
     # last tick; process start-up is reported apart (wall_seconds).
     play = max(1e-9, engine.wall_s if engine and engine.wall_s > 0 else got.ended - got.started)
+    honest = match_outcome(cfg, sums, got.crashed, got.lost, got.missing, got.void)
+    recording = recorder.extra if recorder else None
+    if cfg.record and recorder is None:
+        why = next((f["reason"] for f in honest["faults"] if f["process"] == "recorder"), "no summary")
+        recording = {"path": cfg.record, "complete": False, "error": f"the recorder failed: {why}"}
     return {
+        "outcome": honest["outcome"],
+        "void": honest["void"],
+        "outcome_reasons": honest["outcome_reasons"],
         "home": cfg.home,
         "away": cfg.away,
         "score": score,
@@ -351,9 +432,11 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "distance_m": engine.extra.get("distance_m", {}) if engine else {},
         "rejected": sum(rejected.values()),
         "rejected_reasons": dict(rejected),
-        "dead": sorted({d for s in sums.values() for d in s.dead}),
+        "dead": honest["dead"],
+        "faults": honest["faults"],
+        "conflicts": honest["conflicts"],
         "sent_by_key": dict(sorted(sent_by_key.items())),
-        "recording": recorder.extra if recorder else None,
+        "recording": recording,
         "referee_log": referee.extra.get("log", []) if referee else [],
     }
 
@@ -366,11 +449,14 @@ def play_match(
     progress: bool = False,
     log_dir: str | None = None,
     announce=None,
+    strict: bool = False,
 ) -> dict:
     """Play one match as separate processes and return its result dict.
 
     `announce(text)` is called with instructions for `--external` processes.
-    Raises MatchError when the match cannot be completed.
+    A failed process is a fault in the result (`outcome`, `faults`: see
+    tools/faults.py); with `strict`, it raises MatchError instead, as does a
+    match that cannot start.
     """
     t_start = time.monotonic()
     compile_sources()
@@ -409,18 +495,23 @@ def play_match(
                     children,
                     [str(p) for p in cfg.processes()],
                     Progress(cfg.total_ticks, progress),
+                    strict=strict,
                 )
             finally:
                 transport.close()
-        dead = {d for s in got.summaries.values() for d in s.dead}
+        dead = {d for s in got.summaries.values() for d in s.dead} | set(got.lost) | set(got.missing)
         for c in children:
-            if c.name in dead:
-                continue  # hung: stop_all below ends it
+            if c.name in dead or got.void:
+                continue  # hung, or a void match: stop_all below ends it
             try:
                 c.popen.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 pass
-        return assemble(cfg, got, time.monotonic() - t_start, children)
+        result = assemble(cfg, got, time.monotonic() - t_start, children)
+        if result["outcome"] != "completed" and log_dir is None:
+            keep = True  # a fault's evidence
+            result["logs"] = str(tmp)
+        return result
     except MatchError as exc:
         if log_dir is None:
             keep = True

@@ -56,8 +56,8 @@ def test_ctrl_c_stops_every_process(reap):
     assert match_dirs() - before == set(), "an interrupted match leaves no temp dir behind"
 
 
-def test_a_crashing_child_ends_the_match_with_a_clear_message(reap):
-    proc = spawn(*MATCH, "--half-time", "300")
+def test_a_crashing_child_ends_a_strict_match_with_a_clear_message(reap):
+    proc = spawn(*MATCH, "--half-time", "300", "--strict")
     reap.append(proc)
     kids = all_ten(proc.pid)
     victim = next(p for p in kids if "--team a --robot 2" in cmdline(p))

@@ -1,0 +1,72 @@
+"""What a receiver does with a frame that decodes but cannot be used.
+
+Two things, for every message type:
+
+* `nonfinite(raw, msg)`: a NaN or an infinity anywhere in the message (a
+  strategy that divided by zero, a forged frame) names the first such field.
+  The raw payload is scanned first for the msgpack float headers of a
+  non-finite value (0xcb/0xca then an all-ones exponent); only a payload that
+  has one is walked field by field, so a clean frame costs four byte scans.
+* `safe_default(msg, previous)`: what an in-sequence frame that failed
+  validation is replaced by, so its link still advances and nobody waits for a
+  frame that will never come (docs/architecture.md, "Faults"): a `cmd` stops
+  the wheels and never kicks; an `engine/events` or `referee` frame carries no
+  new events or commands (a repeated GOAL would count twice); any other key
+  repeats the previous good message of its link, or delivers nothing if there
+  was none yet.
+"""
+
+from __future__ import annotations
+
+import math
+
+import msgspec
+
+from arena.schemas.messages import Base, Cmd, EngineEvents, Referee
+
+# msgpack float 64 (0xcb) and float 32 (0xca), big-endian: a non-finite value has
+# its exponent bits all set, so its first byte is 0x7f or 0xff.
+_SUSPECT = (b"\xcb\x7f", b"\xcb\xff", b"\xca\x7f", b"\xca\xff")
+
+
+def _walk(value: object, path: str) -> str | None:
+    if type(value) is float:
+        return None if math.isfinite(value) else f"{path or 'value'} is not finite"
+    if isinstance(value, Base):
+        for name in value.__struct_fields__:
+            problem = _walk(getattr(value, name), f"{path}.{name}" if path else name)
+            if problem:
+                return problem
+    elif isinstance(value, list | tuple):
+        for i, item in enumerate(value):
+            problem = _walk(item, f"{path}[{i}]")
+            if problem:
+                return problem
+    elif isinstance(value, dict):
+        for k, item in value.items():
+            problem = _walk(item, f"{path}[{k!r}]")
+            if problem:
+                return problem
+    return None
+
+
+def nonfinite(raw: bytes, msg: Base) -> str | None:
+    """The first non-finite float in `msg` (decoded from `raw`), or None."""
+    for pattern in _SUSPECT:
+        if pattern in raw:
+            return _walk(msg, "")
+    return None
+
+
+def safe_default(msg: Base, previous: Base | None) -> Base | None:
+    """The replacement for `msg`, an in-sequence frame that failed validation (None: deliver nothing)."""
+    tick = msg.tick  # type: ignore[attr-defined]
+    if isinstance(msg, Cmd):
+        return Cmd(tick=tick)
+    if isinstance(msg, EngineEvents):
+        return EngineEvents(tick=tick)
+    if previous is None:
+        return None
+    if isinstance(previous, Referee):
+        return msgspec.structs.replace(previous, tick=tick, commands=[])
+    return msgspec.structs.replace(previous, tick=tick)

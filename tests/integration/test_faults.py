@@ -1,0 +1,173 @@
+"""A match survives a crashed robot, an invalid frame never stalls it, and a broken match never exits 0.
+
+Real processes over real zenoh: the faults are real signals (kill -9,
+SIGSTOP/SIGCONT) sent to real children at a tick read off the wire, and the
+NaN strategy is a real plugin found through its entry point by every process.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import textwrap
+
+import msgspec
+import zenoh
+
+from arena.runtime.session import NetConfig, open_session
+from arena.schemas.messages import Referee
+from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for
+
+MATCH = ("match", "--home", "BS", "--away", "BS", "--json")
+
+
+def child(launcher_pid: int, needle: str) -> int:
+    """The pid of the match process whose command line contains `needle`."""
+
+    def find():
+        return next((p for p in descendants(launcher_pid) if needle in cmdline(p)), None)
+
+    return wait_for(find, 60, f"a process with {needle!r}")
+
+
+def wait_for_tick(endpoint: str, match: str, tick: int, proc) -> int:
+    """Block until the referee has sent a frame for `tick` or later; returns that frame's tick."""
+    decode = msgspec.msgpack.Decoder(Referee).decode
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        sub = session.declare_subscriber(f"arena/{match}/referee", zenoh.handlers.FifoChannel(10000))
+        seen = [-1]
+
+        def reached():
+            assert proc.poll() is None, "the match ended before the tick"
+            while (s := sub.try_recv()) is not None:
+                seen[0] = decode(s.payload.to_bytes()).tick
+            return seen[0] >= tick
+
+        wait_for(reached, 120, f"tick {tick}", interval=0.005)
+        sub.undeclare()
+    return seen[0]
+
+
+def finish(proc, timeout: float = 300) -> tuple[int, dict | None, str]:
+    out, err = proc.communicate(timeout=timeout)
+    return proc.returncode, (json.loads(out) if out.strip() else None), err
+
+
+def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
+    """Issue 15 acceptance: kill -9 of robot b/1 at about tick 1500 of a 2 x 60 s match."""
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "4", "--match", "crash", "--listen", endpoint)
+    reap.append(proc)
+    victim = child(proc.pid, "--team b --robot 1")
+    at = wait_for_tick(endpoint, "crash", 1500, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc)
+    assert code == 0, err
+    assert result["outcome"] == "completed_with_faults" and not result["void"]
+    assert result["ticks"] == 6000 and result["events"]["END_GAME"] == 1
+    assert result["dead"] == ["robot/b/1"]
+    [fault] = result["faults"]
+    assert fault["process"] == "robot/b/1" and "code -9" in fault["reason"]
+    assert at <= fault["tick"] <= at + 500, (at, fault)
+    assert "fault: robot/b/1 at tick" in err and "Traceback" not in err
+    assert result["distance_m"]["b/2"] > 5, "its team plays on"
+
+
+def test_strict_stops_the_match_at_the_first_crash(reap, tmp_path):
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "strict", "--listen", endpoint, "--strict")
+    reap.append(proc)
+    victim = child(proc.pid, "--team a --robot 2")
+    wait_for_tick(endpoint, "strict", 100, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc, 60)
+    assert code == 1 and result is None
+    assert f"robot/a/2 (pid {victim}) exited with code -9" in err
+
+
+def test_a_dead_referee_voids_the_match_at_once(reap, tmp_path):
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "noref", "--listen", endpoint)
+    reap.append(proc)
+    victim = child(proc.pid, "arena run referee")
+    kids = descendants(proc.pid)
+    wait_for_tick(endpoint, "noref", 200, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc, 60)
+    assert code == 1
+    assert result["void"] and result["outcome"] == "void"
+    assert result["ticks"] < 6000
+    assert "referee exited with code -9 (SIGKILL)" in result["outcome_reasons"][0]
+    assert err.strip().splitlines()[-1].startswith("arena match: void: referee exited with code -9")
+    wait_for(lambda: not [p for p in kids if alive(p)], 10, "every process of the void match to stop")
+
+
+def test_a_dead_engine_voids_the_match(reap, tmp_path):
+    """Issue 20: kill -9 of the engine used to leave the others playing to the end and exit 0."""
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "noengine", "--listen", endpoint)
+    reap.append(proc)
+    victim = child(proc.pid, "arena run engine")
+    wait_for_tick(endpoint, "noengine", 200, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc, 60)
+    assert code == 1 and result["outcome"] == "void"
+    assert any("engine exited with code -9" in r for r in result["outcome_reasons"])
+    assert "arena match: void: engine exited with code -9" in err
+
+
+NAN_PLUGIN = '''
+import math
+from arena.schemas.messages import Cmd
+from arena.strategies import registry
+from arena.strategies.base import Strategy
+
+_BS = registry.get("BS")
+
+
+class NanRobot:
+    """The basic-static robot, but every 100th tick its command is NaN."""
+
+    def __init__(self, ctx):
+        self.inner = _BS.make_robot(ctx)
+
+    def step(self, tick, sense, order):
+        cmd = self.inner.step(tick, sense, order)
+        if tick % 100 == 50:
+            return Cmd(tick=tick, vx=math.nan, vy=cmd.vy, omega=math.inf)
+        return cmd
+
+    def report(self, tick, sense):
+        return self.inner.report(tick, sense)
+
+
+STRATEGY = Strategy(name="nan-every-100", make_team=_BS.make_team, make_robot=NanRobot)
+'''
+
+
+def nan_plugin(tmp_path) -> dict[str, str]:
+    """An installed strategy plugin (a module and its dist-info on PYTHONPATH): the env to play it."""
+    root = tmp_path / "plugin"
+    dist = root / "nan_strategy-1.0.dist-info"
+    dist.mkdir(parents=True)
+    (root / "nan_strategy.py").write_text(textwrap.dedent(NAN_PLUGIN))
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: nan-strategy\nVersion: 1.0\n")
+    (dist / "entry_points.txt").write_text("[soccer_arena.strategies]\nnan = nan_strategy:STRATEGY\n")
+    path = os.pathsep.join(p for p in (str(root), os.environ.get("PYTHONPATH", "")) if p)
+    return dict(os.environ, PYTHONPATH=path)
+
+
+def test_a_strategy_that_returns_nan_every_100_ticks_plays_to_the_end(reap, tmp_path):
+    """Issue 15 acceptance: 2 x 60 s to END_GAME, its invalid frames counted, no peer declared dead."""
+    proc = spawn("match", "--home", "nan-every-100", "--away", "BS", "--half-time", "60", "--seed", "5", "--json",
+                 env=nan_plugin(tmp_path))  # fmt: skip
+    reap.append(proc)
+    code, result, err = finish(proc)
+    assert code == 0, err
+    assert result["outcome"] == "completed", result["outcome_reasons"]
+    assert result["ticks"] == 6000 and result["events"]["END_GAME"] == 1
+    assert result["dead"] == [] and result["faults"] == []
+    # Every robot of team a: one NaN command per 100 ticks, ticks 50, 150, ..., 5950.
+    assert result["rejected_reasons"]["invalid"] == 3 * 60, result["rejected_reasons"]
+    assert "out-of-sequence" not in result["rejected_reasons"]

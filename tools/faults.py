@@ -1,0 +1,116 @@
+"""An honest match result: who failed, when, and whether the match counts.
+
+The launcher observes three kinds of failure, each with the process's name:
+
+* `crashed`: a child exited non-zero, or exited without a summary;
+* `lost`: a process's liveliness token vanished before its summary came (a
+  hang: SIGSTOP, a cut cable; or an external that left);
+* `missing`: a process that never delivered its summary within the bound.
+
+The processes themselves report whom they gave up waiting for (`Summary.dead`,
+with their tick in `dead_at`). A process that was itself lost sees everyone
+else vanish, so its claims are not evidence: `dead` is what the processes that
+stayed connected claim (issue 20, "correct blame").
+
+The outcome:
+
+* `void`: the engine or the referee failed, or the match played fewer ticks
+  than configured. It is no result: `arena match` exits 1, a tournament never
+  counts it;
+* `completed_with_faults`: played to the end, but a team process, the recorder
+  or an external failed (a robot breaking down in a real match);
+* `completed`: nothing failed.
+"""
+
+from __future__ import annotations
+
+import signal
+
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import Summary
+
+# A failure of one of these makes the match void: without them there is no game.
+VOIDING = ("engine", "referee")
+
+
+def exit_reason(code: int) -> str:
+    if code < 0:
+        try:
+            return f"exited with code {code} ({signal.Signals(-code).name})"
+        except ValueError:
+            pass
+    return f"exited with code {code}"
+
+
+def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
+    """Dead processes as claimed by processes that were not lost themselves: name -> earliest tick."""
+    dead: dict[str, int] = {}
+    for name, s in summaries.items():
+        if name in lost:
+            continue
+        for peer in s.dead:
+            tick = s.dead_at.get(peer, s.tick)
+            dead[peer] = min(tick, dead.get(peer, tick))
+    return dead
+
+
+def outcome(
+    cfg: MatchConfig,
+    summaries: dict[str, Summary],
+    crashed: dict[str, str],
+    lost: dict[str, str],
+    missing: dict[str, str],
+    void: str = "",
+) -> dict:
+    """The `outcome`, `void`, `outcome_reasons`, `dead`, `faults` and `conflicts` of the match JSON."""
+    dead = blame(summaries, set(lost))
+    order = [str(p) for p in cfg.processes()]
+    faults = []
+    for name in order:
+        why = crashed.get(name) or lost.get(name) or missing.get(name)
+        if why is None and name in dead:
+            why = "stopped responding: its peers gave up waiting for it"
+        if why is None:
+            continue
+        faults.append({"process": name, "tick": dead.get(name), "reason": why})
+    reasons = []
+    if void:
+        reasons.append(void)
+    for kind in VOIDING:
+        if kind not in summaries and not void:
+            f = next((f for f in faults if f["process"] == kind), None)
+            reasons.append(f"{kind}: {f['reason']}" if f else f"{kind}: no summary")
+    engine = summaries.get("engine")
+    ticks = engine.tick if engine is not None else 0
+    if engine is not None and ticks < cfg.total_ticks:
+        reasons.append(f"the engine played {ticks} of {cfg.total_ticks} ticks")
+    if reasons:
+        result = "void"
+    elif faults:
+        result = "completed_with_faults"
+        reasons = [f"{f['process']}: {f['reason']}" for f in faults]
+    else:
+        result = "completed"
+    conflicts: dict[str, int] = {}
+    for s in summaries.values():
+        for key, n in s.conflicts.items():
+            conflicts[key] = conflicts.get(key, 0) + n
+    return {
+        "outcome": result,
+        "void": result == "void",
+        "outcome_reasons": reasons,
+        "dead": sorted(dead),
+        "faults": faults,
+        "conflicts": dict(sorted(conflicts.items())),
+    }
+
+
+def warnings(result: dict) -> list[str]:
+    """One line per fault and per key with two senders, for the terminal."""
+    lines = []
+    for key, n in result.get("conflicts", {}).items():
+        lines.append(f"two senders on {key}: possible spoofing ({n} conflicting frames)")
+    for f in result.get("faults", []):
+        at = f" at tick {f['tick']}" if f.get("tick") is not None else ""
+        lines.append(f"fault: {f['process']}{at}: {f['reason']}")
+    return lines
