@@ -22,7 +22,12 @@ EXAMPLES = {
   arena match --home BS --away BS --external a/1      # start robot a/1 by hand (HIL)
   arena match --home BS --away BS --realtime --half-time 5
   arena match --home BS --away AD --half-time 60 --record match.mcap   # then: arena review match.mcap
-  arena match --home BS --away BS --half-time 10 --strict   # any crashed process ends the match, exit 1""",
+  arena match --home BS --away BS --half-time 10 --strict   # any crashed process ends the match, exit 1
+  arena match --home BS --away BS --realtime --half-time 300 --refbox   # base stations connect to TCP 28097
+  arena match --home BS --away BS --realtime --refbox tcp/0.0.0.0:28097 --refbox-protocol b=legacy --record m.mcap
+  arena match --home BS --away BS --refbox --refbox-teams msl_teams.json --refbox-wait 2 --realtime
+  arena match --home BS --away BS --realtime --refbox-follow 192.168.1.2:28097   # a human runs the RefBox
+  arena match --home BS --away AD --realtime --half-time 30 --refbox --via-refbox   # ours through the bridge""",
     "run": """examples:
   # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
   arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
@@ -122,6 +127,46 @@ def build_parser() -> Parser:
         action="store_true",
         help="stop the match at the first failed process and exit 1 (CI, strategy development); "
         "by default a crashed robot or base station is a fault and its team plays on short-handed",
+    )
+    rb = m.add_argument_group("MSL RefBox (docs/refbox.md)")
+    rb.add_argument(
+        "--refbox",
+        nargs="?",
+        const="tcp/0.0.0.0:28097",
+        metavar="ENDPOINT",
+        help="run the RefBox bridge: base stations connect here over TCP (default tcp/0.0.0.0:28097)",
+    )
+    rb.add_argument(
+        "--refbox-teams",
+        metavar="FILE.json",
+        help="team table in msl_teams.json form (UnicastAddr, Team, MulticastAddr, optional side and protocol); "
+        "unknown addresses get RESET. Default: first connection is team a, the second team b",
+    )
+    rb.add_argument(
+        "--refbox-protocol",
+        action="append",
+        default=[],
+        metavar="TEAM=json|legacy",
+        help="without a team table: the protocol of team a's or b's connection, e.g. b=legacy (json)",
+    )
+    rb.add_argument("--refbox-swap", action="store_true", help="team a is magenta and b cyan (default a cyan)")
+    rb.add_argument(
+        "--refbox-targets",
+        metavar="CYAN,MAGENTA",
+        help="targetTeam strings of the two colours when the team table names none (224.16.32.201,224.16.32.202)",
+    )
+    rb.add_argument(
+        "--refbox-wait", type=int, default=0, metavar="N", help="hold the start until N base stations connected (0)"
+    )
+    rb.add_argument(
+        "--refbox-follow",
+        metavar="HOST:PORT",
+        help="our referee connects to a real RefBox as a base station and mirrors its commands",
+    )
+    rb.add_argument(
+        "--via-refbox",
+        action="store_true",
+        help="our base stations take referee commands over TCP from the bridge (needs --refbox and --realtime)",
     )
 
     r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
@@ -268,6 +313,7 @@ def cmd_match(args: argparse.Namespace) -> int:
 
     record = record_path(args.record) if args.record else ""
     cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
+    cfg = cfg.replace(refbox=refbox_params(args))
     if args.match:
         from arena.schemas.keys import check_match_id
 
@@ -295,6 +341,47 @@ def cmd_match(args: argparse.Namespace) -> int:
         print(f"arena match: error: {exc}", file=sys.stderr)
         return 1
     return emit_match(result, args.json)
+
+
+def refbox_params(args: argparse.Namespace):
+    """The RefBox flags of `arena match` as `RefboxParams`; bad values are a ConfigError."""
+    from pathlib import Path
+
+    from arena.rules import refbox_protocol as rp
+    from arena.runtime.config import RefboxParams
+
+    changes: dict[str, object] = {}
+    try:
+        if args.refbox:
+            rp.parse_endpoint(args.refbox)
+            changes["listen"] = args.refbox
+        if args.refbox_teams:
+            try:
+                text = Path(args.refbox_teams).read_text()
+            except OSError as exc:
+                raise ConfigError(f"cannot read --refbox-teams {args.refbox_teams}: {exc.strerror}") from None
+            changes["teams"] = rp.parse_team_table(text)
+        for item in args.refbox_protocol:
+            team, _, proto = item.partition("=")
+            if team not in ("a", "b") or proto not in rp.PROTOCOLS:
+                raise ConfigError(f"--refbox-protocol {item!r}: use a=json, a=legacy, b=json or b=legacy")
+            changes[f"protocol_{team}"] = proto
+        if args.refbox_targets:
+            cyan, _, magenta = args.refbox_targets.partition(",")
+            if not cyan or not magenta or cyan == magenta:
+                raise ConfigError(f"--refbox-targets {args.refbox_targets!r}: two different strings, CYAN,MAGENTA")
+            changes["target_cyan"], changes["target_magenta"] = cyan, magenta
+        if args.refbox_follow:
+            rp.parse_endpoint(args.refbox_follow)
+            changes["follow"] = args.refbox_follow
+    except rp.ProtocolError as exc:
+        raise ConfigError(str(exc)) from None
+    changes["swap"] = args.refbox_swap
+    changes["wait"] = args.refbox_wait
+    changes["via"] = args.via_refbox
+    if args.refbox_wait and not args.refbox:
+        raise ConfigError("--refbox-wait needs --refbox")
+    return RefboxParams(**changes)
 
 
 def record_path(text: str) -> str:

@@ -73,6 +73,8 @@ def data_topics(cfg) -> list[tuple[str, object]]:
     """(topic, KeySpec) for every data key of this match, in KEYS order."""
     out = []
     for spec in KEYS:
+        if spec.sender == "refbox" and not cfg.refbox.listen:
+            continue  # only a match with the RefBox bridge has worldstates
         teams = TEAMS if "<team>" in spec.pattern else ("",)
         numbers = range(cfg.robots) if "<n>" in spec.pattern else (None,)
         out.extend((spec.rel(t, n), spec) for t in teams for n in numbers)

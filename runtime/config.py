@@ -21,7 +21,7 @@ from typing import Any
 import msgspec
 
 TEAMS = ("a", "b")
-KINDS = ("engine", "referee", "basestation", "robot", "recorder")
+KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox")
 
 
 @dataclass(frozen=True)
@@ -159,6 +159,33 @@ class TimingParams:
 
 
 @dataclass(frozen=True)
+class RefboxTeam:
+    """One row of a RefBox team table (msl_teams.json's keys, plus our `side` and `protocol`)."""
+
+    address: str  # UnicastAddr, "a.b.c.*"
+    name: str = ""  # Team
+    target: str = ""  # MulticastAddr: the targetTeam of this team's commands
+    side: str = ""  # "a", "b" or "" (the first free side)
+    protocol: str = "json"  # json | legacy
+
+
+@dataclass(frozen=True)
+class RefboxParams:
+    """The MSL RefBox bridge (docs/refbox.md). Nothing here changes a lockstep digest."""
+
+    listen: str = ""  # tcp/HOST:PORT: run the bridge process there; "" for no bridge
+    teams: tuple[RefboxTeam, ...] = ()  # team table; empty: first connection a, second b
+    protocol_a: str = "json"  # without a table: the protocol of team a's connection (json | legacy)
+    protocol_b: str = "json"
+    swap: bool = False  # team a is magenta and b cyan (default: a cyan, b magenta)
+    target_cyan: str = "224.16.32.201"  # targetTeam of cyan's commands when no table row names one
+    target_magenta: str = "224.16.32.202"
+    wait: int = 0  # hold the start until this many base stations are connected (0: never wait)
+    follow: str = ""  # HOST:PORT of a real RefBox whose commands our referee mirrors; "" to decide itself
+    via: bool = False  # our base stations take their referee commands over TCP from the bridge
+
+
+@dataclass(frozen=True)
 class MatchConfig:
     seed: int = 0
     home: str = "basic-static"  # strategy of team a
@@ -176,6 +203,7 @@ class MatchConfig:
     sensor: SensorParams = SensorParams()
     timing: TimingParams = TimingParams()
     rules: RulesParams = RulesParams()
+    refbox: RefboxParams = RefboxParams()
 
     # ----------------------------------------------------------------- derived
     @property
@@ -198,6 +226,8 @@ class MatchConfig:
         for team in TEAMS:
             for n in range(self.robots):
                 out.append(ProcessId("robot", team, n))
+        if self.refbox.listen:
+            out.append(ProcessId("refbox"))
         if self.record:
             out.append(ProcessId("recorder"))
         return out
@@ -248,6 +278,19 @@ class MatchConfig:
             raise ConfigError(f"robot.model must be omni4 or omni3, got {self.robot.model!r}")
         if not 0 <= self.seed < 2**63:
             raise ConfigError(f"--seed must be in [0, 2^63), got {self.seed}")
+        rb = self.refbox
+        for side, proto in (("a", rb.protocol_a), ("b", rb.protocol_b)):
+            if proto not in ("json", "legacy"):
+                raise ConfigError(f"refbox protocol of team {side} must be json or legacy, got {proto!r}")
+        if not 0 <= rb.wait <= 2:
+            raise ConfigError(f"--refbox-wait must be 0, 1 or 2, got {rb.wait}")
+        if rb.via and not rb.listen:
+            raise ConfigError("--via-refbox needs the bridge: add --refbox [ENDPOINT]")
+        if rb.via and not self.realtime:
+            raise ConfigError(
+                "--via-refbox needs --realtime: the RefBox protocol carries no tick, so a command read from "
+                "TCP cannot be given the lockstep tick it belongs to (docs/refbox.md)"
+            )
         for ext in self.external:
             pid = ProcessId.parse(ext)
             if pid not in self.processes():
@@ -289,10 +332,10 @@ class ProcessId:
                 return cls("robot", parts[1], int(parts[2]))
             if parts[0] == "basestation" and len(parts) == 2 and parts[1] in TEAMS:
                 return cls("basestation", parts[1])
-            if len(parts) == 1 and parts[0] in ("engine", "referee", "recorder"):
+            if len(parts) == 1 and parts[0] in ("engine", "referee", "recorder", "refbox"):
                 return cls(parts[0])
         except ValueError:
             pass
         raise ConfigError(
-            f"bad process name {text!r}: use a/1 or robot/a/1, basestation/a, engine, referee or recorder"
+            f"bad process name {text!r}: use a/1 or robot/a/1, basestation/a, engine, referee, refbox or recorder"
         )

@@ -99,10 +99,12 @@ class Node:
         lag: int,
         sender: str,
         check: Callable[[M], str | None] | None = None,
+        ideal: bool = False,
     ) -> Inbound[Any]:
+        """An inbound key; `ideal`: no link emulation (a listener outside the modelled links)."""
         spec = KEY_BY_NAME[name]
         key = self.keys.key(name, team, n)
-        model = self.links.get(spec.link_class, IDEAL)
+        model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
         emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
         ib: Inbound[Any] = Inbound(
             key=key,

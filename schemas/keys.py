@@ -77,6 +77,16 @@ KEYS: tuple[KeySpec, ...] = (
         "events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", "every referee period (10 Hz)", "wired"
     ),
     KeySpec("world", "world", m.World, "G_V", "engine", "recorder, viewers", "every world period (50 Hz)", "ideal"),
+    KeySpec(
+        "worldstate",
+        "refbox/<team>/worldstate",
+        m.Worldstate,
+        "B_RefBox",
+        "refbox",
+        "recorder",
+        "as the team's base station sends it (--refbox only)",
+        "ideal",
+    ),
 )
 
 KEY_BY_NAME = {k.name: k for k in KEYS}

@@ -239,6 +239,17 @@ class World(Base):
     last_robot: int = -1
 
 
+# ------------------------------------------------------------- B_RefBox
+class Worldstate(Base):
+    """A base station's worldstate as the MSL RefBox bridge received and validated it (docs/refbox.md)."""
+
+    tick: Annotated[int, Meta(ge=0, description="the bridge's match tick when the message was complete")]
+    team: Team
+    address: Annotated[str, Meta(description="the base station's IP address")] = ""
+    age_ms: Annotated[float, Meta(description="[ms] the message's ageMs")] = 0.0
+    json: Annotated[str, Meta(description="the worldstate JSON exactly as the base station sent it")] = ""
+
+
 # --------------------------------------------------------- infrastructure
 class Summary(Base):
     """End of match: one per process, for the launcher's JSON summary."""
@@ -304,6 +315,7 @@ MESSAGE_TYPES: tuple[type[Base], ...] = (
     Referee,
     EngineEvents,
     World,
+    Worldstate,
     Summary,
     TapBatch,
 )

@@ -346,8 +346,9 @@ def percentile(sorted_values: list[float], q: float) -> float:
 
 def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
     """The match result (what `arena match --json` prints)."""
-    # The recorder sends no data: the digests are the same with or without it.
-    order = [str(p) for p in cfg.processes() if p.kind != "recorder"]
+    # The recorder sends no data, and the RefBox bridge's worldstates are what the
+    # teams sent (no process's input): the digest is the same with or without them.
+    order = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "refbox")]
     sums = got.summaries
     combined = hashlib.blake2b(digest_size=16)
     for name in order:
@@ -437,6 +438,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "conflicts": honest["conflicts"],
         "sent_by_key": dict(sorted(sent_by_key.items())),
         "recording": recording,
+        "refbox": sums["refbox"].extra if "refbox" in sums else None,
         "referee_log": referee.extra.get("log", []) if referee else [],
     }
 

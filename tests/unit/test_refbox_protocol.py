@@ -1,0 +1,145 @@
+"""The MSL RefBox protocol library: encodings, framing, worldstate validation, team table."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from arena.rules import refbox_protocol as rp
+
+GOOD = {"type": "worldstate", "teamName": "T", "intention": "", "ageMs": 12, "robots": [], "balls": [], "obstacles": []}
+
+
+def test_json_command_is_one_object_and_a_nul():
+    assert rp.encode_json("KICKOFF", "224.16.32.80") == b'{"command":"KICKOFF","targetTeam":"224.16.32.80"}\0'
+    assert rp.encode_json("START") == b'{"command":"START","targetTeam":""}\0'
+    assert json.loads(rp.encode_json("IS_ALIVE", "x", 3)[:-1]) == {
+        "command": "IS_ALIVE",
+        "targetTeam": "x",
+        "robotID": 3,
+    }
+    assert b"robotID" not in rp.encode_json("KICKOFF", "x", 3)  # only the robot commands carry it
+
+
+@pytest.mark.parametrize(
+    ("command", "colour", "char"),
+    [
+        ("KICKOFF", "cyan", b"K"),
+        ("KICKOFF", "magenta", b"k"),
+        ("START", "", b"s"),
+        ("STOP", "", b"S"),
+        ("FIRST_HALF", "", b"1"),
+        ("SECOND_HALF", "", b"2"),
+        ("HALF_TIME", "", b"h"),
+        ("END_GAME", "", b"e"),
+        ("DROP_BALL", "", b"N"),
+        ("GOAL", "magenta", b"a"),
+        ("CORNER", "cyan", b"C"),
+        ("WELCOME", "", b"W"),
+        ("RESET", "", b"Z"),
+        ("PARK", "", b"L"),
+    ],
+)
+def test_legacy_characters(command, colour, char):
+    assert rp.encode_legacy(command, colour) == char
+    assert rp.CommandReader().feed(char) == [rp.Command(command, colour=colour)]
+
+
+def test_legacy_has_no_character_for_some_commands():
+    assert rp.encode_legacy("IS_ALIVE", "cyan") is None
+    assert rp.encode_legacy("KICKOFF", "") is None  # a team command needs its colour
+
+
+def test_the_30_commands_and_their_sides():
+    assert len(rp.COMMANDS) == len(set(rp.COMMANDS)) == 30
+    assert rp.TEAM_COMMANDS < set(rp.COMMANDS)
+    assert [rp.colour_of(t) for t in "ab"] == ["cyan", "magenta"]
+    assert [rp.colour_of(t, swap=True) for t in "ab"] == ["magenta", "cyan"]
+    assert all(rp.team_of(rp.colour_of(t, s), s) == t for t in "ab" for s in (False, True))
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 10_000])
+def test_command_reader_any_segmentation(chunk):
+    stream = rp.encode_json("WELCOME", "t") + b"K" + rp.encode_json("STOP") + b"s"
+    reader, got = rp.CommandReader(), []
+    for i in range(0, len(stream), chunk):
+        got += reader.feed(stream[i : i + chunk])
+    assert [c.name for c in got] == ["WELCOME", "KICKOFF", "STOP", "START"]
+    assert got[0].target == "t" and got[1].colour == "cyan"
+    assert not reader.errors
+
+
+def test_command_reader_reports_garbage():
+    reader = rp.CommandReader()
+    assert reader.feed(b'{"command":"NOPE"}\0{bad\0?') == []
+    assert len(reader.errors) == 3
+
+
+def enc(doc) -> bytes:
+    return json.dumps(doc).encode() + b"\0"
+
+
+@pytest.mark.parametrize(
+    ("payload", "reason"),
+    [
+        (b"{not json\0", "malformed-json"),
+        (b"[1,2]\0", "malformed-json"),
+        (b"\0", "malformed-json"),
+        (enc({k: v for k, v in GOOD.items() if k != "type"}), "missing-key"),
+        (enc(GOOD | {"type": "hello"}), "wrong-type"),
+        (enc({k: v for k, v in GOOD.items() if k != "ageMs"}), "missing-key"),
+        (enc(GOOD | {"ageMs": "12"}), "missing-key"),
+        (enc({k: v for k, v in GOOD.items() if k != "teamName"}), "missing-key"),
+        (enc(GOOD | {"robots": {}}), "missing-key"),
+        (enc({k: v for k, v in GOOD.items() if k != "obstacles"}), "missing-key"),
+    ],
+)
+def test_worldstate_errors_as_the_refbox(payload, reason):
+    (r,) = rp.WorldstateReader().feed(payload)
+    assert r.doc is None and r.reason == reason
+
+
+def test_worldstates_split_and_joined_anyhow():
+    stream = enc(GOOD) * 3
+    for chunk in (1, 13, len(stream)):
+        reader, got = rp.WorldstateReader(), []
+        for i in range(0, len(stream), chunk):
+            got += reader.feed(stream[i : i + chunk])
+        assert [r.doc["ageMs"] for r in got] == [12, 12, 12]
+
+
+def test_unterminated_message_is_dropped_once_and_the_stream_recovers():
+    reader = rp.WorldstateReader(limit=100)
+    out = reader.feed(b"x" * 60) + reader.feed(b"x" * 60)
+    assert [r.reason for r in out] == ["not-terminated"]
+    out = reader.feed(b"x" * 500 + b"\0" + enc(GOOD))
+    assert [(r.reason, r.doc is not None) for r in out] == [("", True)]
+
+
+def test_team_table_and_identification():
+    table = rp.parse_team_table(
+        json.dumps(
+            [
+                {"UnicastAddr": "172.16.80.*", "Team": "IRIS", "MulticastAddr": "224.16.32.80", "side": "a"},
+                {"UnicastAddr": "127.0.0.*", "Team": "local", "protocol": "legacy"},
+            ]
+        )
+    )
+    assert rp.identify("172.16.80.17", table).name == "IRIS"
+    assert rp.identify("::1", table).protocol == "legacy"
+    assert rp.identify("::ffff:127.0.0.5", table).name == "local"
+    assert rp.identify("10.0.0.1", table) is None
+    for bad in ('{"a": 1}', "[{}]", '[{"UnicastAddr": "1.2.3.4"}]', '[{"UnicastAddr": "1.2.3.*", "side": "c"}]'):
+        with pytest.raises(rp.ProtocolError):
+            rp.parse_team_table(bad)
+
+
+def test_endpoints():
+    assert rp.parse_endpoint("tcp/0.0.0.0:28097") == ("0.0.0.0", 28097)
+    assert rp.parse_endpoint("10.0.0.2:1234") == ("10.0.0.2", 1234)
+    assert rp.parse_endpoint("tcp/[::1]:5") == ("::1", 5)
+    assert rp.parse_endpoint("refbox.local") == ("refbox.local", rp.PORT)
+    for bad in ("udp/1.2.3.4:5", "tcp/:5", "h:xx", "h:70000"):
+        with pytest.raises(rp.ProtocolError):
+            rp.parse_endpoint(bad)
