@@ -4,4 +4,32 @@ state machine that turns ball events into MSL RefBox commands
 (setpieces.py), and the MSL RefBox's own wire, so real base stations can
 join a match: the protocol (refbox_protocol.py) and the bridge's TCP server
 (refbox_server.py). May import `arena.runtime` and `arena.schemas`; imported by
-strategies, processes and tools."""
+strategies, processes and tools.
+
+The referee's vocabulary (command and stage names as `Literal` types, the set
+pieces, `other_team`) is defined once in `arena.schemas.vocabulary`, because
+the wire types in schemas/ check it on decode and schemas/ imports nothing
+above it; it is re-exported here for rule code.
+"""
+
+from arena.schemas.vocabulary import (
+    REF_COMMANDS,
+    RESTARTS,
+    SET_PIECES,
+    STAGES,
+    RefCommandName,
+    SetPieceName,
+    StageName,
+    other_team,
+)
+
+__all__ = [
+    "REF_COMMANDS",
+    "RESTARTS",
+    "SET_PIECES",
+    "STAGES",
+    "RefCommandName",
+    "SetPieceName",
+    "StageName",
+    "other_team",
+]

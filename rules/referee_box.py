@@ -40,28 +40,10 @@ from dataclasses import dataclass
 from arena.rules import setpieces as sp
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee
+from arena.schemas.vocabulary import REF_COMMANDS, STAGES, other_team
 
-MSL_COMMANDS = frozenset(
-    {
-        "START",
-        "STOP",
-        "KICKOFF",
-        "FREEKICK",
-        "GOALKICK",
-        "THROWIN",
-        "CORNER",
-        "PENALTY",
-        "DROP_BALL",
-        "GOAL",
-        "FIRST_HALF",
-        "HALF_TIME",
-        "SECOND_HALF",
-        "END_GAME",
-        "PARK",
-    }
-)
+MSL_COMMANDS = REF_COMMANDS  # arena.schemas.vocabulary.RefCommandName: the wire types check them on decode
 TEAM_COMMANDS = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "GOAL"})  # need a team
-STAGES = ("PRE_GAME", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME")
 PLAYING_STAGES = frozenset({"FIRST_HALF", "SECOND_HALF"})
 _STAGE_COMMANDS = frozenset({"FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"})
 _KEEP_IN_FORCE = frozenset({"GOAL", "FIRST_HALF", "SECOND_HALF"})  # announced; the command in force stays
@@ -200,21 +182,21 @@ def goal_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
     """GOAL: the scorer's goal counts; the conceding team kicks off."""
     if ev.team not in TEAMS:
         return None
-    return Restart("KICKOFF", sp.other(ev.team), (0.0, 0.0), goal=ev.team)
+    return Restart("KICKOFF", other_team(ev.team), (0.0, 0.0), goal=ev.team)
 
 
 def touch_line_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
     """TOUCH_LINE: throw-in for the other team than the last toucher's (nobody touched: drop ball)."""
     if ev.last_team not in TEAMS:
         return Restart("DROP_BALL", "", sp.drop_ball_spot(ev.x, ev.y, rules.cfg))
-    return Restart("THROWIN", sp.other(ev.last_team), sp.throw_in_spot(ev.x, ev.y, rules.cfg))
+    return Restart("THROWIN", other_team(ev.last_team), sp.throw_in_spot(ev.x, ev.y, rules.cfg))
 
 
 def goal_line_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
     """GOAL_LINE: corner if the defending team (`ev.team`) touched it last, else goal kick."""
     defender = ev.team if ev.team in TEAMS else sp.defender_of_goal_line(ev.x, st.attack_dir_a)
     if ev.last_team == defender:
-        return Restart("CORNER", sp.other(defender), sp.corner_spot(ev.x, ev.y, rules.cfg))
+        return Restart("CORNER", other_team(defender), sp.corner_spot(ev.x, ev.y, rules.cfg))
     return Restart("GOALKICK", defender, sp.goal_kick_spot(ev.x, ev.y, rules.cfg))
 
 
@@ -227,7 +209,7 @@ def foul_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
     """FOUL_PUSHING, FOUL_DRIBBLING: free kick for the other team where the foul happened."""
     if ev.team not in TEAMS:
         return None
-    return Restart("FREEKICK", sp.other(ev.team), sp.free_kick_spot(ev.x, ev.y, rules.cfg))
+    return Restart("FREEKICK", other_team(ev.team), sp.free_kick_spot(ev.x, ev.y, rules.cfg))
 
 
 EventRule = Callable[[RefereeState, BallEvent, Rules], Restart | None]

@@ -41,16 +41,12 @@ import math
 from dataclasses import dataclass
 
 from arena.runtime.config import TEAMS, MatchConfig
+from arena.schemas.vocabulary import SET_PIECES, other_team
 
-SET_PIECES = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL"})
 PLACE_MARGIN = 0.05  # [m] a placed robot stands this much beyond the distance it must keep
 RING_STEP = 0.5  # [m] next ring of candidate spots when a whole ring is taken
 ANGLE_STEP = math.radians(5.0)  # [rad] between candidate spots on a ring
 CLEARANCE = 0.05  # [m] between a placed robot's bounding circle and the others', and to the fence
-
-
-def other(team: str) -> str:
-    return "b" if team == "a" else "a"
 
 
 def attack_dir(team: str, attack_dir_a: int) -> int:
@@ -110,11 +106,11 @@ def keep_away(command: str, team: str, cfg: MatchConfig) -> KeepAway | None:
     """Who keeps how far from the ball spot while `command` (for `team`) is being set up."""
     r = cfg.rules
     if command == "KICKOFF":
-        return KeepAway(cfg.field.center_circle_radius + cfg.robot.size / 2, (other(team),))
+        return KeepAway(cfg.field.center_circle_radius + cfg.robot.size / 2, (other_team(team),))
     if command == "DROP_BALL":
         return KeepAway(r.drop_ball_distance, TEAMS)
     if command in SET_PIECES and team in TEAMS:
-        return KeepAway(r.setpiece_distance, (other(team),))
+        return KeepAway(r.setpiece_distance, (other_team(team),))
     return None
 
 

@@ -24,14 +24,14 @@ from typing import Annotated, Literal
 import msgspec
 from msgspec import Meta, Struct
 
+from arena.schemas.vocabulary import RefCommandName, StageName, Team, TeamOrNone
+
 # ---------------------------------------------------------------- field types
 Tick = Annotated[int, Meta(ge=0, description="control tick at which the message was sent")]
 Meters = Annotated[float, Meta(description="[m]")]
 MetersPerSecond = Annotated[float, Meta(description="[m/s]")]
 Radians = Annotated[float, Meta(description="[rad]")]
 RadPerSecond = Annotated[float, Meta(description="[rad/s]")]
-Team = Literal["a", "b"]
-TeamOrNone = Literal["a", "b", ""]
 
 
 class Base(Struct, kw_only=True, forbid_unknown_fields=False):
@@ -137,7 +137,7 @@ class Order(Base):
 
     tick: Tick
     robot: Annotated[int, Meta(ge=0, description="robot number n")]
-    command: Annotated[str, Meta(description="C: current referee command (MSL RefBox name)")] = "STOP"
+    command: Annotated[RefCommandName, Meta(description="C: current referee command (MSL RefBox name)")] = "STOP"
     command_team: Annotated[TeamOrNone, Meta(description="team the command is for, '' = both")] = ""
     spot_x: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
     spot_y: Annotated[float, Meta(description="[m] restart ball spot, field frame")] = 0.0
@@ -158,7 +158,7 @@ class Order(Base):
 
 # ----------------------------------------------------------- Re_G / Re -> B
 class RefCommand(Base):
-    name: Annotated[str, Meta(description="MSL RefBox command name")]
+    name: Annotated[RefCommandName, Meta(description="MSL RefBox command name")]
     team: Annotated[TeamOrNone, Meta(description="target team, '' = both")] = ""
     x: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
     y: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
@@ -169,8 +169,8 @@ class Referee(Base):
     """Re_G and referee to base stations: the referee box's state and new commands."""
 
     tick: Tick
-    stage: Annotated[str, Meta(description="PRE_GAME, FIRST_HALF, HALF_TIME, SECOND_HALF, END_GAME")]
-    command: Annotated[str, Meta(description="the command in force (MSL RefBox name)")]
+    stage: Annotated[StageName, Meta(description="MSL RefBox stage")]
+    command: Annotated[RefCommandName, Meta(description="the command in force (MSL RefBox name)")]
     command_team: TeamOrNone = ""
     spot_x: Meters = 0.0
     spot_y: Meters = 0.0

@@ -35,6 +35,7 @@ import math
 from arena.rules import setpieces
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
+from arena.schemas.vocabulary import other_team
 from arena.strategies.base import RobotContext, Strategy, TeamContext
 from arena.strategies.roles import referee_fields
 
@@ -294,7 +295,7 @@ class SimpleRobot:
 
     def _open_corner(self, sense: Sense, goal_x: float) -> float:
         """y of the aim point: AIM_FRACTION of the half-width, on the side away from the keeper."""
-        other = "b" if self.team == "a" else "a"
+        other = other_team(self.team)
         keeper_y = 0.0
         best = 1.5  # [m] only a robot this close to the goal centre counts as the keeper
         for r in sense.robots:

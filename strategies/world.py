@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 from arena.runtime.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
+from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
 
@@ -101,7 +102,7 @@ class TeamModel:
 
     def __init__(self, team: str, robots: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams()):
         self.team = team
-        self.other = "b" if team == "a" else "a"
+        self.other = other_team(team)
         self.robots = robots
         self.sensor = sensor
         self.p = p
@@ -168,7 +169,7 @@ class RobotView:
 
     def __init__(self, team: str, n: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams()):
         self.team = team
-        self.other = "b" if team == "a" else "a"
+        self.other = other_team(team)
         self.n = n
         self.p = p
         self.sensor = sensor

@@ -39,6 +39,7 @@ import math
 import pymunk
 
 from arena.schemas.messages import BallEvent
+from arena.schemas.vocabulary import other_team
 from arena.sim.physics.bodies import _ROBOT_TYPE0, RobotBody
 
 
@@ -118,7 +119,7 @@ class Events:
                 self._event("GOAL", attacker, x, y)
                 self._stop_in_goal()
                 return
-            self._event("GOAL_LINE", "b" if attacker == "a" else "a", x, y)  # team: the defender
+            self._event("GOAL_LINE", other_team(attacker), x, y)  # team: the defender
         elif ay > self._half_wid + self._ball_r:
             self._out = True
             self._event("TOUCH_LINE", "", x, y)

@@ -14,7 +14,6 @@ from arena.strategies.world import FusionParams
 Vec = tuple[float, float]
 
 PLAY = "START"
-SET_PIECES = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL"})
 WALL_PIECES = frozenset({"KICKOFF", "FREEKICK", "THROWIN", "CORNER"})  # advance defense: wall and mark at these
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from arena.navigation import get
 from arena.schemas.messages import Cmd, Order, Pose, Report, Sense
+from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import roles as R
 from arena.strategies.base import RobotContext
 from arena.strategies.iris.attack import AttackMixin
@@ -19,7 +20,7 @@ from arena.strategies.iris.handling import HandlingMixin
 from arena.strategies.iris.keeper import KeeperMixin
 from arena.strategies.iris.memory import Memory, Plan
 from arena.strategies.iris.motion import MotionMixin
-from arena.strategies.iris.params import PLAY, SET_PIECES, IrisParams, Vec
+from arena.strategies.iris.params import PLAY, IrisParams, Vec
 from arena.strategies.iris.positions import PositionsMixin
 from arena.strategies.iris.setpieces import SetPieceMixin
 from arena.strategies.world import RobotView

@@ -15,10 +15,11 @@ from __future__ import annotations
 import math
 
 from arena.schemas.messages import Order, Referee, Report, TeamPose
+from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import roles as R
 from arena.strategies import skills as S
 from arena.strategies.base import TeamContext
-from arena.strategies.iris.params import PLAY, SET_PIECES, IrisParams
+from arena.strategies.iris.params import PLAY, IrisParams
 from arena.strategies.world import TeamModel
 
 
