@@ -18,7 +18,6 @@ import hashlib
 import logging
 import os
 import resource
-import statistics
 import threading
 import time
 from collections.abc import Callable
@@ -28,6 +27,7 @@ from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
 from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
+from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
@@ -269,7 +269,7 @@ class Node:
         tick_us: list[float] = []
         if self._work_s:
             w = sorted(self._work_s)
-            tick_us = [statistics.median(w) * 1e6, w[int(0.95 * (len(w) - 1))] * 1e6]
+            tick_us = [percentile(w, 50) * 1e6, percentile(w, 95) * 1e6]
         return msgs.Summary(
             tick=self.last_tick,
             process=self.name,

@@ -30,9 +30,10 @@ import math
 
 import numpy as np
 
+from arena.navigation.frames import wrap_angle
 from arena.runtime.config import SensorParams
 from arena.schemas.messages import BallSeen, Pose, RobotSeen, Sense
-from arena.sim.physics import Physics, wrap_angle
+from arena.sim.physics import Physics
 
 RobotStates = list[tuple[str, int, float, float, float, float, float, float]]
 

@@ -29,6 +29,7 @@ import msgspec
 
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.session import NetConfig, open_session
+from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Referee, Summary
@@ -337,13 +338,6 @@ def supervise(
     return got
 
 
-def percentile(sorted_values: list[float], q: float) -> float:
-    if not sorted_values:
-        return 0.0
-    i = min(len(sorted_values) - 1, max(0, int(round(q * (len(sorted_values) - 1)))))
-    return sorted_values[i]
-
-
 def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
     """The match result (what `arena match --json` prints)."""
     # The recorder sends no data, and the RefBox bridge's worldstates are what the
@@ -370,7 +364,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         d = sorted(acc.pop("_delays"))
         acc["drop_rate"] = round(acc["dropped"] / acc["sent"], 5) if acc["sent"] else 0.0
         acc["delay_ms_mean"] = round(sum(d) / len(d), 3) if d else 0.0
-        acc["delay_ms_p95"] = round(percentile(d, 0.95), 3)
+        acc["delay_ms_p95"] = round(percentile(d, 95), 3)
     rejected = Counter()
     for s in sums.values():
         rejected.update(s.rejected_reasons)

@@ -23,6 +23,7 @@ Nothing here is random or reads a clock: equal inputs give equal outputs.
 Callers import from the package: `from arena.sim.physics import Physics`.
 """
 
+from arena.navigation.frames import wrap_angle  # the one wrap_angle, (-pi, pi]; re-exported for callers
 from arena.sim.physics.bodies import (
     BOUNCE_STOP,
     CATCH_MAX_Z,
@@ -32,7 +33,6 @@ from arena.sim.physics.bodies import (
     NO_CATCH_S,
     NO_CHALLENGE_S,
     PIN_TOLERANCE,
-    wrap_angle,
 )
 from arena.sim.physics.model import Physics
 

@@ -7,7 +7,6 @@ collision type `_ROBOT_TYPE0 + i`, so that a contact names its robot.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import pymunk
@@ -50,12 +49,6 @@ _ALL_FIELDS = (
     | pmbatch.BodyFields.ANGULAR_VELOCITY
 )
 _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
-
-
-def wrap_angle(a: float) -> float:
-    """Angle wrapped to (-pi, pi] [rad]."""
-    a = math.remainder(a, math.tau)
-    return math.pi if a <= -math.pi else a
 
 
 @dataclass(eq=False)

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import math
 
+from arena.navigation.frames import wrap_angle
 from arena.runtime.config import TEAMS
 from arena.schemas.messages import RobotState, World
-from arena.sim.physics.bodies import wrap_angle
 
 
 class State:
