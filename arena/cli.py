@@ -42,7 +42,10 @@ EXAMPLES = {
   arena tournament                                  # the paper's experiment: 4 strategies x 10 legs = 60 matches
   arena tournament --strategies AD,BS --legs 4 --half-time 60 --out runs/quick
   arena tournament --out runs/paper --resume        # continue after Ctrl-C or a crash
-  arena tournament --link congested-wifi --jobs 2 --json""",
+  arena tournament --link congested-wifi --jobs 2 --json
+  arena tournament --ray                            # every match a task on a local Ray instance (docs/cluster.md)
+  arena tournament --ray auto --out runs/big        # join the Ray cluster this node belongs to (ray start ...)
+  arena tournament --ray 10.0.0.5:6379 --resume     # join the cluster whose head node is there""",
     "bench": """examples:
   arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
   arena bench match --runs 5 --half-time 120 --link wifi
@@ -211,6 +214,15 @@ def build_parser() -> Parser:
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
     t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
+    t.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
+        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
+    )
     t.add_argument("--json", action="store_true", help="print one JSON object")
 
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
@@ -457,6 +469,10 @@ def cmd_tournament(args: argparse.Namespace) -> int:
         cls, param, value = parse_override(text)
         overrides.setdefault(cls, {})[param] = value
     resolve(args.link, overrides)
+    if args.ray:
+        from arena.tools.cluster import parse_address
+
+        parse_address(args.ray)
     summary, interrupted = tournament.run(args)
     if args.json:
         print(json.dumps(summary, indent=2))

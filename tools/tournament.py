@@ -27,7 +27,7 @@ import subprocess
 import sys
 import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from itertools import combinations
 from pathlib import Path
@@ -494,6 +494,25 @@ def default_jobs() -> int:
     return max(1, os.cpu_count() or 1)
 
 
+def play_local(args, runner: Runner, todo: list[Fixture], arrived) -> bool:
+    """`--jobs` matches at once in a thread pool; arrived(Result) as each is in. Returns interrupted."""
+    with ThreadPoolExecutor(max_workers=args.jobs or default_jobs()) as pool:
+        pending = {pool.submit(runner.play, fx) for fx in todo}
+        try:
+            while pending:
+                done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                for f in done:
+                    r = f.result()
+                    if r is not None:
+                        arrived(r)
+        except KeyboardInterrupt:
+            runner.stop()
+            for f in pending:
+                f.cancel()
+            return True
+    return False
+
+
 def run(args) -> tuple[dict, bool]:
     """Play (or resume) the tournament. Returns (summary, interrupted)."""
     from rich.console import Console
@@ -529,33 +548,26 @@ def run(args) -> tuple[dict, bool]:
         previous = None
         if threading.current_thread() is threading.main_thread():
             previous = signal.signal(signal.SIGTERM, _interrupt)
-        with ThreadPoolExecutor(max_workers=args.jobs or default_jobs()) as pool:
-            futures: dict[Future, Fixture] = {pool.submit(runner.play, fx): fx for fx in todo}
-            pending = set(futures)
-            try:
-                while pending:
-                    done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
-                    for f in done:
-                        r = f.result()
-                        if r is None:
-                            continue
-                        results[r.id] = r
-                        last = (
-                            f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}"
-                            if r.status == "ok"
-                            else f"{r.id} failed"
-                        )
-                        bar.update(task, advance=1, last=last)
-                        if not show and not args.json:
-                            console.print(f"[{len(results)}/{len(fixtures)}] {last}")
-            except KeyboardInterrupt:
-                interrupted = True
-                runner.stop()
-                for f in pending:
-                    f.cancel()
-            finally:
-                if previous is not None:
-                    signal.signal(signal.SIGTERM, previous)
+
+        def arrived(r: Result) -> None:
+            results[r.id] = r
+            last = (
+                f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}" if r.status == "ok" else f"{r.id} failed"
+            )
+            bar.update(task, advance=1, last=last)
+            if not show and not args.json:
+                console.print(f"[{len(results)}/{len(fixtures)}] {last}")
+
+        try:
+            if getattr(args, "ray", None) is not None:
+                from arena.tools import cluster  # imports Ray; never without --ray
+
+                interrupted = cluster.play(args, runner, todo, arrived)
+            else:
+                interrupted = play_local(args, runner, todo, arrived)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
     ordered = [results[fx.id] for fx in fixtures if fx.id in results]
     summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed)
     summary["skipped"] = len(fixtures) - len(todo)

@@ -1,0 +1,169 @@
+"""`arena tournament --ray` on a real multi-node Ray cluster on this machine (ray.cluster_utils.Cluster).
+
+Two nodes, the head and one worker, each a separate raylet with its own
+worker processes and 2 CPUs: one distributed-engine match at a time each. The tournament
+runs as a separate `arena` process that joins the cluster by its address.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+
+import pytest
+
+from tests.integration.helpers import ARENA, arena_json, cmdline, descendants, spawn, wait_for
+
+ray = pytest.importorskip("ray", reason="the cluster extra: pip install -e '.[test,cluster]'")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    from ray.cluster_utils import Cluster
+
+    c = Cluster(initialize_head=True, head_node_args={"num_cpus": 2, "include_dashboard": False})
+    try:
+        workers = [c.add_node(num_cpus=2)]
+        c.wait_for_nodes()
+        yield c, workers
+    finally:
+        c.shutdown()
+
+
+def tournament(*extra: str) -> tuple[str, ...]:
+    return ("tournament", "--legs", "1", "--half-time", "10", "--seed", "3", *extra)
+
+
+def digests(summary: dict) -> dict[str, str]:
+    return {m["id"]: m["digest"] for m in summary["matches"]}
+
+
+def check_tables(summary: dict, matches_each: int) -> None:
+    assert summary["failed"] == [] and all(m["status"] == "ok" for m in summary["matches"])
+    ids = [m["id"] for m in summary["matches"]]
+    assert len(ids) == len(set(ids))
+    for row in summary["table"]:
+        assert row["W"] + row["D"] + row["L"] == matches_each, row
+        assert row["P"] == 3 * row["W"] + row["D"]
+    assert sum(r["GF"] for r in summary["table"]) == sum(r["GA"] for r in summary["table"])
+    goals = sum(sum(m["score"]) for m in summary["matches"])
+    assert sum(r["GF"] for r in summary["table"]) == goals
+
+
+def test_two_nodes_same_digests_as_local_jobs(cluster, tmp_path):
+    """Fast: 2 matches, one per node, digests equal to the local run's."""
+    c, _ = cluster
+    args = tournament("--strategies", "BS,AD", "--legs", "2", "--half-time", "5")
+    local = arena_json(*args, "--jobs", "2", "--out", str(tmp_path / "local"))
+    remote = arena_json(*args, "--ray", c.address, "--out", str(tmp_path / "ray"))
+    assert digests(remote) == digests(local) and len(digests(local)) == 2
+    check_tables(remote, 2)
+    logs = [(tmp_path / "ray" / "logs" / f"{m['id']}.log").read_text() for m in remote["matches"]]
+    assert all("[cluster] played on node" in text for text in logs)
+    saved = json.loads((tmp_path / "ray" / "tournament.json").read_text())
+    assert saved["table"] == remote["table"]
+
+
+@pytest.mark.slow
+def test_six_match_round_robin_equals_local(cluster, tmp_path):
+    c, _ = cluster
+    args = tournament("--strategies", "AD,AS,BD,BS")
+    local = arena_json(*args, "--jobs", "2", "--out", str(tmp_path / "local"))
+    remote = arena_json(*args, "--ray", c.address, "--out", str(tmp_path / "ray"))
+    assert len(digests(local)) == 6
+    assert digests(remote) == digests(local)
+    assert remote["table"] == local["table"]
+    check_tables(remote, 3)
+
+
+def raylet_pid(node) -> int:
+    from ray._private import ray_constants
+
+    return node.all_processes[ray_constants.PROCESS_TYPE_RAYLET][0].process.pid
+
+
+@pytest.mark.slow
+def test_worker_node_removed_mid_task(cluster, tmp_path, reap):
+    """A node dies while its match plays: Ray reruns the task on the other node; every match counted once."""
+    c, workers = cluster
+    victim = c.add_node(num_cpus=2)  # the fixture's nodes stay for the other tests
+    c.wait_for_nodes()
+    out = tmp_path / "ray"
+    proc = spawn(*tournament("--strategies", "AD,AS,BD,BS", "--ray", c.address, "--out", str(out), "--json"))
+    reap.append(proc)
+    on_victim = wait_for(
+        lambda: [p for p in descendants(raylet_pid(victim)) if " arena match " in cmdline(p)],
+        120,
+        "a match to run on the node to be removed",
+    )
+    time.sleep(1.0)  # well inside the match (10 s halves take several seconds)
+    c.remove_node(victim, allow_graceful=False)
+    wait_for(lambda: not any(" arena match " in cmdline(p) for p in on_victim), 20, "the match to die with its node")
+    stdout, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 0, stderr[-3000:]
+    summary = json.loads(stdout)
+    assert len(summary["matches"]) == 6
+    check_tables(summary, 3)
+    assert len(list((out / "matches").glob("*.json"))) == 6
+    local = arena_json(*tournament("--strategies", "AD,AS,BD,BS", "--jobs", "2", "--out", str(tmp_path / "local")))
+    assert digests(summary) == digests(local)
+
+
+def test_no_cluster_at_address_is_one_line_and_exit_2(tmp_path):
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # closed again below: nothing listens there
+    t0 = time.monotonic()
+    r = subprocess.run(
+        [*ARENA, *tournament("--strategies", "BS,AD", "--ray", f"127.0.0.1:{port}", "--out", str(tmp_path))],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert time.monotonic() - t0 < 30
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"127.0.0.1:{port}" in lines[0] and "no Ray cluster" in lines[0], r.stderr
+    bad = subprocess.run([*ARENA, "tournament", "--ray", "nowhere"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "HOST:PORT" in bad.stderr
+
+
+def test_worker_with_another_version_refuses(cluster):
+    """The real task on a real worker compares its own soccer-arena with what the driver says it has."""
+    c, _ = cluster
+    script = f"""
+import json, ray
+from arena.tools import cluster
+ray.init(address={c.address!r}, logging_level="ERROR", log_to_driver=False)
+task = ray.remote(cluster.play_on_worker).options(num_cpus=1)
+mine = cluster.fingerprint()
+other = dict(mine, version="0.0.9", git="0123456789ab")
+same = ray.get(ray.remote(cluster.fingerprint).options(num_cpus=1).remote())
+bad = ray.get(task.remote(["-c", "print(1)"], other, 30))
+print(json.dumps({{"mine": mine, "same": same, "bad": bad}}))
+ray.shutdown()
+"""
+    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-3000:]
+    got = json.loads(r.stdout.strip().splitlines()[-1])
+    assert got["same"] == got["mine"], "a worker on this machine has the driver's soccer-arena"
+    reason = got["bad"]["reason"]
+    assert got["bad"]["rc"] != 0 and "version mismatch" in reason
+    assert "0.0.9 (git 0123456789ab" in reason and f"{got['mine']['version']} (git {got['mine']['git']}" in reason
+
+
+def test_without_ray_flag_ray_is_never_imported(tmp_path):
+    script = f"""
+import sys
+from arena.cli import main
+code = main(["tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "1", "--jobs", "1",
+             "--out", {str(tmp_path)!r}, "--json"])
+assert code == 0, code
+assert "ray" not in sys.modules and "arena.tools.cluster" not in sys.modules, "Ray was imported"
+"""
+    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-3000:]

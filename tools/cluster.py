@@ -1,0 +1,276 @@
+"""`arena tournament --ray [ADDRESS]`: every fixture one Ray task, the tables on the driver.
+
+Ray is imported only here, and only when `--ray` is given. Each task runs on a
+worker node the same `arena match ... --json` command that a local job runs,
+in its own process group with its own zenoh router (a unix socket in a private
+temp dir), so matches never hear each other, on one node or many. The task
+returns the match's JSON; the driver writes the result atomically to
+`<out>/matches/<id>.json` as it arrives (so `--resume` works), feeds the
+progress bar from `ray.wait`, and on Ctrl-C or SIGTERM cancels the pending
+tasks (`ray.cancel(force=True)` kills the worker, the match dies with it by
+PR_SET_PDEATHSIG) and keeps what is finished.
+
+Two kinds of failure, two mechanisms:
+- a match that fails (non-zero exit, no JSON, time-out, a version mismatch)
+  is played once more by the driver, as locally, possibly on another node;
+- a worker or node that dies mid-task is a system failure: Ray itself runs the
+  task again on a live node (`max_retries`), and the driver still gets exactly
+  one result per fixture, so nothing is counted twice.
+
+A worker whose soccer-arena differs from the driver's (version, git revision
+or the hash of its source files) refuses to play and says which two differ.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import hashlib
+import importlib.metadata
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+from arena.runtime.config import ConfigError
+
+# CPUs a match needs, by engine: the distributed engine runs ~11 processes
+# that keep about two cores busy; the in-process engine is one thread.
+TASK_CPUS = {"processes": 2.0, "inprocess": 1.0}
+SYSTEM_RETRIES = 3  # worker or node deaths Ray absorbs per task (not match failures)
+PACKAGES = ("runtime", "processes", "schemas", "tools", "strategies", "navigation", "sim", "rules", "recording")
+INSTALL_HINT = "--ray needs Ray: pip install 'soccer-arena[cluster]'"
+
+
+# ------------------------------------------------------------------ address
+def parse_address(text: str | None) -> str | None:
+    """None: start a local instance; "auto": the cluster on this node; "HOST:PORT": that head node."""
+    if text is None or text == "auto":
+        return text
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ConfigError(f"--ray {text!r}: give auto or HOST:PORT of a Ray head node (e.g. 10.0.0.5:6379)")
+    return text
+
+
+def probe(address: str, timeout: float = 5.0) -> None:
+    """Fail fast if nothing listens at HOST:PORT (ray.init would retry for over a minute)."""
+    host, _, port = address.rpartition(":")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+            pass
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise ConfigError(
+            f"--ray {address}: no Ray cluster there ({reason}); start one with `ray start --head --port {port}`"
+        ) from None
+
+
+def connect(address: str | None, local_cpus: float):
+    """ray.init for the driver; a one-line ConfigError on any failure."""
+    try:
+        import ray
+    except ImportError:
+        raise ConfigError(INSTALL_HINT) from None
+    if address not in (None, "auto"):
+        probe(address)
+    kw = {"logging_level": "ERROR", "log_to_driver": False, "include_dashboard": False}
+    try:
+        if address is None:
+            ray.init(address="local", num_cpus=local_cpus, **kw)
+        else:
+            ray.init(address=address, **kw)
+    except (ConnectionError, RuntimeError, ValueError, TimeoutError) as exc:
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise ConfigError(f"--ray {address or ''}: cannot join the cluster: {first}".replace("  ", " ")) from None
+    return ray
+
+
+# -------------------------------------------------------------- fingerprint
+_FINGERPRINT: dict | None = None
+
+
+def fingerprint() -> dict:
+    """This process's soccer-arena: version, git revision (if a checkout) and a hash of its sources."""
+    global _FINGERPRINT
+    if _FINGERPRINT is None:
+        import arena
+
+        try:
+            version = importlib.metadata.version("soccer-arena")
+        except importlib.metadata.PackageNotFoundError:
+            version = "not installed"
+        root = Path(arena.__file__).resolve().parent.parent
+        try:
+            rev = subprocess.run(
+                ["git", "-C", str(root), "rev-parse", "--short=12", "HEAD"],
+                capture_output=True,
+                text=True,
+                timeout=10,
+            ).stdout.strip()
+        except (OSError, subprocess.TimeoutExpired):
+            rev = ""
+        _FINGERPRINT = {"version": version, "git": rev or "none", "source": source_hash()}
+    return _FINGERPRINT
+
+
+def source_hash() -> str:
+    """BLAKE2b of every .py file of the `arena` package that this process imports, by module path."""
+    import importlib
+
+    h = hashlib.blake2b(digest_size=8)
+    for name in ("arena", *(f"arena.{p}" for p in PACKAGES)):
+        for base in map(Path, importlib.import_module(name).__path__):
+            for f in sorted(base.rglob("*.py")):
+                h.update(f"{name}/{f.relative_to(base)}".encode())
+                h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def describe(fp: dict) -> str:
+    return f"soccer-arena {fp['version']} (git {fp['git']}, source {fp['source']})"
+
+
+# ---------------------------------------------------------------- the task
+def _die_with_parent() -> None:
+    with contextlib.suppress(OSError):
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+
+
+def play_on_worker(argv: list[str], driver: dict, timeout: float) -> dict:
+    """Body of the Ray task: check the version, play one match, return what the driver needs."""
+    import ray
+
+    node = ray.get_runtime_context().get_node_id()[:12]
+    mine = fingerprint()
+    if mine != driver:
+        return {
+            "rc": -1,
+            "reason": f"version mismatch on node {node}: the worker has {describe(mine)}, "
+            f"the driver has {describe(driver)}; install the same soccer-arena on every node or use a runtime_env",
+        }
+    t0 = time.monotonic()
+    proc = subprocess.Popen(
+        [sys.executable, *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=_die_with_parent,
+    )
+    reason = ""
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate()
+        reason = f"timed out after {timeout:g} s"
+    return {
+        "rc": proc.returncode,
+        "out": out,
+        "err": err,
+        "reason": reason,
+        "wall": time.monotonic() - t0,
+        "node": node,
+        "pid": os.getpid(),
+    }
+
+
+# ------------------------------------------------------------------ driver
+def task_cpus(args) -> float:
+    return TASK_CPUS.get(getattr(args, "engine", None) or "processes", 2.0)
+
+
+def play(args, runner, todo: list, on_result) -> bool:
+    """Play `todo` on the cluster; call on_result(Result) as each arrives. Returns interrupted."""
+    from arena.tools import tournament as T
+
+    cpus = task_cpus(args)
+    jobs = args.jobs or T.default_jobs()
+    address = parse_address(args.ray) if args.ray != "" else None
+    ray = connect(address, local_cpus=jobs * cpus)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, T._interrupt)  # ray.init put in its own, which exits at once
+    try:
+        remote = ray.remote(play_on_worker).options(num_cpus=cpus, max_retries=SYSTEM_RETRIES, retry_exceptions=False)
+        driver = fingerprint()
+        timeout = 120.0 + 2.0 * args.half_time
+        # An existing cluster decides how many run at once; --jobs caps it if given.
+        cap = jobs if address is None or args.jobs else len(todo)
+        queue = list(todo)
+        inflight: dict = {}  # ref -> (fixture, attempt)
+
+        def submit(fx, attempt: int) -> None:
+            argv = runner.command(fx)[1:]  # the worker's own interpreter runs it
+            inflight[remote.remote(argv, driver, timeout)] = (fx, attempt)
+
+        try:
+            while queue and len(inflight) < cap:
+                submit(queue.pop(0), 1)
+            while inflight:
+                ready, _ = ray.wait(list(inflight), num_returns=1, timeout=0.2)
+                for ref in ready:
+                    fx, attempt = inflight.pop(ref)
+                    try:
+                        got = ray.get(ref)
+                    except Exception as exc:  # the task itself failed (retries used up)
+                        got = {"rc": -1, "reason": f"task failed: {str(exc).strip().splitlines()[-1][:300]}"}
+                    r = finish(runner, fx, attempt, got)
+                    if r is None:
+                        submit(fx, attempt + 1)
+                        continue
+                    on_result(r)
+                    if queue:
+                        submit(queue.pop(0), 1)
+        except KeyboardInterrupt:
+            for ref in inflight:
+                with contextlib.suppress(Exception):
+                    ray.cancel(ref, force=True)
+            return True
+        return False
+    finally:
+        with contextlib.suppress(Exception):
+            ray.shutdown()
+
+
+def finish(runner, fx, attempt: int, got: dict):
+    """The Result of one attempt, written to --out; None if the match is to be played again."""
+    from arena.tools.tournament import Result, write_atomic
+
+    base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
+    log = runner.logs_dir / f"{fx.id}.log"
+    write_atomic(log, (got.get("err") or "") + (f"[cluster] played on node {got['node']}\n" if "node" in got else ""))
+    reason = got.get("reason", "")
+    if got["rc"] == 0 and not reason:
+        try:
+            m = json.loads(got["out"])
+        except json.JSONDecodeError:
+            reason = "the match printed no JSON"
+        else:
+            r = Result(
+                id=fx.id,
+                status="ok",
+                score=m["score"],
+                distance_m=m["distance_m"],
+                attempts=attempt,
+                wall_seconds=round(got["wall"], 2),
+                rtf=m["rtf"],
+                digest=m["digest"],
+                **base,
+            )
+            write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+            return r
+    if not reason:
+        tail = (got.get("err") or "").strip().splitlines()
+        reason = tail[-1] if tail else f"exit code {got['rc']}"
+    if attempt < 2:
+        return None
+    r = Result(id=fx.id, status="failed", reason=reason, attempts=attempt, **base)
+    write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+    return r
