@@ -1,7 +1,12 @@
 """The `arena` command: one subcommand per job.
 
-Bad input never ends in a traceback: a bad flag or value prints one line
-`arena <cmd>: error: ...` and exits with code 2.
+Bad input never ends in a traceback. Exit codes, the same for every subcommand:
+
+* 0: done;
+* 1: an internal failure: one line that names the log with the details;
+* 2: a user error (a flag, a value, an endpoint, a port, a file, the
+  environment): one line `arena <cmd>: error: ...` that says what to change;
+* 130: interrupted (Ctrl-C).
 """
 
 from __future__ import annotations
@@ -9,10 +14,11 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import sys
 from typing import NoReturn
 
-from arena.runtime.config import KINDS, ConfigError, MatchConfig, ProcessId
+from arena.runtime.config import KINDS, MAX_HALF_TIME, ConfigError, MatchConfig, ProcessId
 
 EXAMPLES = {
     "match": """examples:
@@ -76,11 +82,58 @@ class Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+def seconds(text: str) -> float:
+    """argparse type: a finite, positive number of seconds."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number of seconds > 0")
+    return value
+
+
+def half_time(text: str) -> float:
+    """argparse type: a half's length, finite, > 0 and at most MAX_HALF_TIME."""
+    value = seconds(text)
+    if value > MAX_HALF_TIME:
+        raise argparse.ArgumentTypeError(f"{text!r}: at most {MAX_HALF_TIME:g} s per half")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: give 1 or more")
+    return value
+
+
+def package_version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("soccer-arena")
+    except metadata.PackageNotFoundError:
+        from arena import __version__
+
+        return __version__
+
+
 def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = True) -> None:
     p.add_argument("--home", required=required, metavar="STRATEGY", help="team a's strategy (name or BS/BD/AS/AD)")
     p.add_argument("--away", required=required, metavar="STRATEGY", help="team b's strategy")
     p.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team, goalkeeper included (3)")
-    p.add_argument("--half-time", type=float, default=300.0, metavar="SECONDS", help="simulated half length (300)")
+    p.add_argument(
+        "--half-time",
+        type=half_time,
+        default=300.0,
+        metavar="SECONDS",
+        help=f"simulated half length [s], at most {MAX_HALF_TIME:g} (300)",
+    )
     if seed:
         p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (0)")
     p.add_argument("--link", default="ideal", metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
@@ -99,6 +152,7 @@ def build_parser() -> Parser:
         description="Wheeled-robot soccer (RoboCup MSL / KRSBI-B) as separate processes over zenoh.",
         epilog="Run 'arena <command> --help' for examples.",
     )
+    top.add_argument("--version", action="version", version=f"arena {package_version()}")
     sub = top.add_subparsers(dest="command", metavar="<command>", parser_class=Parser)
     sub.required = True
 
@@ -122,7 +176,11 @@ def build_parser() -> Parser:
     m.add_argument("--logs", metavar="DIR", help="keep every process's log in DIR")
     m.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     m.add_argument(
-        "--startup-timeout", type=float, default=None, metavar="S", help="wait this long for processes to come up"
+        "--startup-timeout",
+        type=seconds,
+        default=None,
+        metavar="S",
+        help="wait this long [s] for processes to come up (30; 600 with --external)",
     )
     m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
     m.add_argument(
@@ -184,7 +242,9 @@ def build_parser() -> Parser:
     r.add_argument("--realtime", action="store_true", help="the match runs in real-time mode")
     r.add_argument("--config", metavar="FILE", help="match configuration JSON (default: ask the engine)")
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
-    r.add_argument("--startup-timeout", type=float, default=60.0, metavar="S", help="wait for the match (60)")
+    r.add_argument(
+        "--startup-timeout", type=seconds, default=60.0, metavar="S", help="wait this long [s] for the match (60)"
+    )
     r.add_argument("--log-level", default="WARNING", choices=["DEBUG", "INFO", "WARNING", "ERROR"])
     r.add_argument(
         "--record",
@@ -197,14 +257,16 @@ def build_parser() -> Parser:
     u = add("up", "start the services of a compose file as local processes (no Docker needed)")
     u.add_argument("file", help="compose.yaml")
     u.add_argument("--json", action="store_true", help="print the match result as JSON")
-    u.add_argument("--timeout", type=float, default=600.0, metavar="S", help="give up after S seconds (600)")
+    u.add_argument("--timeout", type=seconds, default=600.0, metavar="S", help="give up after S seconds (600)")
 
     t = add("tournament", "round-robin of strategies: the paper's tables, charts and ratings")
     t.add_argument("--strategies", default="AD,AS,BD,BS", metavar="A,B,...", help="strategies (AD,AS,BD,BS)")
     t.add_argument(
-        "--legs", type=int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
+        "--legs", type=positive_int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
     )
-    t.add_argument("--half-time", type=float, default=300.0, metavar="SECONDS", help="simulated half length (300)")
+    t.add_argument(
+        "--half-time", type=half_time, default=300.0, metavar="SECONDS", help="simulated half length [s] (300)"
+    )
     t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
     t.add_argument(
@@ -233,12 +295,14 @@ def build_parser() -> Parser:
         "nav: the navigators in their papers' scenarios",
     )
     b.add_argument("--strategy", default="advance-dynamic", metavar="NAME", help="robot: strategy to time (AD)")
-    b.add_argument("--runs", type=int, default=3, metavar="N", help="runs (3)")
-    b.add_argument("--half-time", type=float, default=60.0, metavar="SECONDS", help="half length (60)")
+    b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
+    b.add_argument("--half-time", type=half_time, default=60.0, metavar="SECONDS", help="half length [s] (60)")
     b.add_argument("--robots", type=int, default=3, metavar="N")
     b.add_argument("--link", default="ideal", metavar="PRESET")
     b.add_argument("--json", action="store_true")
-    b.add_argument("--trials", type=int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)")
+    b.add_argument(
+        "--trials", type=positive_int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)"
+    )
     b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
     b.add_argument(
         "--scenarios", metavar="FILE", help="nav: scenario file (default: the built-in tools/navbench/navbench.toml)"
@@ -350,8 +414,8 @@ def cmd_match(args: argparse.Namespace) -> int:
             strict=args.strict,
         )
     except launcher.MatchError as exc:
-        print(f"arena match: error: {exc}", file=sys.stderr)
-        return 1
+        print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
+        return 2 if isinstance(exc, launcher.JoinError) else 1
     return emit_match(result, args.json)
 
 
@@ -394,6 +458,15 @@ def refbox_params(args: argparse.Namespace):
     if args.refbox_wait and not args.refbox:
         raise ConfigError("--refbox-wait needs --refbox")
     return RefboxParams(**changes)
+
+
+def one_line(text: str) -> str:
+    """A multi-line failure (headline, a log's tail, where the logs are) as one line."""
+    lines = [line.strip() for line in text.strip().splitlines() if line.strip()]
+    if len(lines) <= 1:
+        return text.strip()
+    head, *tail, last = lines
+    return f"{head} {tail[-1]}; {last}" if tail else f"{head.rstrip(':')}; {last}"
 
 
 def record_path(text: str) -> str:
@@ -455,10 +528,14 @@ def cmd_up(args: argparse.Namespace) -> int:
 
 
 def cmd_tournament(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
     from arena.tools import tournament
 
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise ConfigError(f"--out {args.out} exists and is not a directory")
     names = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
     if len(set(names)) < 2:
         raise ConfigError("--strategies needs at least two different strategies")
@@ -506,8 +583,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def cmd_review(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from arena.tools import review
 
+    if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
+        raise ConfigError(f"--plots {args.plots} exists and is not a directory")
     return review.main(args.file, plots=args.plots, as_json=args.json)
 
 
@@ -544,3 +625,24 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"arena {args.command}: interrupted; every process of the match was stopped", file=sys.stderr)
         return 130
+    except OSError as exc:  # a file or directory the user named: missing, read-only, full disk
+        where = f" {exc.filename}" if exc.filename else ""
+        print(f"arena {args.command}: error:{where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, the details in a log
+        return internal_error(args.command, exc)
+
+
+def internal_error(command: str, exc: BaseException) -> int:
+    """A bug, not the user's fault: the traceback goes to a log file, one line names it; exit 1."""
+    import os
+    import tempfile
+    import traceback
+
+    fd, path = tempfile.mkstemp(prefix=f"arena-{command}-crash-", suffix=".log")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(f"arena {package_version()} {' '.join(sys.argv)}\n")
+        traceback.print_exception(exc, file=fh)
+    first = (str(exc).strip().splitlines() or [""])[0]
+    print(f"arena {command}: internal error: {type(exc).__name__}: {first} (details in {path})", file=sys.stderr)
+    return 1

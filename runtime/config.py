@@ -21,6 +21,7 @@ from typing import Any
 import msgspec
 
 TEAMS = ("a", "b")
+MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox")
 
 
@@ -269,11 +270,17 @@ class MatchConfig:
             raise ConfigError(f"--robots must be between 1 and 6, got {self.robots}")
         if not self.half_time > 0:
             raise ConfigError(f"--half-time must be positive, got {self.half_time}")
+        if not self.half_time <= MAX_HALF_TIME:  # also catches inf and nan
+            raise ConfigError(f"--half-time must be at most {MAX_HALF_TIME:g} s, got {self.half_time}")
         if self.half_ticks < 1:
             raise ConfigError(f"--half-time {self.half_time} is shorter than one tick")
         t = self.timing
         if t.dt <= 0 or t.substeps < 1 or t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
             raise ConfigError("timing: dt must be > 0 and every period >= 1 tick")
+        for name in ("startup_timeout", "wait_timeout"):
+            value = getattr(t, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ConfigError(f"timing.{name} must be a finite number of seconds > 0, got {value}")
         if self.robot.model not in ("omni4", "omni3"):
             raise ConfigError(f"robot.model must be omni4 or omni3, got {self.robot.model!r}")
         if not 0 <= self.seed < 2**63:

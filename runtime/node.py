@@ -67,6 +67,9 @@ class Node:
         self.last_tick = 0
         self._wall_s = 0.0
         self._collector = False
+        # Called with the peers still missing, once a wait at the start barrier
+        # passes 1 s and whenever that list changes (`arena run` by hand prints it).
+        self.on_waiting: Callable[[list[str]], None] | None = None
         # A recorded match: everything this process sends also goes to its tap
         # (runtime/tap.py), which the recorder collects.
         self.tap: Tap | None = None
@@ -172,9 +175,15 @@ class Node:
         self.transport.watch_alive(self.keys.alive_all(), self._on_alive)
         self.transport.declare_alive(self.keys.alive(self.name))
         expected = set(self.expected_peers())
-        deadline = time.monotonic() + self.cfg.timing.startup_timeout
+        start = time.monotonic()
+        deadline = start + self.cfg.timing.startup_timeout
+        told: list[str] | None = None
         with self._alive_cond:
             while not expected <= self._alive:
+                missing_now = sorted(expected - self._alive)
+                if self.on_waiting is not None and missing_now != told and time.monotonic() - start > 1.0:
+                    told = missing_now
+                    self.on_waiting(missing_now)
                 left = deadline - time.monotonic()
                 if left <= 0:
                     missing = ", ".join(sorted(expected - self._alive))
@@ -182,6 +191,8 @@ class Node:
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )
                 self._alive_cond.wait(min(left, 0.5))
+        if told is not None and self.on_waiting is not None:
+            self.on_waiting([])
 
     # -------------------------------------------------------------------- run
     def loop(self) -> None:

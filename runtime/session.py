@@ -27,9 +27,41 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from dataclasses import dataclass, field
 
 import zenoh
+
+from arena.runtime.config import ConfigError
+
+_PROTOCOLS = ("tcp", "udp", "tls", "quic", "ws", "unixsock-stream", "unixpipe", "vsock")
+
+
+class EndpointError(ConfigError):
+    """An endpoint that cannot be used: malformed, busy, or refused (a user error, exit 2)."""
+
+
+def check_endpoint(flag: str, text: str) -> str:
+    """`text` if it is a zenoh endpoint we can use, else EndpointError naming `flag`."""
+    proto, _, address = text.partition("/")
+    hint = "use e.g. tcp/192.168.1.10:7447 or unixsock-stream/PATH"
+    if proto not in _PROTOCOLS or not address:
+        raise EndpointError(f"{flag} {text}: not a zenoh endpoint ({hint})")
+    if proto in ("tcp", "udp", "tls", "quic", "ws"):
+        host, sep, port = address.split("?", 1)[0].split("#", 1)[0].rpartition(":")
+        if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+            raise EndpointError(f"{flag} {text}: needs HOST:PORT with a port in 0..65535 ({hint})")
+    return text
+
+
+def zenoh_reason(exc: Exception) -> str:
+    """zenoh's error text without its Rust wrappers and source paths."""
+    text = str(exc)
+    inner = re.search(r'msg: "(.*?)"', text)
+    if inner:
+        text = inner.group(1)
+    text = re.sub(r"\s+at /\S+?\.rs:\d+\.?", "", text)
+    return text.strip(" .[]")
 
 
 @dataclass(frozen=True)
@@ -70,4 +102,12 @@ ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),
 def open_session(net: NetConfig) -> zenoh.Session:
     """Open a zenoh session; use as `with open_session(net) as session:`."""
     os.environ.setdefault("ZENOH_RUNTIME", ONE_THREAD_RUNTIME)
-    return zenoh.open(net.zenoh_config())
+    for ep in net.listen:
+        check_endpoint("--listen", ep)
+    for ep in net.connect:
+        check_endpoint("--connect", ep)
+    try:
+        return zenoh.open(net.zenoh_config())
+    except zenoh.ZError as exc:
+        where = " and ".join([*(f"listen on {e}" for e in net.listen), *(f"connect to {e}" for e in net.connect)])
+        raise EndpointError(f"cannot {where or 'open a zenoh session'}: {zenoh_reason(exc)}") from None

@@ -97,6 +97,7 @@ SUMMARY = "summary"  # arena/<m>/summary/<process id>: one Summary per process a
 CONFIG = "config"  # queryable: the match configuration as JSON
 ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
 COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
+REFUSED = "refused"  # arena/<m>/refused/<process id>: a second process with that identity was turned away
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
 TAP_PERIOD = 50  # [ticks] one tap batch per process every 1 s of simulated time (at 20 ms ticks)
 
@@ -135,6 +136,12 @@ class Keys:
 
     def ack(self, process: str) -> str:
         return f"{self.prefix}{ACK}/{process}"
+
+    def refused(self, process: str) -> str:
+        return f"{self.prefix}{REFUSED}/{process}"
+
+    def refused_all(self) -> str:
+        return f"{self.prefix}{REFUSED}/**"
 
     def collector(self) -> str:
         return f"{self.prefix}{COLLECTOR}"

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import msgspec
+import zenoh
 
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.session import NetConfig, open_session
@@ -49,6 +50,85 @@ def _die_with_parent() -> None:
 
 class MatchError(RuntimeError):
     """The match could not be played to the end; the message says why."""
+
+
+class JoinError(MatchError):
+    """An `--external` process never joined (a user's or a network's matter: exit 2)."""
+
+
+def lan_addresses() -> list[str]:
+    """This machine's IPv4 addresses other than loopback and link-local (what a robot on the LAN can reach)."""
+    import fcntl
+    import socket
+    import struct
+
+    found: list[str] = []
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for _, name in socket.if_nameindex():
+            try:
+                packed = fcntl.ioctl(s.fileno(), 0x8915, struct.pack("256s", name[:15].encode()))  # SIOCGIFADDR
+            except OSError:
+                continue  # no IPv4 address on this interface
+            addr = socket.inet_ntoa(packed[20:24])
+            if not addr.startswith(("127.", "169.254.")) and addr not in found:
+                found.append(addr)
+    return found
+
+
+def robot_endpoints(endpoint: str) -> tuple[list[str], bool]:
+    """The endpoints a process on another computer can connect to, and whether it needs `--mode client`.
+
+    `tcp/0.0.0.0:P` (every interface) becomes one endpoint per LAN address; a
+    loopback or unix-socket endpoint stays as it is, for a process on this
+    machine, which can mesh with the others as a peer. A process on another
+    computer cannot reach the others' loopback ports, so it talks through the
+    router: `--mode client` (docs/architecture.md).
+    """
+    proto, _, address = endpoint.partition("/")
+    host, _, port = address.rpartition(":")
+    if proto == "unixsock-stream" or host.startswith(("127.", "localhost", "[::1]")):
+        return [endpoint], False
+    if host in ("0.0.0.0", "[::]"):
+        lan = lan_addresses()
+        if not lan:  # no network but loopback: only this machine can join
+            return [f"{proto}/127.0.0.1:{port}"], False
+        return [f"{proto}/{a}:{port}" for a in lan], True
+    return [endpoint], True
+
+
+class Joins:
+    """Which processes of the match have their liveliness token (who is there), seen from the router."""
+
+    def __init__(self, session, keys: Keys, external: set[ProcessId], announce) -> None:
+        self.external = {str(p) for p in external}
+        self.alive: set[str] = set()
+        self.announce = announce or (lambda text: None)
+        self._subs = []
+        if self.external:
+            self._subs.append(session.liveliness().declare_subscriber(keys.alive_all(), self._on_alive, history=True))
+            self._subs.append(session.declare_subscriber(keys.refused_all(), self._on_refused))
+
+    def _on_alive(self, sample) -> None:
+        name = str(sample.key_expr).split("/alive/", 1)[-1]
+        if sample.kind == zenoh.SampleKind.PUT:
+            self.alive.add(name)
+            if name in self.external:
+                self.announce(f"external {name} joined")
+        else:
+            self.alive.discard(name)
+
+    def _on_refused(self, sample) -> None:
+        name = str(sample.key_expr).split("/refused/", 1)[-1]
+        self.announce(
+            f"refused a second {name}: one is already running ({sample.payload.to_bytes().decode(errors='replace')})"
+        )
+
+    def missing(self) -> list[str]:
+        return sorted(self.external - self.alive)
+
+    def close(self) -> None:
+        for sub in self._subs:
+            sub.undeclare()
 
 
 @dataclass
@@ -437,6 +517,21 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
     }
 
 
+def instructions(external: list[ProcessId], match: str, endpoint: str, cfg: MatchConfig) -> str:
+    """What to type on the robot's computer: a command per --external process, with an address it can reach."""
+    endpoints, client = robot_endpoints(endpoint)
+    n = len(external)
+    lines = [f"waiting for {n} external process{'es' if n != 1 else ''}; start {'each' if n != 1 else 'it'} with:"]
+    for p in external:
+        argv = run_argv(p, match, endpoints[0], record=cfg.record)[3:]
+        if client:
+            argv += ["--mode", "client"]
+        lines.append("  arena " + " ".join(argv))
+    if len(endpoints) > 1:
+        lines.append(f"  (this machine is also reachable as: {', '.join(e.split('/', 1)[1] for e in endpoints[1:])})")
+    return "\n".join(lines)
+
+
 def play_match(
     cfg: MatchConfig,
     *,
@@ -460,7 +555,7 @@ def play_match(
     keys = Keys(match)
     tmp = Path(tempfile.mkdtemp(prefix="arena-"))
     endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
-    connect = endpoint.replace("0.0.0.0", "127.0.0.1")
+    connect = endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
     cfg_path = tmp / "config.json"
     cfg_path.write_text(cfg.to_json())
     logs = Path(log_dir) if log_dir else tmp
@@ -476,12 +571,9 @@ def play_match(
                 if p in external:
                     continue
                 children.append(spawn(str(p), p, run_argv(p, match, connect, str(cfg_path), cfg.record), logs))
+            joins = Joins(session, keys, external, announce)
             if external and announce is not None:
-                lines = [f"waiting for {len(external)} external process(es); start each with:"]
-                for p in sorted(external):
-                    argv = run_argv(p, match, connect, record=cfg.record)[2:]
-                    lines.append("  arena " + " ".join(argv[1:]))
-                announce("\n".join(lines))
+                announce(instructions(sorted(external), match, endpoint, cfg))
             try:
                 got = supervise(
                     transport,
@@ -493,7 +585,15 @@ def play_match(
                     Progress(cfg.total_ticks, progress),
                     strict=strict,
                 )
+            except MatchError:
+                if joins.missing():
+                    raise JoinError(
+                        f"external {', '.join(joins.missing())} did not join within "
+                        f"{cfg.timing.startup_timeout:g} s (start it with the command printed above)"
+                    ) from None
+                raise
             finally:
+                joins.close()
                 transport.close()
         dead = {d for s in got.summaries.values() for d in s.dead} | set(got.lost) | set(got.missing)
         for c in children:
@@ -511,7 +611,7 @@ def play_match(
     except MatchError as exc:
         if log_dir is None:
             keep = True
-            raise MatchError(f"{exc}\nevery process's log is kept in {tmp}") from None
+            raise type(exc)(f"{exc}\nevery process's log is kept in {tmp}") from None
         raise
     finally:
         stop_all(children)

@@ -14,19 +14,23 @@ Where the match configuration comes from:
 from __future__ import annotations
 
 import logging
+import os
 import signal
+import socket
 import sys
 import time
 from pathlib import Path
 
+import msgspec
 import zenoh
 
 from arena.processes import node_class
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.node import StartupError
-from arena.runtime.session import NetConfig, open_session
+from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys
+from arena.schemas.messages import Referee
 
 
 def _sigterm(signum, frame):  # noqa: ARG001 - signal handler signature
@@ -57,16 +61,63 @@ def load_config(path: str) -> MatchConfig:
     return MatchConfig.from_json(text)
 
 
-def fetch_config(transport: ZenohTransport, keys: Keys, timeout: float) -> MatchConfig:
+def fetch_config(
+    transport: ZenohTransport, keys: Keys, timeout: float, session=None, where: str = "", tell=None
+) -> MatchConfig:
+    """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
     deadline = time.monotonic() + timeout
+    state = ""
     while time.monotonic() < deadline:
         payload = transport.query(keys.config(), timeout=1.0)
         if payload is not None:
             return MatchConfig.from_json(payload.decode())
+        if session is not None:
+            connected = bool(list(session.info.routers_zid()) or list(session.info.peers_zid()))
+            now = f"a router at {where}, but no match {keys.match!r} there" if connected else f"no router at {where}"
+            if now != state and tell is not None:
+                tell(f"waiting: {now} (retrying for up to {timeout:g} s)")
+            state = now
         time.sleep(0.2)
     raise StartupError(
-        f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
+        f"gave up after {timeout:g} s: {state}"
+        if state
+        else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
         f"{keys.match!r} running and reachable on the given endpoint?"
+    )
+
+
+def open_until(net: NetConfig, timeout: float, where: str, tell):
+    """Open the session; a client retries until `timeout` while no router answers at its endpoint."""
+    for ep in net.connect:
+        check_endpoint("--connect", ep)
+    deadline = time.monotonic() + timeout
+    told = False
+    while True:
+        try:
+            return open_session(net)
+        except EndpointError as exc:
+            if net.mode != "client" or not net.connect:
+                raise
+            if time.monotonic() + 1.0 > deadline:
+                raise StartupError(f"gave up after {timeout:g} s: no router at {where}") from None
+            if not told:
+                tell(f"waiting: no router at {where} ({exc}; retrying for up to {timeout:g} s)")
+                told = True
+            time.sleep(1.0)
+
+
+def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
+    """Liveliness knows who is there: a second process with a running one's identity is turned away.
+
+    The match hears of it too (`arena/<m>/refused/<process>`, printed by `arena match`).
+    """
+    name = str(pid)
+    if not any(r.ok is not None for r in session.liveliness().get(keys.alive(name), timeout=1.0)):
+        return
+    session.put(keys.refused(name), f"from {socket.gethostname()}, pid {os.getpid()}".encode())
+    time.sleep(0.2)  # let the put leave before the session closes
+    raise ConfigError(
+        f"{name} is already running in match {keys.match!r}: a second one is refused (check --team and --robot)"
     )
 
 
@@ -84,15 +135,27 @@ def run(
 
     `record`: the recorder's output path; it overrides the configuration's
     (which names the path on the machine that started the match).
+
+    Started by hand (no `--config`: the robot on its own computer), it says on
+    stderr what it connected to, whom it waits for, and the final score.
     """
     signal.signal(signal.SIGTERM, _sigterm)
     keys = Keys(match)
     log = logging.getLogger(f"arena.{pid}")
-    with open_session(net) as session:
+    talk = cfg is None or sys.stderr.isatty()
+
+    def tell(text: str) -> None:
+        if talk:
+            print(f"arena run: {pid}: {text}", file=sys.stderr, flush=True)
+
+    where = ", ".join(net.connect or net.listen)
+    last_ref: list[bytes] = []
+    with open_until(net, startup_timeout, where, tell) as session:
         transport = ZenohTransport(session)
+        ref_sub = None
         try:
             if cfg is None:
-                cfg = fetch_config(transport, keys, startup_timeout)
+                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell)
             if seed is not None and seed != cfg.seed:
                 raise ConfigError(f"--seed {seed} differs from the match's seed {cfg.seed}")
             if realtime and not cfg.realtime:
@@ -104,12 +167,39 @@ def run(
                     cfg = cfg.replace(record=record)
             if pid not in cfg.processes():
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
+            refuse_duplicate(session, keys, pid)
+            tell(
+                f"connected to {where} (zenoh {net.mode}); match {match!r}: {cfg.home} v {cfg.away}, "
+                f"{cfg.robots} robots per team, 2 x {cfg.half_time:g} s"
+            )
+            if talk:
+                ref_sub = session.declare_subscriber(
+                    keys.key("referee"), lambda s: last_ref[:1].clear() or last_ref.append(s.payload.to_bytes())
+                )
             node = node_class(pid.kind)(pid, cfg, transport, keys)
+            node.on_waiting = lambda missing: tell(
+                f"waiting for: {', '.join(missing)} (up to {cfg.timing.startup_timeout:g} s)"
+                if missing
+                else "every process is here: playing"
+            )
             node.run()
         finally:
+            if ref_sub is not None:
+                ref_sub.undeclare()
             transport.close()
+    tell(final_score(last_ref, cfg))
     log.debug("%s done", pid)
     return 0
+
+
+def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
+    if not last_ref:
+        return "match over (no referee message seen: the score is in the match's output)"
+    try:
+        ref = msgspec.msgpack.Decoder(Referee).decode(last_ref[-1])
+    except (msgspec.DecodeError, msgspec.ValidationError):
+        return "match over (the last referee message was unreadable)"
+    return f"match over at tick {ref.tick} ({ref.stage}): a ({cfg.home}) {ref.score_a} : {ref.score_b} b ({cfg.away})"
 
 
 def run_router(match: str, net: NetConfig) -> int:
@@ -144,12 +234,14 @@ def main_guarded(fn, *args) -> int:
     except ConfigError as exc:
         print(f"arena run: error: {exc}", file=sys.stderr)
         return 2
-    except StartupError as exc:
+    except StartupError as exc:  # the match or its router never came: a matter of addresses and timing
         print(f"arena run: error: {exc}", file=sys.stderr)
-        return 3
+        return 2
     except zenoh.ZError as exc:
-        print(f"arena run: zenoh error: {exc}", file=sys.stderr)
-        return 3
+        from arena.runtime.session import zenoh_reason
+
+        print(f"arena run: zenoh error: {zenoh_reason(exc)}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("arena run: interrupted", file=sys.stderr)
         return 130

@@ -22,7 +22,7 @@ def arena(*args: str) -> subprocess.CompletedProcess:
         (["match", "--home", "BS", "--away", "BS", "--link", "5g"], "unknown link preset '5g'"),
         (["match", "--home", "BS", "--away", "BS", "--link-param", "wifi.warp=9"], "unknown link parameter 'warp'"),
         (["match", "--home", "BS", "--away", "BS", "--external", "c/9"], "bad process name"),
-        (["match", "--home", "BS", "--away", "BS", "--half-time", "-3"], "--half-time must be positive"),
+        (["match", "--home", "BS", "--away", "BS", "--half-time", "-3"], "give a finite number of seconds > 0"),
         (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
         (
             ["run", "robot", "--match", "m/x", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"],

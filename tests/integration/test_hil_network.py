@@ -1,0 +1,109 @@
+"""Issue 19: hardware in the loop across a real network, inside network namespaces made here.
+
+Two namespaces joined by a veth pair stand for the laptop that runs the match
+and the robot's own computer. The match listens on every interface
+(`tcp/0.0.0.0:7447`); the robot is started on the other side with the command
+the match printed, copied verbatim, so that command must name an address the
+robot can reach and `--mode client`. A second robot with the same identity is
+refused on both sides. Needs root and iproute2; skipped otherwise.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from tests.integration.helpers import wait_for
+
+NET = f"10.{200 + os.getpid() % 50}.{os.getpid() % 250}"  # addresses that exist only in the namespaces below
+
+
+def _ip(*args: str) -> None:
+    subprocess.run(["ip", *args], check=True, capture_output=True, timeout=10)
+
+
+@pytest.fixture
+def two_hosts():
+    """(laptop namespace, robot namespace); removed again in teardown."""
+    if os.geteuid() != 0 or shutil.which("ip") is None:
+        pytest.skip("needs root and iproute2 (ip netns) for a network namespace pair")
+    tag = f"arena{os.getpid()}"
+    laptop, robot = f"{tag}-l", f"{tag}-r"
+    try:
+        _ip("netns", "add", laptop)
+    except subprocess.CalledProcessError as exc:
+        pytest.skip(f"cannot create a network namespace here: {exc.stderr.decode().strip()}")
+    try:
+        _ip("netns", "add", robot)
+        _ip("link", "add", f"{tag}a", "netns", laptop, "type", "veth", "peer", "name", f"{tag}b", "netns", robot)
+        for ns, dev, host in ((laptop, f"{tag}a", 1), (robot, f"{tag}b", 2)):
+            _ip("-n", ns, "addr", "add", f"{NET}.{host}/24", "dev", dev)
+            _ip("-n", ns, "link", "set", dev, "up")
+            _ip("-n", ns, "link", "set", "lo", "up")
+        yield laptop, robot
+    finally:
+        for ns in (laptop, robot):
+            subprocess.run(["ip", "netns", "del", ns], capture_output=True, timeout=10)
+
+
+def _in(ns: str, *argv: str, **kw) -> subprocess.Popen:
+    return subprocess.Popen(
+        ["ip", "netns", "exec", ns, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw
+    )
+
+
+def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap):
+    laptop, robot_host = two_hosts
+    py = [sys.executable, "-m", "arena"]
+    match = _in(
+        laptop,
+        *py,
+        *("match", "--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "3"),
+        *("--external", "a/1", "--match", "lan", "--listen", "tcp/0.0.0.0:7447", "--json"),
+    )
+    reap.append(match)
+    assert "external" in wait_for(lambda: match.stderr.readline(), 60, "the launcher's instructions")
+    printed = match.stderr.readline().strip()
+    assert printed.startswith("arena run robot ") and f"--connect tcp/{NET}.1:7447" in printed, printed
+    assert "--mode client" in printed, printed
+    # The robot's computer runs exactly what was printed (`arena` is this interpreter's module).
+    robot = _in(robot_host, *py, *printed.split()[1:])
+    reap.append(robot)
+    assert "external robot/a/1 joined" in wait_for(lambda: match.stderr.readline(), 60, "the robot joining")
+    # The same robot started a second time is refused, and the match says so.
+    twin = subprocess.run(
+        ["ip", "netns", "exec", robot_host, *py, *printed.split()[1:]], capture_output=True, text=True, timeout=60
+    )
+    assert twin.returncode == 2, twin.stderr
+    assert "robot/a/1 is already running in match 'lan'" in twin.stderr.strip().splitlines()[-1]
+    out, err = match.communicate(timeout=240)
+    assert match.returncode == 0, err
+    assert "refused a second robot/a/1" in err
+    r_out, r_err = robot.communicate(timeout=30)
+    assert robot.returncode == 0, r_err
+    assert f"connected to tcp/{NET}.1:7447 (zenoh client)" in r_err
+    assert "match over at tick 1000 (END_GAME)" in r_err, r_err
+    result = json.loads(out)
+    a1 = next(p for p in result["processes"] if (p["kind"], p["team"], p["robot"]) == ("robot", "a", 1))
+    assert a1["external"] and result["distance_m"]["a/1"] > 0.5, "the robot across the network moved"
+    assert result["dead"] == []
+
+
+def test_an_external_robot_that_never_comes_is_named(tmp_path):
+    r = subprocess.run(
+        [
+            *(sys.executable, "-m", "arena", "match", "--home", "BS", "--away", "BS", "--half-time", "2"),
+            *("--external", "a/1", "--startup-timeout", "3", "--listen", f"unixsock-stream/{tmp_path}/r.sock"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 2, r.stderr
+    last = r.stderr.strip().splitlines()[-1]
+    assert last.startswith("arena match: error: external robot/a/1 did not join within 3 s"), r.stderr

@@ -1,0 +1,149 @@
+"""Issue 19: no traceback from any command, for any input.
+
+A table of bad invocations across every subcommand. Each must print exactly
+one line on stderr, never a traceback, and exit with the documented code
+(arena/cli.py: 2 for a user error). `{tmp}` is an empty directory, `{file}` a
+file with garbage in it, `{busy}` a TCP port that something already listens on.
+"""
+
+from __future__ import annotations
+
+import socket
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+M = ["match", "--home", "BS", "--away", "BS", "--half-time", "1"]
+R = ["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"]
+T = ["tournament", "--strategies", "AD,BS", "--legs", "1", "--half-time", "1"]
+
+BAD = [
+    # arena match
+    (["match", "--home", "BS", "--away", "BS", "--half-time", "inf"], "give a finite number"),
+    (["match", "--home", "BS", "--away", "BS", "--half-time", "nan"], "give a finite number"),
+    (["match", "--home", "BS", "--away", "BS", "--half-time", "1e12"], "at most 3600 s per half"),
+    (["match", "--home", "BS", "--away", "BS", "--half-time", "-3"], "give a finite number"),
+    (["match", "--home", "BS", "--away", "BS", "--half-time", "soon"], "is not a number of seconds"),
+    ([*M, "--startup-timeout", "-1"], "--startup-timeout: '-1'"),
+    ([*M, "--startup-timeout", "0"], "--startup-timeout: '0'"),
+    ([*M, "--listen", "foo"], "--listen foo: not a zenoh endpoint"),
+    ([*M, "--listen", "tcp/127.0.0.1:99999"], "a port in 0..65535"),
+    ([*M, "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use"),
+    ([*M, "--robots", "0"], "--robots must be between 1 and 6"),
+    ([*M, "--robots", "lots"], "invalid int value"),
+    (["match", "--home", "tiki-taka", "--away", "BS"], "unknown strategy 'tiki-taka'"),
+    (["match", "--home", "BS"], "required: --away"),
+    ([*M, "--link", "5g"], "unknown link preset '5g'"),
+    ([*M, "--link-param", "wifi.warp=9"], "unknown link parameter 'warp'"),
+    ([*M, "--link-param", "nonsense"], "bad link override"),
+    ([*M, "--external", "c/9"], "bad process name"),
+    ([*M, "--external", "a/7"], "no such process"),
+    ([*M, "--match", "m/x"], "bad match id"),
+    ([*M, "--record", "/nonexistent/dir/m.mcap"], "does not exist"),
+    ([*M, "--record", "{tmp}"], "is a directory"),
+    ([*M, "--seed", "-1"], "--seed must be in"),
+    ([*M, "--bogus"], "unrecognized arguments: --bogus"),
+    # arena run
+    (["run", "robot", "--match", "m", "--connect", "foo", "--team", "a", "--robot", "1"], "--connect foo"),
+    (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
+    (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--team", "a"], "needs --robot"),
+    (["run", "basestation", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"], "--robot"),
+    ([*R, "--startup-timeout", "-1"], "--startup-timeout: '-1'"),
+    ([*R[:3], "m/x", *R[4:]], "bad match id"),
+    ([*R, "--record", "x.mcap"], "--record does not apply"),
+    ([*R, "--team", "c"], "invalid choice: 'c'"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
+    (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),
+    (["run", "router", "--match", "m", "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use"),
+    (["run", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "the following arguments are required: kind"),
+    # arena up
+    (["up", "/nonexistent/compose.yaml"], "cannot read"),
+    (["up", "{file}"], "not valid YAML"),
+    (["up", "compose.yaml", "--timeout", "-5"], "--timeout: '-5'"),
+    # arena tournament
+    ([*T, "--out", "{file}"], "exists and is not a directory"),
+    (["tournament", "--strategies", "AD"], "at least two different strategies"),
+    (["tournament", "--strategies", "AD,nope"], "unknown strategy 'nope'"),
+    ([*T, "--legs", "0"], "--legs: '0'"),
+    (["tournament", "--half-time", "inf"], "finite number"),
+    ([*T, "--link-param", "x"], "bad link override"),
+    ([*T, "--jobs", "-1"], "--jobs"),
+    ([*T, "--robots", "9"], "--robots"),
+    # arena bench
+    (["bench", "match", "--runs", "0"], "--runs: '0'"),
+    (["bench", "match", "--half-time", "1e12"], "at most 3600 s"),
+    (["bench", "nav", "--trials", "0"], "--trials: '0'"),
+    (["bench", "nav", "--scenarios", "/nonexistent.toml"], "nonexistent.toml"),
+    (["bench", "nav", "--only", "nosuch"], "nosuch"),
+    (["bench", "frob"], "invalid choice: 'frob'"),
+    # arena review
+    (["review", "/nonexistent.mcap"], "cannot read"),
+    (["review", "{file}"], "not an MCAP file"),
+    (["review", "{file}", "--plots", "{file}"], "exists and is not a directory"),
+    # arena replay
+    (["replay", "/nonexistent.mcap", "--process", "a/1"], "cannot read"),
+    (["replay", "{file}", "--process", "a/1"], "not an MCAP file"),
+    (["replay", "/nonexistent.mcap"], "required: --process"),
+    # arena schemas, and the top level
+    (["schemas", "--check", "--write"], "not allowed with argument"),
+    (["frobnicate"], "invalid choice"),
+    ([], "required: <command>"),
+]
+
+
+@pytest.fixture(scope="module")
+def busy_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        yield s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def garbage(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bad") / "garbage.txt"
+    path.write_text("this is neither JSON, YAML, nor MCAP: {[\n")
+    return path
+
+
+@pytest.mark.parametrize(("args", "needle"), BAD, ids=[" ".join(a)[:60] for a, _ in BAD])
+def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, busy_port, garbage, tmp_path):
+    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path) for a in args]
+    r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
+    assert "Traceback" not in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert needle in r.stderr, r.stderr
+    assert r.returncode == 2, r.stderr
+
+
+def test_the_table_covers_every_subcommand():
+    from arena.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    covered = {args[0] for args, _ in BAD if args}
+    assert set(sub.choices) - covered == set(), "every subcommand needs bad invocations in the table"
+    assert len(BAD) >= 40
+
+
+def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, capsys):
+    from arena import cli
+
+    def broken(args):
+        raise ZeroDivisionError("the bug")
+
+    monkeypatch.setattr(cli, "cmd_schemas", broken)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    assert cli.main(["schemas", "--check"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "internal error: ZeroDivisionError: the bug" in err
+    log = Path(err.rsplit("details in ", 1)[1].rstrip(")"))
+    assert log.parent == tmp_path and "Traceback" in log.read_text() and "the bug" in log.read_text()
+
+
+def test_version():
+    r = subprocess.run([sys.executable, "-m", "arena", "--version"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and r.stdout.startswith("arena ") and r.stdout.split()[1][0].isdigit()
