@@ -126,6 +126,23 @@ class Joins:
     def missing(self) -> list[str]:
         return sorted(self.external - self.alive)
 
+    def wait(self, timeout: float, children: list[Child]) -> None:
+        """Until every external process has joined; JoinError after `timeout`.
+
+        The children wait as long at their start barrier, but their clocks
+        start later (after spawn and imports), so this gives up first and the
+        message names who never came. A child that fails meanwhile is
+        supervise()'s to report.
+        """
+        deadline = time.monotonic() + timeout
+        while self.missing() and all(c.popen.poll() is None for c in children):
+            if time.monotonic() > deadline:
+                raise JoinError(
+                    f"external {', '.join(self.missing())} did not join within {timeout:g} s "
+                    "(start it with the command printed above)"
+                )
+            time.sleep(0.1)
+
     def close(self) -> None:
         for sub in self._subs:
             sub.undeclare()
@@ -575,6 +592,7 @@ def play_match(
             if external and announce is not None:
                 announce(instructions(sorted(external), match, endpoint, cfg))
             try:
+                joins.wait(cfg.timing.startup_timeout, children)
                 got = supervise(
                     transport,
                     collector,
@@ -585,13 +603,6 @@ def play_match(
                     Progress(cfg.total_ticks, progress),
                     strict=strict,
                 )
-            except MatchError:
-                if joins.missing():
-                    raise JoinError(
-                        f"external {', '.join(joins.missing())} did not join within "
-                        f"{cfg.timing.startup_timeout:g} s (start it with the command printed above)"
-                    ) from None
-                raise
             finally:
                 joins.close()
                 transport.close()
