@@ -64,6 +64,10 @@ EXAMPLES = {
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
   arena review match.mcap --plots plots/     # PNG charts and an animated GIF of the match""",
+    "facts": """examples:
+  arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
+  arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
+  arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio""",
     "replay": """examples:
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
   arena replay match.mcap --process basestation/b --json
@@ -309,6 +313,17 @@ def build_parser() -> Parser:
     )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
+
+    fa = add("facts", "play matches in process and measure them: rules and team-play facts per match and strategy")
+    fa.add_argument("--seeds", type=int, default=20, metavar="N", help="matches, seeds first-seed.. (20)")
+    fa.add_argument("--first-seed", type=int, default=0, metavar="S", help="first seed (0)")
+    fa.add_argument("--half-time", type=float, default=60.0, metavar="SECONDS", help="simulated half length (60)")
+    fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
+    fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
+    fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once (default: up to 2)")
+    fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
+    fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
+    fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
 
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
     v.add_argument("file", help="an MCAP file written by arena match --record")
@@ -592,6 +607,22 @@ def cmd_review(args: argparse.Namespace) -> int:
     return review.main(args.file, plots=args.plots, as_json=args.json)
 
 
+def cmd_facts(args: argparse.Namespace) -> int:
+    from arena.tools import facts
+
+    return facts.main(
+        seeds=args.seeds,
+        first_seed=args.first_seed,
+        half_time=args.half_time,
+        home=args.home,
+        away=args.away,
+        workers=args.workers or None,
+        round_robin_of=[s for s in (args.round_robin or "").split(",") if s] or None,
+        legs=args.legs,
+        seed=args.seed,
+    )
+
+
 def cmd_replay(args: argparse.Namespace) -> int:
     from arena.tools import replay
 
@@ -615,6 +646,7 @@ def main(argv: list[str] | None = None) -> int:
         "schemas": cmd_schemas,
         "tournament": cmd_tournament,
         "review": cmd_review,
+        "facts": cmd_facts,
         "replay": cmd_replay,
     }
     try:

@@ -1,17 +1,12 @@
 """`arena review FILE.mcap`: what happened in a recorded match.
 
-Everything comes from the recording itself (recording/reader.py):
+The analysis is `arena.recording.analysis` (shared with `arena facts` and the
+tests); this module prints it and draws the plots.
 
-* teams, strategies, seed: the `arena` metadata (the match configuration);
-* score, goal timeline, restarts by type: the `referee` frames;
-* possession and the trajectories: the ground-truth `world` frames. A frame
-  counts for the team whose robot holds the ball on its dribbler, else for the
-  team of the robot nearest the ball if it is within `POSSESSION_RADIUS`, else
-  for nobody (a loose ball);
-* distance per robot: the engine's Summary (physics at 250 Hz, the number
-  `arena match` reports), or the world frames when the file has no summary;
-* applied link statistics and per-process tick timing: the processes'
-  Summaries, which the recorder stores as metadata at the end of the match.
+Everything comes from the recording itself (recording/reader.py): the match
+configuration from its `arena` metadata, score, goals and restarts from the
+`referee` frames, possession, distances and trajectories from the `world`
+frames, link statistics and timing from the processes' Summaries.
 
 A truncated recording (the recorder was killed) is reviewed up to where it
 ends, and the report says so. `--plots DIR` adds PNG charts and an animated
@@ -23,149 +18,20 @@ from __future__ import annotations
 import json
 import math
 import sys
-from collections import Counter
 from pathlib import Path
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from arena.recording.analysis import NEEDED, analyse
+from arena.recording.analysis.review import JUMP
 from arena.recording.reader import Recording, RecordingError, load
-from arena.schemas.messages import Referee, World
+from arena.schemas.messages import World
 
-POSSESSION_RADIUS = 0.5  # [m] robot centre to ball centre: within this the nearest robot's team has the ball
-RESTARTS = ("KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "DROP_BALL")  # MSL RefBox
-JUMP = 0.5  # [m] a move longer than this between two world frames is a placement, not driving
 GIF_FRAMES = 100  # [-] at most this many frames in the animation (Pillow encodes ~30 ms each)
 GIF_FPS = 10  # [1/s]
 TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in the Foxglove scene
-NEEDED = frozenset({"world", "referee"})
-
-
-def _percentiles(values: list[float]) -> dict[str, float]:
-    if not values:
-        return {"p50": 0.0, "p95": 0.0, "p99": 0.0, "max": 0.0}
-    a = np.asarray(values, dtype=float)
-    return {
-        "p50": round(float(np.percentile(a, 50)), 3),
-        "p95": round(float(np.percentile(a, 95)), 3),
-        "p99": round(float(np.percentile(a, 99)), 3),
-        "max": round(float(a.max()), 3),
-    }
-
-
-def _link_stats(rec: Recording) -> dict[str, dict]:
-    """Per link class and per (receiving process, class): frames, drops, delay percentiles."""
-    per_class: dict[str, dict] = {}
-    per_process: dict[str, dict] = {}
-    for name, s in rec.summaries.items():
-        for cls, agg in s.links.items():
-            frames, dropped = int(agg.get("frames", 0)), int(agg.get("dropped", 0))
-            delays = s.delays_ms.get(cls, [])
-            acc = per_class.setdefault(cls, {"frames": 0, "dropped": 0, "_d": []})
-            acc["frames"] += frames
-            acc["dropped"] += dropped
-            acc["_d"].extend(delays)
-            per_process.setdefault(name, {})[cls] = {
-                "frames": frames,
-                "dropped": dropped,
-                "drop_percent": round(100.0 * dropped / frames, 3) if frames else 0.0,
-                "delay_ms": _percentiles(delays),
-            }
-    for acc in per_class.values():
-        d = acc.pop("_d")
-        acc["drop_percent"] = round(100.0 * acc["dropped"] / acc["frames"], 3) if acc["frames"] else 0.0
-        acc["delay_ms"] = _percentiles(d)
-    return {"by_class": dict(sorted(per_class.items())), "by_process": per_process}
-
-
-def analyse(rec: Recording) -> dict:
-    """The review as one JSON-able dict."""
-    cfg = rec.cfg
-    dt = cfg.timing.dt
-    refs: list[Referee] = rec.decoded("referee", Referee)
-    worlds: list[World] = rec.decoded("world", World)
-    score = [refs[-1].score_a, refs[-1].score_b] if refs else [0, 0]
-    goals, restarts, commands = [], Counter(), Counter()
-    for r in refs:
-        for c in r.commands:
-            commands[c.name] += 1
-            if c.name in RESTARTS:
-                restarts[f"{c.name} {c.team}".strip()] += 1
-            if c.name == "GOAL":
-                goals.append(
-                    {"tick": c.tick, "t": round(c.tick * dt, 2), "team": c.team, "score": [r.score_a, r.score_b]}
-                )
-    # possession and distance from the ground truth
-    holds = Counter()
-    dist: dict[str, float] = {}
-    last: dict[str, tuple[float, float]] = {}
-    for w in worlds:
-        holder = ""
-        best = POSSESSION_RADIUS
-        for rb in w.robots:
-            name = f"{rb.team}/{rb.robot}"
-            if name in last:
-                px, py = last[name]
-                step = math.hypot(rb.x - px, rb.y - py)
-                dist[name] = dist.get(name, 0.0) + (step if step <= JUMP else 0.0)
-            last[name] = (rb.x, rb.y)
-            if rb.has_ball:
-                holder, best = rb.team, -1.0
-            d = math.hypot(rb.x - w.ball_x, rb.y - w.ball_y)
-            if d < best:
-                holder, best = rb.team, d
-        holds[holder or "loose"] += 1
-    held = holds["a"] + holds["b"]
-    possession = {
-        "a": round(100.0 * holds["a"] / held, 1) if held else 0.0,
-        "b": round(100.0 * holds["b"] / held, 1) if held else 0.0,
-        "loose_percent_of_time": round(100.0 * holds["loose"] / len(worlds), 1) if worlds else 0.0,
-    }
-    engine = rec.summaries.get("engine")
-    if engine is not None and engine.extra.get("distance_m"):
-        distance, source = dict(engine.extra["distance_m"]), "engine summary"
-    else:
-        distance, source = {k: round(v, 3) for k, v in sorted(dist.items())}, "world frames"
-    timing = {}
-    for name in [str(p) for p in cfg.processes()]:
-        s = rec.summaries.get(name)
-        if s is None:
-            continue
-        timing[name] = {
-            "tick_us_median": round(s.tick_us[0], 1) if s.tick_us else None,
-            "tick_us_p95": round(s.tick_us[1], 1) if s.tick_us else None,
-            "wall_s": round(s.wall_s, 3),
-            "cpu_s": round(sum(s.cpu_s), 3) if s.cpu_s else None,
-        }
-    last_tick = worlds[-1].tick if worlds else 0
-    return {
-        "file": rec.path,
-        "truncated": rec.truncated,
-        "truncation": rec.problem,
-        "complete": rec.complete,
-        "home": cfg.home,
-        "away": cfg.away,
-        "seed": cfg.seed,
-        "robots": cfg.robots,
-        "link": cfg.link,
-        "git_revision": rec.meta.get("arena", {}).get("git_revision", "unknown"),
-        "score": score,
-        "ticks": last_tick,
-        "sim_seconds": round(last_tick * dt, 3),
-        "planned_ticks": cfg.total_ticks,
-        "planned_sim_seconds": round(cfg.total_ticks * dt, 3),
-        "goals": goals,
-        "restarts": dict(sorted(restarts.items())),
-        "commands": dict(sorted(commands.items())),
-        "possession_percent": possession,
-        "distance_m": distance,
-        "distance_source": source,
-        "links": _link_stats(rec),
-        "timing": timing,
-        "summaries": sorted(rec.summaries),
-        "messages": dict(sorted(rec.counts.items())),
-    }
 
 
 # ------------------------------------------------------------------ output
@@ -193,6 +59,14 @@ def print_review(r: dict, console: Console | None = None) -> None:
     console.print(
         f"possession: a {p['a']:.1f} %, b {p['b']:.1f} % (ball loose {p['loose_percent_of_time']:.1f} % of the time)"
     )
+    f = r.get("facts")
+    if f is not None:
+        a, b = f["teams"]
+        console.print(
+            f"shots a {a['shots']} ({a['on_target']} on target), b {b['shots']} ({b['on_target']}); "
+            f"keeper saves a {a['saves']}, b {b['saves']}; blocks a {a['blocks']}, b {b['blocks']}; "
+            f"robot contact {f['contact_s']:.1f} pair-s"
+        )
     d = Table(title="distance per robot", caption=f"from the {r['distance_source']}")
     d.add_column("robot")
     d.add_column("[m]", justify="right")

@@ -17,13 +17,15 @@ from mcap.writer import Writer
 
 from arena.processes.recorder import data_topics
 from arena.recording import scene
+from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import RecordingError, load
 from arena.runtime.config import MatchConfig
 from arena.runtime.tap import Tap
 from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
+from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import registry
-from arena.tools import replay, review
+from arena.tools import facts, replay, review
 from arena.tools.inprocess import play_in_process
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
@@ -177,11 +179,11 @@ def test_recording_changes_nothing_in_the_match(recorded):
 # ---------------------------------------------------------------------- review
 def test_review_reports_the_match(recorded):
     path, summaries = recorded
-    r = review.analyse(load(str(path), keep=review.NEEDED))
+    r = analyse(load(str(path), keep=NEEDED))
     ref = summaries["referee"].extra
     assert r["score"] == ref["score"]
     assert [g["tick"] for g in r["goals"]] == [e["tick"] for e in ref["log"] if e["command"] == "GOAL"]
-    assert sum(r["restarts"].values()) == sum(ref["events"].get(k, 0) for k in review.RESTARTS)
+    assert sum(r["restarts"].values()) == sum(ref["events"].get(k, 0) for k in SET_PIECES)
     p = r["possession_percent"]
     assert p["a"] + p["b"] == pytest.approx(100.0, abs=0.2)
     assert r["distance_m"] == summaries["engine"].extra["distance_m"]
@@ -191,10 +193,19 @@ def test_review_reports_the_match(recorded):
     assert not r["truncated"] and r["complete"]
 
 
+def test_review_and_arena_facts_measure_the_same_match_the_same_way(recorded):
+    """One analysis: the facts from the recording equal those `arena facts` measures in process."""
+    path, _ = recorded
+    from_file = analyse(load(str(path), keep=NEEDED))["facts"]
+    in_process = dataclasses.asdict(facts.match_facts(CFG))
+    assert from_file is not None and from_file["ticks"] == CFG.total_ticks + 1
+    assert from_file == in_process
+
+
 def test_review_plots_write_pngs_and_an_animation(tmp_path):
     path, _ = record(tmp_path, "short.mcap", MatchConfig(seed=2, half_time=1.0))
-    rec = load(str(path), keep=review.NEEDED)
-    written = review.write_plots(rec, review.analyse(rec), str(tmp_path / "plots"))
+    rec = load(str(path), keep=NEEDED)
+    written = review.write_plots(rec, analyse(rec), str(tmp_path / "plots"))
     names = sorted(p.rsplit("/", 1)[-1] for p in written)
     assert names == ["heatmap.png", "match.gif", "score.png", "trajectories.png"]
     for p in written:
@@ -210,9 +221,9 @@ def test_a_cut_file_is_read_up_to_the_cut_and_said_to_be_truncated(recorded, tmp
     data = path.read_bytes()
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(data[: int(len(data) * fraction)])
-    rec = load(str(cut), keep=review.NEEDED)
+    rec = load(str(cut), keep=NEEDED)
     assert rec.truncated and not rec.complete and rec.problem
-    r = review.analyse(rec)
+    r = analyse(rec)
     assert r["truncated"] and 0 < r["ticks"] <= CFG.total_ticks
     full = load(str(path))
     for topic, frames in rec.topics.items():

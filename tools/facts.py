@@ -1,0 +1,128 @@
+"""`arena facts`: facts about whole matches played in process, the rules
+acceptance (issue 3) and "play that looks like soccer" (issue 4).
+
+`match_facts(cfg)` plays one match in-process (tools/inprocess.py, the very
+`Node` code of a real match) and measures it with the one analysis of the
+World/Referee streams (`arena.recording.analysis.measure`, which also serves
+`arena review`); the facts are described there.
+
+`arena facts --seeds 20` prints one line per seed and a
+summary; `--home AD --away BS` picks the strategies. `--round-robin AD,AS,BD,BS
+--legs 4` plays every pairing `legs` times, home and away alternating, and
+prints the paper's Table 2 and the robot 1 / robot 2 coverage ratio (Fig. 9),
+with the tournament's own table code (tools/tournament.py).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from itertools import combinations
+
+import msgspec
+
+from arena.recording.analysis.facts import MatchFacts, measure
+from arena.runtime.config import ConfigError, MatchConfig
+from arena.schemas.messages import Referee, World
+from arena.tools.facts_table import line, summary
+from arena.tools.inprocess import play_in_process
+
+
+def match_facts(cfg: MatchConfig) -> MatchFacts:
+    summaries, frames = play_in_process(cfg, watch=("world", "referee"))
+    worlds = [msgspec.msgpack.decode(raw, type=World) for raw in frames["world"]]
+    referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in frames["referee"])}
+    extra = summaries["referee"].extra
+    return measure(cfg, worlds, referee, extra, summaries["engine"].extra.get("distance_m", {}))
+
+
+def many(cfgs: list[MatchConfig], workers: int | None = None) -> list[MatchFacts]:
+    """`match_facts` of every configuration, in worker processes (spawned: no fork of threads)."""
+    workers = workers or min(len(cfgs), os.cpu_count() or 1)
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        return list(pool.map(match_facts, cfgs))
+
+
+def round_robin(
+    strategies: list[str], legs: int, half_time: float, seed: int, workers: int
+) -> tuple[list, list[MatchFacts]]:
+    """Every pairing `legs` times, home and away alternating, in-process; returns (Results, facts)."""
+    from arena.runtime import seeds
+    from arena.tools.tournament import Result
+
+    fixtures = []
+    for first, second in combinations(strategies, 2):
+        for leg in range(1, legs + 1):
+            home, away = (first, second) if leg % 2 == 1 else (second, first)
+            s = seeds.derive(seed, "tournament", first, second, leg) % (2**31)
+            fixtures.append((first, second, leg, home, away, s))
+    cfgs = [MatchConfig(seed=s, home=h, away=a, half_time=half_time) for _, _, _, h, a, s in fixtures]
+    facts = many(cfgs, workers)
+    results = [
+        Result(
+            id=f"{i:03d}",
+            first=fst,
+            second=snd,
+            leg=leg,
+            home=h,
+            away=a,
+            seed=s,
+            status="ok",
+            score=list(m.score),
+            distance_m={f"{side}/{k}": d for side, t in zip("ab", m.teams) for k, d in enumerate(t.distance_m)},
+        )
+        for i, ((fst, snd, leg, h, a, s), m) in enumerate(zip(fixtures, facts))
+    ]
+    return results, facts
+
+
+def main(
+    seeds: int = 20,
+    first_seed: int = 0,
+    half_time: float = 60.0,
+    home: str = "chase",
+    away: str = "chase",
+    workers: int | None = None,
+    round_robin_of: list[str] | None = None,
+    legs: int = 4,
+    seed: int = 0,
+) -> int:
+    """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2."""
+    workers = workers or min(2, os.cpu_count() or 1)
+    if seeds < 1 or legs < 1 or workers < 1:
+        raise ConfigError(f"--seeds, --legs and --workers must be at least 1 (got {seeds}, {legs}, {workers})")
+    if not half_time > 0:
+        raise ConfigError(f"--half-time must be > 0, got {half_time}")
+    t0 = time.monotonic()
+    if round_robin_of:
+        from arena.strategies import registry
+        from arena.tools.tournament import coverage, short, standings
+
+        names = [registry.resolve_name(s) for s in round_robin_of]
+        results, facts = round_robin(names, legs, half_time, seed, workers)
+        for r, m in zip(results, facts):
+            print(f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}")
+        for row in summary(facts):
+            print(row)
+        cover = coverage(results, names)
+        print("team              W  D  L  GF  GA  GD   P   robot1 m  robot2 m  ratio")
+        for row in standings(results, names):
+            c = cover[row["team"]]
+            print(
+                f"{short(row['team']):16s} {row['W']:2d} {row['D']:2d} {row['L']:2d} {row['GF']:3d} {row['GA']:3d} "
+                f"{row['GD']:3d} {row['P']:3d}   {c['robot1_m']:7.1f}  {c['robot2_m']:7.1f}  {c['ratio']}"
+            )
+        print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s")
+        return 0
+    cfgs = [
+        MatchConfig(seed=s, half_time=half_time, home=home, away=away) for s in range(first_seed, first_seed + seeds)
+    ]
+    facts = many(cfgs, workers)
+    for m in facts:
+        print(line(m))
+    for row in summary(facts):
+        print(row)
+    print(f"in {time.monotonic() - t0:.0f} s")
+    return 0
