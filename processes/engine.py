@@ -204,11 +204,11 @@ class EngineNode(Node):
             total_ticks=cfg.total_ticks,
         )
 
-    def loop(self) -> None:
-        self.field_out.send(self.field_spec())
-        super().loop()
-
     def lockstep(self) -> Waits:
+        # The field frame is part of the loop, not of `loop()`: whoever drives the
+        # generator (Reactor, pull, the cooperative driver of tools/inprocess.py)
+        # sends it first, so the engine's digest is the same under every driver.
+        self.field_out.send(self.field_spec())
         last = self.cfg.total_ticks
         ph = self.physics
         for k in range(last + 1):
@@ -238,6 +238,7 @@ class EngineNode(Node):
         timeout_ticks = max(1, int(round(self.cfg.robot.cmd_timeout / dt)))
         last_cmd = {r: 0 for r in self.robots}
         ph = self.physics
+        self.field_out.send(self.field_spec())
         start = time.monotonic()
         for k in range(last + 1):
             t0 = time.perf_counter()

@@ -403,14 +403,25 @@ class RecorderNode(Node):
                     self.log.error("no tap batch for %g s: closing the recording", self.cfg.timing.wait_timeout)
                     break
                 time.sleep(POLL_S)
-            self._drain()
-            self._write_ready(NEVER)
         finally:
-            self._close()
+            self.finish()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
         if self.interrupted:
             raise SystemExit(128 + signal.Signals[self.interrupted].value)
+
+    # A cooperative match (tools/inprocess.py) calls these two instead of `loop`.
+    def pump(self) -> None:
+        """Take in the tap batches and summaries that are there; write what every watermark passed."""
+        self._drain()
+
+    def finish(self) -> None:
+        """Take in the rest, write every pending frame, close the file."""
+        try:
+            self._drain()
+            self._write_ready(NEVER)
+        finally:
+            self._close()
 
     def summary_extra(self) -> dict[str, object]:
         return {

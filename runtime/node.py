@@ -36,6 +36,15 @@ from arena.schemas.keys import KEY_BY_NAME, Keys
 M = TypeVar("M", bound=msgs.Base)
 
 
+def settle_heap() -> None:
+    """Everything built so far lives for the whole match: keep it out of the
+    collector's way (the tick loop allocates only short-lived, acyclic objects
+    that reference counting frees)."""
+    gc.collect()
+    gc.freeze()
+    gc.set_threshold(50_000, 50, 100)
+
+
 class StartupError(RuntimeError):
     """The match could not start: a process never came up."""
 
@@ -55,7 +64,9 @@ class Node:
         # real time, and the memory transport of in-process runs, pull instead.
         self.reactive = not cfg.realtime and getattr(transport, "callbacks", False)
         self.reactor = Reactor(cfg.timing.wait_timeout) if self.reactive else None
-        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout, thread=not self.reactive)
+        # A cooperative driver (runtime/coop.py) bounds the waits itself: no thread.
+        cooperative = getattr(transport, "cooperative", False)
+        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout, thread=not (self.reactive or cooperative))
         self.outbound: list[Outbound[Any]] = []
         self.inbound: list[Inbound[Any]] = []
         self.gone: set[str] = set()  # peers whose liveliness token vanished
@@ -221,17 +232,16 @@ class Node:
     def run(self) -> msgs.Summary:
         try:
             self.barrier()
-            # Everything built so far lives for the whole match: keep it out of
-            # the collector's way (the tick loop allocates only short-lived,
-            # acyclic objects that reference counting frees).
-            gc.collect()
-            gc.freeze()
-            gc.set_threshold(50_000, 50, 100)
+            settle_heap()
             t0 = time.perf_counter()
             self.loop()
             self._wall_s = time.perf_counter() - t0
         finally:
             self.watchdog.stop()
+        return self.conclude()
+
+    def conclude(self) -> msgs.Summary:
+        """After the loop: the tap's final batch, then the Summary, published and returned."""
         if self.tap is not None:
             self.tap.close(self.last_tick)
             if self._tap_handoff is not None:

@@ -262,6 +262,7 @@ def finish(runner, fx, attempt: int, got: dict):
                 wall_seconds=round(got["wall"], 2),
                 rtf=m["rtf"],
                 digest=m["digest"],
+                engine=m.get("engine", "processes"),
                 **base,
             )
             write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))

@@ -1,49 +1,106 @@
-"""A whole match in one Python process over the in-memory transport.
+"""`arena match --engine inprocess`: a whole match in one process and one thread.
 
-Every process kind runs in its own thread with the very same `Node` code as
-in a real match, but the transport is `MemoryTransport`. This is for fast unit
-and determinism tests of process logic; it is never what `arena match` runs.
+The very same `Node` code as in a distributed match, driven cooperatively
+(runtime/coop.py): each node's lockstep generator is resumed when the link it
+waits on is ready, frames are the same msgpack bytes on an in-memory bus, and
+no node has a thread of its own. The per-process digests are those of the
+distributed run (tests/golden/digests.json pins 20 configurations; an
+integration test compares against real processes over zenoh).
+
+What differs from the distributed run is only what the machine does: one
+interpreter, no zenoh, no start barrier or liveliness (every node is there by
+construction), and per-node `cpu_s` is the wall time the single thread spent
+in that node's loop. A recorded match (`cfg.record`) runs the recorder node
+too: it drains the taps between rounds of the run queue and writes the same
+MCAP message records as the distributed recorder.
 """
 
 from __future__ import annotations
 
-import threading
+import gc
+import os
+import time
+
+import msgspec
 
 from arena.processes import node_class
 from arena.runtime.config import MatchConfig
-from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.runtime.coop import CoopBus, CoopTransport, NodeFailed, Task, drive
+from arena.runtime.node import settle_heap
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Summary
 
+ENGINE = "inprocess"
+LOCKSTEP_KINDS = {"engine", "referee", "basestation", "robot", "recorder"}  # what this engine can host
 
-def play_in_process(cfg: MatchConfig, watch: tuple[str, ...] = ("world",), timeout: float = 120.0):
-    """Play `cfg` in threads. Returns (summaries by process, {key name: [payload, ...]})."""
-    bus = MemoryBus()
+
+class InprocessError(RuntimeError):
+    """The match could not be played to the end; the message says why (one line)."""
+
+
+def _play(cfg: MatchConfig, watch: tuple[str, ...]):
+    bus = CoopBus()
     keys = Keys("inprocess")
     taps = {name: bus.subscribe(None, keys.key(name)) for name in watch}
+    nodes = {str(p): node_class(p.kind)(p, cfg, CoopTransport(bus), keys) for p in cfg.processes()}
+    recorder = nodes.pop("recorder", None)
+    settle_heap()
+    t0 = time.perf_counter()
+    tasks = [Task(name, node.lockstep()) for name, node in nodes.items()]
+    try:
+        deadlocks = drive(bus, tasks, on_idle=recorder.pump if recorder is not None else None)
+    except NodeFailed as exc:
+        if recorder is not None:
+            recorder.finish()
+        raise InprocessError(str(exc)) from exc.__cause__
+    play = time.perf_counter() - t0
+    for line in deadlocks:
+        nodes[tasks[0].name].log.error("%s", line)
     summaries: dict[str, Summary] = {}
-    errors: list[BaseException] = []
-
-    def run(pid) -> None:
-        try:
-            node = node_class(pid.kind)(pid, cfg, MemoryTransport(bus), keys)
-            summaries[str(pid)] = node.run()
-        except BaseException as exc:  # reported to the caller below
-            errors.append(exc)
-
-    threads = [threading.Thread(target=run, args=(p,), name=str(p), daemon=True) for p in cfg.processes()]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout)
-        if t.is_alive():
-            raise TimeoutError(f"{t.name} did not finish within {timeout:g} s")
-    if errors:
-        raise errors[0]
+    for task in tasks:
+        node = nodes[task.name]
+        node._wall_s = play
+        s = node.conclude()
+        summaries[task.name] = msgspec.structs.replace(s, cpu_s=[round(task.busy_s, 3), 0.0])
+    if recorder is not None:
+        recorder.finish()
+        summaries["recorder"] = recorder.conclude()
+    gc.unfreeze()  # a worker plays many matches: let this one's objects go
     frames = {}
     for name, ch in taps.items():
         got = []
         while (raw := ch.try_recv()) is not None:
             got.append(raw)
         frames[name] = got
+    return summaries, frames, play, deadlocks
+
+
+def play_in_process(cfg: MatchConfig, watch: tuple[str, ...] = ("world",), timeout: float = 120.0):  # noqa: ARG001
+    """Play `cfg` in this thread. Returns (summaries by process, {key name: [payload, ...]}).
+
+    `timeout` is kept for callers of the threaded driver this replaced: a
+    cooperative match cannot hang (a deadlock is detected, not waited out).
+    """
+    summaries, frames, _, _ = _play(cfg, watch)
     return summaries, frames
+
+
+def play_match(cfg: MatchConfig) -> dict:
+    """Play one match in-process and return the result dict of `arena match --json`."""
+    from arena.tools.launcher import Collected, assemble
+
+    if cfg.realtime:
+        raise InprocessError("--engine inprocess plays in lockstep only (no --realtime)")
+    if cfg.external:
+        raise InprocessError("--engine inprocess has no external processes (--external needs --engine processes)")
+    others = sorted({p.kind for p in cfg.processes()} - LOCKSTEP_KINDS)
+    if others:
+        raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
+    t_start = time.monotonic()
+    summaries, _, play, deadlocks = _play(cfg, watch=())
+    got = Collected(summaries=summaries, started=0.0, ended=play)
+    result = assemble(cfg, got, time.monotonic() - t_start, [])
+    result["engine"] = ENGINE
+    result["pid"] = os.getpid()
+    result["deadlocks"] = deadlocks
+    return result

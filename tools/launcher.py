@@ -511,6 +511,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "half_time": cfg.half_time,
         "link": cfg.link,
         "realtime": cfg.realtime,
+        "engine": "processes",  # tools/inprocess.py says "inprocess"
         "ticks": ticks,
         "sim_seconds": round(sim_seconds, 3),
         "wall_seconds": round(wall_total, 3),

@@ -11,7 +11,7 @@ def print_match(result: dict, console: Console | None = None) -> None:
     a, b = result["score"]
     console.print(
         f"[bold]{result['home']}[/] (a) [bold]{a} : {b}[/] [bold]{result['away']}[/] (b)   "
-        f"seed {result['seed']}, link {result['link']}"
+        f"seed {result['seed']}, link {result['link']}, engine {result.get('engine', 'processes')}"
     )
     console.print(
         f"{result['sim_seconds']:.1f} s simulated in {result['play_wall_seconds']:.2f} s "

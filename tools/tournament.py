@@ -87,6 +87,7 @@ class Result:
     wall_seconds: float = 0.0
     rtf: float = 0.0
     digest: str = ""
+    engine: str = "processes"  # which engine played it (arena match --engine)
 
     def goals(self, team: str) -> tuple[int, int]:
         """(for, against) for `team` in this match."""
@@ -312,8 +313,16 @@ def charts(out: Path, table: list[dict], cover: dict[str, dict]) -> list[Path]:
     return written
 
 
-def report(results: list[Result], strategies: list[str], legs: int, out: Path, wall: float, seed: int) -> dict:
-    """Write every table and chart to `out`; return the JSON summary."""
+def report(
+    results: list[Result],
+    strategies: list[str],
+    legs: int,
+    out: Path,
+    wall: float,
+    seed: int,
+    engine: str = "processes",
+) -> dict:
+    """Write every table and chart to `out`; return the JSON summary. `engine`: which one played."""
     done = [r for r in results if r.status == "ok"]
     table = standings(results, strategies)
     cover = coverage(results, strategies)
@@ -337,7 +346,8 @@ def report(results: list[Result], strategies: list[str], legs: int, out: Path, w
     md = [
         f"# Tournament: {', '.join(short(s) for s in strategies)}, {legs} legs, seed {seed}",
         "",
-        f"{len(done)} of {len(results)} matches played ({len(failed)} failed), {wall:.0f} s of wall time.",
+        f"{len(done)} of {len(results)} matches played ({len(failed)} failed), {wall:.0f} s of wall time, "
+        f"engine {engine} (arena tournament --engine).",
         "",
         "## Table 1: scores per pairing and leg (first-named team's goals first)",
         "",
@@ -372,6 +382,7 @@ def report(results: list[Result], strategies: list[str], legs: int, out: Path, w
         "matches": [asdict(r) for r in results],
         "failed": failed,
         "wall_seconds": round(wall, 2),
+        "engine": engine,
         "out": str(out),
     }
     write_atomic(out / "tournament.json", json.dumps(summary, indent=2))
@@ -391,6 +402,81 @@ class Runner:
         self._lock = threading.Lock()
         self._running: set[subprocess.Popen] = set()
         self.stopping = False
+        self.engine = getattr(args, "engine", "processes")
+        # --engine inprocess: one worker process per job, each playing whole
+        # matches in one thread, one after another; it imports once, not per match.
+        self.pool = None
+        if self.engine == "inprocess":
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            self.pool = ProcessPoolExecutor(
+                max_workers=args.jobs or default_jobs(),
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_worker_init,
+            )
+
+    def match_config(self, fx: Fixture):
+        from arena.runtime.config import MatchConfig
+        from arena.runtime.links import parse_override
+
+        overrides: dict[str, dict[str, float]] = {}
+        for text in self.args.link_param:
+            cls, param, value = parse_override(text)
+            overrides.setdefault(cls, {})[param] = value
+        cfg = MatchConfig(
+            seed=fx.seed,
+            home=fx.home,
+            away=fx.away,
+            robots=self.args.robots,
+            half_time=self.args.half_time,
+            link=self.args.link,
+            link_overrides=overrides,
+        )
+        cfg.validate()
+        return cfg
+
+    def play_inprocess(self, fx: Fixture) -> Result | None:
+        """`play` on a worker process of the pool (--engine inprocess)."""
+        base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
+        reason = ""
+        for attempt in (1, 2):
+            if self.stopping:
+                return None
+            t0 = time.monotonic()
+            try:
+                m = self.pool.submit(_play_inprocess, self.match_config(fx)).result()
+            except Exception as exc:  # a failed match is recorded, never fatal to the tournament
+                if self.stopping:
+                    return None
+                reason = f"{type(exc).__name__}: {exc}".splitlines()[0]
+                (self.logs_dir / f"{fx.id}.log").write_text(reason + "\n")
+                continue
+            r = Result(
+                id=fx.id,
+                status="ok",
+                score=m["score"],
+                distance_m=m["distance_m"],
+                attempts=attempt,
+                wall_seconds=round(time.monotonic() - t0, 2),
+                rtf=m["rtf"],
+                digest=m["digest"],
+                engine=self.engine,
+                **base,
+            )
+            write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+            return r
+        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, engine=self.engine, **base)
+        write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
+        return r
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(wait=not self.stopping, cancel_futures=True)
+            if self.stopping:
+                for p in list(getattr(self.pool, "_processes", {}).values()):
+                    if p.is_alive():
+                        p.kill()
 
     def command(self, fx: Fixture) -> list[str]:
         a = self.args
@@ -411,6 +497,8 @@ class Runner:
             str(fx.seed),
             "--link",
             a.link,
+            "--engine",
+            self.engine,
             "--json",
         ]
         for p in a.link_param:
@@ -419,6 +507,8 @@ class Runner:
 
     def play(self, fx: Fixture) -> Result | None:
         """Play one fixture (one retry on failure). None if stopped by Ctrl-C."""
+        if self.pool is not None:
+            return self.play_inprocess(fx)
         base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
         reason = ""
         timeout = 120.0 + 2.0 * self.args.half_time  # generous: rtf >= 1 plus start-up
@@ -459,18 +549,21 @@ class Runner:
                     wall_seconds=round(time.monotonic() - t0, 2),
                     rtf=m["rtf"],
                     digest=m["digest"],
+                    engine=self.engine,
                     **base,
                 )
                 write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
                 return r
             tail = (self.logs_dir / f"{fx.id}.log").read_text(errors="replace").strip().splitlines()
             reason = reason or (tail[-1] if tail else f"exit code {proc.returncode}")
-        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, **base)
+        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, engine=self.engine, **base)
         write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
         return r
 
     def stop(self) -> None:
         self.stopping = True
+        if self.pool is not None:
+            self.close()
         with self._lock:
             running = list(self._running)
         for p in running:
@@ -480,6 +573,25 @@ class Runner:
 
 def _interrupt(signum, frame) -> None:  # noqa: ARG001
     raise KeyboardInterrupt
+
+
+def _worker_init() -> None:
+    """An --engine inprocess worker: dies with the tournament, leaves Ctrl-C to it, imports once."""
+    import ctypes
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except OSError:
+        pass
+    import arena.processes.engine  # noqa: F401 - the heavy imports (pymunk, numpy), once per worker
+    import arena.tools.inprocess  # noqa: F401
+
+
+def _play_inprocess(cfg) -> dict:
+    from arena.tools.inprocess import play_match
+
+    return play_match(cfg)
 
 
 def default_jobs() -> int:
@@ -568,8 +680,9 @@ def run(args) -> tuple[dict, bool]:
         finally:
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
+    runner.close()
     ordered = [results[fx.id] for fx in fixtures if fx.id in results]
-    summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed)
+    summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed, engine=runner.engine)
     summary["skipped"] = len(fixtures) - len(todo)
     summary["interrupted"] = interrupted
     return summary, interrupted
@@ -599,4 +712,7 @@ def print_summary(summary: dict) -> None:
         c.print(f"[yellow]note:[/] {note}")
     for f in summary["failed"]:
         c.print(f"[red]failed:[/] {f['id']}: {f['reason']}")
-    c.print(f"tables, charts and per-match results in {summary['out']} ({summary['wall_seconds']:.0f} s)")
+    c.print(
+        f"tables, charts and per-match results in {summary['out']} "
+        f"({summary['wall_seconds']:.0f} s, engine {summary.get('engine', 'processes')})"
+    )

@@ -1,0 +1,178 @@
+"""Cooperative lockstep: every node of a match in ONE thread, no locks.
+
+Each node's lockstep loop is a generator that yields `(inbound, k)` where it
+needs that link's frames due at tick k (runtime/lockstep.py). `drive` resumes
+each generator as long as the link it waits on is `ready(k)`, and parks it
+otherwise; a frame put on the channel a parked node waits on makes that node
+runnable again. Frames are the very msgpack bytes a real match sends, on the
+in-memory bus (`CoopBus`, a `MemoryBus` without locks whose channels know who
+waits on them), and they are accepted by the same `Inbound` code in the same
+order, so every process's digest is the one of the distributed run.
+
+Nothing blocks, so nothing needs a watchdog thread: when no node is runnable
+and some have not finished, every unfinished node waits on another one, a
+deadlock. Where the distributed run's watchdog would give up on a silent link
+after `wait_timeout` of wall time, `drive` gives up on the links the parked
+nodes wait on at once, with a logged reason; their senders are then recorded
+in `dead` as in the distributed run, and the match goes on.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from arena.runtime.lockstep import Inbound, Waits
+from arena.runtime.transport import MemoryBus, MemoryTransport
+
+
+class WouldBlock(RuntimeError):
+    """A node tried to block in `recv` on the cooperative bus (only `drive` may wait)."""
+
+
+class CoopChannel:
+    """A subscription: a deque, and the parked task (if any) to wake on the next frame."""
+
+    __slots__ = ("_q", "waiter", "_wake")
+
+    def __init__(self, wake: Callable[[Task], None]):
+        self._q: deque[bytes] = deque()
+        self.waiter: Task | None = None
+        self._wake = wake
+
+    def put(self, payload: bytes) -> None:
+        self._q.append(payload)
+        w = self.waiter
+        if w is not None:
+            self.waiter = None
+            self._wake(w)
+
+    def try_recv(self) -> bytes | None:
+        q = self._q
+        return q.popleft() if q else None
+
+    def recv(self) -> bytes:
+        if self._q:
+            return self._q.popleft()
+        raise WouldBlock("recv on an empty channel in a cooperative match (lockstep only; no --realtime)")
+
+
+class CoopBus(MemoryBus):
+    """The in-memory bus of one cooperative match: no locks, delivery targets cached per key."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.runnable: deque[Task] = deque()
+        self._targets: dict[str, list[tuple[object, CoopChannel]]] = {}
+
+    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+        targets = self._targets.get(key)
+        if targets is None:
+            targets = self._targets[key] = [
+                (owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs
+            ]
+        for owner, ch in targets:
+            if only is None or owner is only:
+                ch.put(payload)
+
+    def subscribe(self, owner: object, key: str) -> CoopChannel:  # type: ignore[override]
+        ch = CoopChannel(self.runnable.append)
+        self._subs[key].append((owner, ch))  # type: ignore[arg-type]
+        self._targets.clear()
+        return ch
+
+
+class CoopTransport(MemoryTransport):
+    """A `MemoryTransport` on a `CoopBus`: `Node` starts no watchdog thread for it."""
+
+    cooperative = True
+
+
+class Task:
+    """One node's lockstep loop as the driver sees it."""
+
+    __slots__ = ("name", "steps", "waiting", "done", "busy_s", "resumes")
+
+    def __init__(self, name: str, steps: Waits):
+        self.name = name
+        self.steps = steps
+        self.waiting: tuple[Inbound[Any], int] | None = None
+        self.done = False
+        self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
+        self.resumes = 0
+
+
+class NodeFailed(RuntimeError):
+    """A node's loop raised; the message names the node."""
+
+    def __init__(self, name: str, exc: BaseException):
+        super().__init__(f"{name} failed: {type(exc).__name__}: {exc}")
+        self.name = name
+
+
+def _advance(task: Task) -> None:
+    """Run `task` until it waits on a link that is not ready, or ends."""
+    w = task.waiting
+    steps = task.steps
+    while True:
+        if w is not None:
+            ib, k = w
+            if not ib.ready(k):
+                ch = ib._channel
+                while (raw := ch.try_recv()) is not None:
+                    ib._accept(raw, None)
+                if not ib.ready(k):
+                    task.waiting = w
+                    ch.waiter = task  # type: ignore[union-attr]
+                    return
+        try:
+            w = next(steps)
+        except StopIteration:
+            task.waiting = None
+            task.done = True
+            return
+
+
+def drive(bus: CoopBus, tasks: list[Task], on_idle: Callable[[], None] | None = None) -> list[str]:
+    """Run every task to its end; returns the deadlocks met (one line each), usually none.
+
+    `on_idle` is called whenever the run queue has gone round once (the
+    recorder drains its taps there). A task that raises ends the match:
+    `NodeFailed` names it.
+    """
+    runnable = bus.runnable
+    runnable.extend(tasks)
+    deadlocks: list[str] = []
+    clock = time.perf_counter
+    while True:
+        n = len(runnable)
+        for _ in range(n):
+            task = runnable.popleft()
+            if task.done:
+                continue
+            t0 = clock()
+            try:
+                _advance(task)
+            except Exception as exc:
+                raise NodeFailed(task.name, exc) from exc
+            task.busy_s += clock() - t0
+            task.resumes += 1
+        if on_idle is not None:
+            on_idle()
+        if runnable:
+            continue
+        parked = [t for t in tasks if not t.done]
+        if not parked:
+            return deadlocks
+        # Every unfinished node waits for another: what the watchdog would end
+        # after `wait_timeout` in a distributed match, ended at once here.
+        waits = ", ".join(f"{t.name} on {t.waiting[0].key} (tick {t.waiting[1]})" for t in parked if t.waiting)
+        deadlocks.append(f"deadlock: every unfinished node waits: {waits}")
+        for t in parked:
+            if t.waiting is not None:
+                ib, k = t.waiting
+                ib._channel.waiter = None  # type: ignore[union-attr]
+                ib._give_up(f"deadlock: nobody can send tick {k} (cooperative driver)")
+            runnable.append(t)

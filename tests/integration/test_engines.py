@@ -1,0 +1,56 @@
+"""`--engine inprocess` against `--engine processes`: the same digests, the same recording.
+
+A sample of what the acceptance compares in full (the 60-match tournament):
+several seeds on two link presets, through `arena tournament` with each
+engine, and one recorded match whose MCAP message records must be equal.
+Short half-times keep it to seconds.
+"""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+
+from tests.integration.helpers import ARENA, arena_json
+from tests.unit.test_recording import records_in_file_order
+
+SAMPLE = ("tournament", "--strategies", "AD,BS,chase", "--legs", "1", "--half-time", "2", "--seed", "11")
+
+
+@pytest.mark.parametrize("link", ["ideal", "congested-wifi"])
+def test_both_engines_give_the_same_digests_in_a_tournament(tmp_path, link):
+    runs = {}
+    for engine in ("processes", "inprocess"):
+        out = tmp_path / engine
+        runs[engine] = arena_json(*SAMPLE, "--link", link, "--engine", engine, "--out", str(out))
+        assert runs[engine]["engine"] == engine
+        assert {m["engine"] for m in runs[engine]["matches"]} == {engine}
+    a, b = ({m["id"]: (m["status"], m["digest"], m["score"]) for m in runs[e]["matches"]} for e in runs)
+    assert len(a) == 3 and len({d for _, d, _ in a.values()}) == 3, "three different matches"
+    assert a == b
+    assert runs["processes"]["table"] == runs["inprocess"]["table"]
+
+
+def test_a_recorded_inprocess_match_has_the_same_records_and_digests(tmp_path):
+    base = ("match", "--home", "AD", "--away", "BS", "--half-time", "3", "--seed", "6", "--link", "wifi")
+    rec = {e: tmp_path / f"{e}.mcap" for e in ("processes", "inprocess")}
+    got = {e: arena_json(*base, "--engine", e, "--record", str(rec[e])) for e in rec}
+    assert got["inprocess"]["engine"] == "inprocess"
+    assert got["processes"]["process_digests"] == got["inprocess"]["process_digests"]
+    assert got["processes"]["recording"]["messages"] == got["inprocess"]["recording"]["messages"]
+    assert got["inprocess"]["recording"]["complete"] is True
+    records = {e: records_in_file_order(rec[e]) for e in rec}
+    assert len(records["processes"]) > 1000
+    assert records["processes"] == records["inprocess"]
+
+
+@pytest.mark.parametrize(
+    ("flag", "value"),
+    [("--realtime", None), ("--external", "a/1"), ("--listen", "tcp/127.0.0.1:0"), ("--logs", "/tmp")],
+)
+def test_inprocess_refuses_what_needs_processes_in_one_line(flag, value):
+    args = ["match", "--home", "BS", "--away", "BS", "--engine", "inprocess", flag] + ([value] if value else [])
+    r = subprocess.run([*ARENA, *args], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "needs --engine processes" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
