@@ -74,6 +74,10 @@ EXAMPLES = {
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
   arena replay match.mcap --process basestation/b --json
   arena replay match.mcap --process all                # every process of the match""",
+    "strategies": """examples:
+  arena strategies                 # every strategy, built-in or plugin, and whether it passes the conformance suite
+  arena strategies AD my-plugin    # only these
+  arena strategies --no-check --json""",
     "schemas": """examples:
   arena schemas --check            # is schemas/README.md up to date with schemas/messages.py?
   arena schemas --write""",
@@ -352,6 +356,11 @@ def build_parser() -> Parser:
         help="robot/a/1 (or a/1), basestation/b, engine, referee, or all (repeatable)",
     )
     y.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    st = add("strategies", "list the strategies: built-ins and installed plugins, with their conformance status")
+    st.add_argument("names", nargs="*", metavar="NAME", help="only these strategies (names or aliases)")
+    st.add_argument("--no-check", action="store_true", help="skip the conformance suite (~1.5 s per strategy)")
+    st.add_argument("--json", action="store_true", help="print one JSON object")
 
     s = add("schemas", "the wire contract: check or rewrite schemas/README.md from schemas/messages.py")
     g = s.add_mutually_exclusive_group()
@@ -666,6 +675,27 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return replay.main(args.file, args.process, as_json=args.json)
 
 
+def cmd_strategies(args: argparse.Namespace) -> int:
+    from arena.strategies import registry
+
+    wanted = {registry.resolve_name(n) for n in args.names}
+    rows = [r for r in registry.describe(check=not args.no_check, only=wanted or None)]
+    if args.json:
+        print(json.dumps({"strategies": rows}, indent=2))
+        return 0
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    t = Table(title="strategies (arena match --home NAME --away ALIAS)")
+    for col in ("name", "alias", "from", "conformance"):
+        t.add_column(col)
+    for r in rows:
+        t.add_row(r["name"], "/".join(r["aliases"]) or "-", escape(r["source"]), escape(r["conformance"]))
+    Console().print(t)
+    return 0 if not any(r["conformance"].startswith("fails") for r in rows) else 1
+
+
 def cmd_schemas(args: argparse.Namespace) -> int:
     from arena.schemas import contract
 
@@ -681,6 +711,7 @@ def main(argv: list[str] | None = None) -> int:
         "up": cmd_up,
         "bench": cmd_bench,
         "schemas": cmd_schemas,
+        "strategies": cmd_strategies,
         "tournament": cmd_tournament,
         "review": cmd_review,
         "facts": cmd_facts,
@@ -694,9 +725,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"arena {args.command}: interrupted; every process of the match was stopped", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # `arena ... | head`: the reader left; nothing to say
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except OSError as exc:  # a file or directory the user named: missing, read-only, full disk
-        where = f" {exc.filename}" if exc.filename else ""
-        print(f"arena {args.command}: error:{where}: {exc.strerror or exc}", file=sys.stderr)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"arena {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, the details in a log
         return internal_error(args.command, exc)

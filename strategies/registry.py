@@ -47,6 +47,40 @@ def all_strategies() -> dict[str, Strategy]:
     return found
 
 
+def describe(check: bool = True, only: set[str] | None = None) -> list[dict]:
+    """One row per strategy: name, aliases, where it comes from, conformance (`arena strategies`).
+
+    `source` is the module of a built-in, or the plugin's distribution and
+    entry point; `conformance` is "passes", "fails: <the first failed check>"
+    or "not checked".
+    """
+    from importlib.metadata import entry_points
+
+    plugins = {}
+    for ep in entry_points(group=GROUP):
+        dist = ep.dist.name if ep.dist is not None else "?"
+        plugins[ep.name] = f"plugin {dist} ({ep.value})"
+    rows = []
+    for name, s in all_strategies().items():
+        if only is not None and name not in only:
+            continue
+        if name in builtin_strategies():
+            source = f"built-in {s.make_team.__module__}"
+        else:
+            source = next((v for k, v in plugins.items() if k == name or k in s.aliases), "plugin")
+        status = "not checked"
+        if check:
+            from arena.strategies import conformance
+
+            try:
+                conformance.check_all(s)
+                status = "passes"
+            except AssertionError as exc:
+                status = f"fails: {(str(exc).splitlines() or ['?'])[0]}"
+        rows.append({"name": name, "aliases": list(s.aliases), "source": source, "conformance": status})
+    return rows
+
+
 def _find(table: dict[str, Strategy], wanted: str) -> str | None:
     for s in table.values():
         if wanted == s.name.lower() or wanted in (a.lower() for a in s.aliases):

@@ -14,6 +14,7 @@ import tempfile
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from arena.runtime.config import MatchConfig
@@ -53,7 +54,7 @@ def bench_match(args: argparse.Namespace) -> int:
     }
     rows = [
         ("real-time factor (sim s / wall s)", f"{rtf:.1f}x"),
-        ("ms per tick (all 10 processes)", f"{ms_tick:.3f}"),
+        ("wall time per tick, all processes [ms]", f"{ms_tick:.3f}"),
         ("ticks per second", f"{1000.0 / ms_tick:.0f}"),
         ("process start-up [s]", f"{startup:.2f}"),
     ]
@@ -70,7 +71,7 @@ def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: b
     t.add_column("metric")
     t.add_column("value", justify="right")
     for name, value in rows:
-        t.add_row(name, value)
+        t.add_row(escape(name), value)  # "[s]" is a unit, not rich markup
     Console().print(t)
     return 0
 
@@ -182,7 +183,7 @@ def bench_robot(args: argparse.Namespace) -> int:
     t = Table(title=f"arena bench robot: {args.strategy}, medians of 200 batches of 50 steps")
     t.add_column("metric")
     t.add_column("value", justify="right")
-    t.add_row("robot control step (perception, behaviour, navigation) [us]", f"{out['robot_step_us']:.1f}")
-    t.add_row("F-SFM step, 5 obstacles [us]", f"{out['fsfm_step_us']:.1f}")
+    t.add_row(r"robot control step (perception, behaviour, navigation) \[us]", f"{out['robot_step_us']:.1f}")
+    t.add_row(r"F-SFM step, 5 obstacles \[us]", f"{out['fsfm_step_us']:.1f}")
     Console().print(t)
     return 0

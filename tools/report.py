@@ -22,7 +22,7 @@ def print_match(result: dict, console: Console | None = None) -> None:
         dt = result["sim_seconds"] / max(1, result["ticks"])
         console.print("goals: " + ", ".join(f"{e['team']} {e['tick'] * dt:.1f}s" for e in goals))
     t = Table(title="links", show_header=True)
-    for col in ("class", "sent", "dropped", "drop %", "delay mean ms", "delay p95 ms"):
+    for col in ("class", "sent", "dropped", r"dropped \[%]", r"delay mean \[ms]", r"delay p95 \[ms]"):
         t.add_column(col, justify="right")
     for cls, s in sorted(result["links"].items()):
         t.add_row(
@@ -34,9 +34,9 @@ def print_match(result: dict, console: Console | None = None) -> None:
             f"{s['delay_ms_p95']:.2f}",
         )
     console.print(t)
-    d = Table(title="distance per robot [m]")
+    d = Table(title=r"distance per robot \[m]")
     d.add_column("robot")
-    d.add_column("m", justify="right")
+    d.add_column(r"\[m]", justify="right")
     for name, m in result["distance_m"].items():
         d.add_row(name, f"{m:.1f}")
     console.print(d)

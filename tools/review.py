@@ -69,14 +69,14 @@ def print_review(r: dict, console: Console | None = None) -> None:
         )
     d = Table(title="distance per robot", caption=f"from the {r['distance_source']}")
     d.add_column("robot")
-    d.add_column("[m]", justify="right")
+    d.add_column(r"\[m]", justify="right")
     for name, m in r["distance_m"].items():
         d.add_row(name, f"{m:.1f}")
     console.print(d)
     links = r["links"]["by_class"]
     if links:
         t = Table(title="links (applied by the receivers)")
-        for col in ("class", "frames", "dropped", "drop %", "delay p50 ms", "p95 ms", "p99 ms"):
+        for col in ("class", "frames", "dropped", r"dropped \[%]", r"delay p50 \[ms]", r"p95 \[ms]", r"p99 \[ms]"):
             t.add_column(col, justify="right")
         for cls, s in links.items():
             dm = s["delay_ms"]
@@ -94,7 +94,7 @@ def print_review(r: dict, console: Console | None = None) -> None:
         console.print("[yellow]links: no process summaries in the file[/]")
     if r["timing"]:
         t = Table(title="per-process tick timing (own work)")
-        for col in ("process", "median us", "p95 us", "wall s", "cpu s"):
+        for col in ("process", r"median \[us]", r"p95 \[us]", r"wall \[s]", r"CPU \[s]"):
             t.add_column(col, justify="right")
         for name, s in r["timing"].items():
             t.add_row(

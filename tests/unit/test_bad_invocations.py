@@ -88,6 +88,9 @@ BAD = [
     (["replay", "/nonexistent.mcap", "--process", "a/1"], "cannot read"),
     (["replay", "{file}", "--process", "a/1"], "not an MCAP file"),
     (["replay", "/nonexistent.mcap"], "required: --process"),
+    # arena strategies
+    (["strategies", "tiki-taka"], "unknown strategy 'tiki-taka'"),
+    (["strategies", "--check"], "unrecognized arguments: --check"),
     # arena schemas, and the top level
     (["schemas", "--check", "--write"], "not allowed with argument"),
     (["frobnicate"], "invalid choice"),

@@ -10,6 +10,7 @@ from arena.tools.navbench.spec import FSFM_BUDGET_US, METHODS, PAPER_FIS_OVERHEA
 
 def print_report(r: Report, console: Any = None) -> None:
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
 
     if console is None:
@@ -31,7 +32,7 @@ def print_report(r: Report, console: Any = None) -> None:
             ("paper", "right"),
             ("safe %", "right"),
             ("paper %", "right"),
-            ("step us", "right"),
+            (r"step \[us]", "right"),
         ]:
             t.add_column(col, justify=just)
         for row in (x for x in rows if x["scenario"] == sc.name):
@@ -75,8 +76,8 @@ def print_report(r: Report, console: Any = None) -> None:
     tm = timing(r)
     t = Table(title="compute time per iteration (medians over every iteration of every trial)", title_justify="left")
     t.add_column("method")
-    t.add_column("navigator step [us]", justify="right")
-    t.add_column("whole iteration [us]", justify="right")
+    t.add_column(r"navigator step \[us]", justify="right")
+    t.add_column(r"whole iteration \[us]", justify="right")
     for m in METHODS:
         if m in tm["step_us_median"]:
             t.add_row(m, _fmt(tm["step_us_median"][m], "{:.2f}"), _fmt(tm["iteration_us_median"][m], "{:.1f}"))
@@ -108,7 +109,7 @@ def print_report(r: Report, console: Any = None) -> None:
             "final dist to goal [m]",
             "contacts",
         ):
-            t.add_column(col, justify="left" if col in ("env", "method") else "right")
+            t.add_column(escape(col), justify="left" if col in ("env", "method") else "right")
         for row in minima_rows(r):
             t.add_row(
                 row["env"],

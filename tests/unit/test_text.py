@@ -1,0 +1,63 @@
+"""Issue 19 part 6: units that rich does not swallow, `arena --version`, `arena strategies`."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from rich.console import Console
+
+from arena.tools import report
+
+
+def arena(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "arena", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_units_in_table_headers_survive_rich():
+    console = Console(record=True, width=120)
+    result = {
+        "home": "basic-static",
+        "away": "chase",
+        "score": [1, 0],
+        "seed": 7,
+        "link": "wifi",
+        "sim_seconds": 2.0,
+        "play_wall_seconds": 1.0,
+        "rtf": 2.0,
+        "wall_seconds": 1.5,
+        "digest": "0" * 32,
+        "ticks": 100,
+        "links": {"wifi": {"sent": 10, "dropped": 1, "drop_rate": 0.1, "delay_ms_mean": 3.0, "delay_ms_p95": 5.0}},
+        "distance_m": {"a/1": 12.5},
+        "events": {},
+        "rejected": 0,
+        "dead": [],
+    }
+    report.print_match(result, console)
+    text = console.export_text()
+    assert "robot [m]" in text and "┃  [m] ┃" in text, text  # the title and the unit column
+    assert "delay mean [ms]" in text and "dropped [%]" in text
+
+
+def test_version_matches_the_package():
+    from importlib.metadata import version
+
+    r = arena("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"arena {version('soccer-arena')}"
+
+
+def test_strategies_lists_name_alias_source_and_conformance():
+    r = arena("strategies", "chase", "BS", "--json")
+    assert r.returncode == 0, r.stderr
+    rows = {row["name"]: row for row in json.loads(r.stdout)["strategies"]}
+    assert set(rows) == {"chase", "basic-static"}
+    assert rows["basic-static"]["aliases"] == ["BS"]
+    assert rows["basic-static"]["source"] == "built-in arena.strategies.iris"
+    assert rows["chase"]["conformance"] == "passes"
+    listed = json.loads(arena("strategies", "--no-check", "--json").stdout)["strategies"]
+    assert {"basic-static", "basic-dynamic", "advance-static", "advance-dynamic", "chase"} <= {
+        x["name"] for x in listed
+    }
+    assert all(x["conformance"] == "not checked" for x in listed)
