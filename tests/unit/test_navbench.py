@@ -147,7 +147,7 @@ def test_the_cli_reports_a_missing_file_in_one_line_with_exit_2():
     ("args", "needle"),
     [
         (["--scenarios", "BROKEN"], "not valid TOML"),
-        (["--trials", "0"], "--trials must be at least 1"),
+        (["--trials", "0"], "--trials: '0': give 1 or more"),
         (["--only", "penalty"], "--only penalty: no such scenario"),
         (["--plots", "FILE"], "exists and is not a directory"),
     ],
