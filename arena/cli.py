@@ -704,7 +704,10 @@ def cmd_schemas(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a bad flag (already said in one line)
+        return exc.code if isinstance(exc.code, int) else 2
     handlers = {
         "match": cmd_match,
         "run": cmd_run,
