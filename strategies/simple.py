@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 
+from arena.navigation.frames import wrap_angle
 from arena.rules import setpieces
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
@@ -65,10 +66,6 @@ CHIP_MIN, CHIP_MAX = 3.0, 5.0  # [m] flight to the goal line for a chip over the
 CHIP_CLEAR = 1.0  # [m] a chip is still too low to pass over a robot this close ahead
 CHIP_MARGIN = 0.3  # [m] a chip must cross the goal line this far inside the posts
 GRAVITY = 9.81  # [m/s^2]
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 class SimpleTeam:
@@ -186,7 +183,7 @@ class SimpleRobot:
         tx = own_x - math.copysign(0.35, own_x)
         face = math.atan2(by - p.y, bx - p.x)
         near = math.hypot(bx - p.x, by - p.y) < 0.45
-        shot = KICK_SPEED if kick and near and abs(_wrap(face - p.theta)) < 0.5 else 0.0
+        shot = KICK_SPEED if kick and near and abs(wrap_angle(face - p.theta)) < 0.5 else 0.0
         return self._goto(tick, p, tx, ty, face, CRUISE, dribbler=False, kick=shot)
 
     def _play(self, tick: int, sense: Sense, order: Order) -> Cmd:
@@ -215,7 +212,7 @@ class SimpleRobot:
         aim = math.atan2(aim_y - p.y, goal_x - p.x)  # robot -> aim point
         to_goal = math.atan2(aim_y - by, goal_x - bx)
         if self._carried(p) > DRIBBLE_MAX:  # shoot rather than foul; release if facing away from the goal
-            goalward = abs(_wrap(aim - p.theta)) < FORCED_SHOT_ANGLE
+            goalward = abs(wrap_angle(aim - p.theta)) < FORCED_SHOT_ANGLE
             return Cmd(tick=tick, dribbler=goalward, kick_speed=KICK_SPEED if goalward else 0.0)
         seen = sense.robots
         if sense.has_ball:
@@ -232,7 +229,7 @@ class SimpleRobot:
         behind_x = bx - BEHIND * ux - side * uy
         behind_y = by - BEHIND * uy + side * ux
         dx, dy = behind_x - p.x, behind_y - p.y
-        if dx * dx + dy * dy < 0.2**2 and abs(_wrap(to_goal - p.theta)) < 0.4:
+        if dx * dx + dy * dy < 0.2**2 and abs(wrap_angle(to_goal - p.theta)) < 0.4:
             return self._goto(tick, p, bx, by, to_goal, 1.5, dribbler=True, avoid=seen)
         return self._goto(tick, p, behind_x, behind_y, to_goal, CRUISE, dribbler=True, avoid=seen)
 
@@ -248,7 +245,7 @@ class SimpleRobot:
 
     def _in_front(self, p: Pose, bx: float, by: float) -> bool:
         d = math.hypot(bx - p.x, by - p.y)
-        return d < self.hold + 0.08 and abs(_wrap(math.atan2(by - p.y, bx - p.x) - p.theta)) < 0.3
+        return d < self.hold + 0.08 and abs(wrap_angle(math.atan2(by - p.y, bx - p.x) - p.theta)) < 0.3
 
     def _shot(self, sense: Sense, p: Pose, goal_x: float) -> tuple[float, bool] | None:
         """(kick speed [m/s], lob) for a shot along the current heading, or None.
@@ -331,7 +328,7 @@ class SimpleRobot:
         if v > vmax:
             vx, vy = vx * vmax / v, vy * vmax / v
         c, s = math.cos(p.theta), math.sin(p.theta)
-        omega = max(-2.5, min(2.5, K_HEAD * _wrap(heading - p.theta)))
+        omega = max(-2.5, min(2.5, K_HEAD * wrap_angle(heading - p.theta)))
         return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
 
 

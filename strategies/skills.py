@@ -31,6 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from arena.navigation.frames import wrap_angle
+
 Vec = tuple[float, float]
 
 
@@ -59,11 +61,6 @@ def dist(a: Vec, b: Vec) -> float:
 def angle_to(a: Vec, b: Vec) -> float:
     """Direction [rad] from a to b."""
     return math.atan2(b[1] - a[1], b[0] - a[0])
-
-
-def wrap(a: float) -> float:
-    """Angle wrapped to [-pi, pi) [rad]."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def clamp(x: float, lo: float, hi: float) -> float:
@@ -138,7 +135,7 @@ def best_aim(
         aim = (goal_x, y)
         room = min((segment_distance(r, ball, aim)[0] for r in near), default=math.inf)
         if heading is not None and room >= margin:
-            cost = turn_cost * abs(wrap(angle_to(ball, aim) - heading)) - min(room, 1.5)
+            cost = turn_cost * abs(wrap_angle(angle_to(ball, aim) - heading)) - min(room, 1.5)
             if best_room < margin or cost < best_turn:
                 best, best_room, best_turn = aim, room, cost
         elif room > best_room + 1e-9 and (heading is None or best_room < margin):
@@ -214,7 +211,7 @@ def circle_past(
     """
     b = angle_to(opponent, pos)  # bearing of us seen from the opponent
     g = angle_to(opponent, goal)
-    off = wrap(g - b)
+    off = wrap_angle(g - b)
     r = radius
     if dist(pos, opponent) > 1.5 * radius:
         # Still short of it: make for its side, facing the goal, and curve round it from there.
@@ -229,7 +226,7 @@ def circle_past(
     if rot == 0.0:
         rot = math.copysign(1.0, off) if abs(off) < 2.0 else -sidestep_side(pos, goal)
     a = b + rot * step
-    return (opponent[0] + r * math.cos(a), opponent[1] + r * math.sin(a)), wrap(b + rot * math.pi / 2.0), rot
+    return (opponent[0] + r * math.cos(a), opponent[1] + r * math.sin(a)), wrap_angle(b + rot * math.pi / 2.0), rot
 
 
 def passed(pos: Vec, opponent: Vec, goal: Vec) -> bool:

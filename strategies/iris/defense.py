@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from math import hypot
 
+from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import Vec
@@ -92,7 +93,7 @@ class DefenseMixin:
             if self.is_blocker(block, carrier, own):
                 # Within take_distance of the ball, take it, but only from the kick line: straight at the
                 # ball from goal-side; going round the ball to get behind it would open the line to our goal.
-                on_line = abs(S.wrap(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
+                on_line = abs(wrap_angle(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
                 if S.dist(pos, ball) < sp.take_distance and on_line:
                     return self.drive(
                         tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True, avoid=False

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from math import cos, hypot, sin
 
+from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import Vec
@@ -61,7 +62,9 @@ class HandlingMixin:
         bx, by = ball
         to_ball = math.atan2(by - y, bx - x)  # S.angle_to(pos, ball)
         d = hypot(x - bx, y - by)  # S.dist(pos, ball)
-        if d < self._near_ball and (S.lined_up(pos, ball, target, sp.capture_lane) or abs(S.wrap(to_ball - th)) < 0.35):
+        if d < self._near_ball and (
+            S.lined_up(pos, ball, target, sp.capture_lane) or abs(wrap_angle(to_ball - th)) < 0.35
+        ):
             return self.drive(tick, ball, to_ball, p.approach_speed, dribbler=True, avoid=False)
         a = math.atan2(target[1] - by, target[0] - bx)  # S.angle_to(ball, target) ...
         off = sp.behind_ball  # ... for S.behind_point(ball, target, behind_ball)
@@ -101,7 +104,7 @@ class HandlingMixin:
         spread = self.p.shot_spread * (2.0 if is_pass else 1.0)
         tol = S.clamp(math.atan2(spread, S.dist((x, y), aim)), self.p.min_aim_tolerance, self.p.aim_tolerance)
         # The kick leaves along the heading of the next tick, when the command applies.
-        kick = speed if abs(S.wrap(want - th - self.view.omega * self.cfg.timing.dt)) < tol else 0.0
+        kick = speed if abs(wrap_angle(want - th - self.view.omega * self.cfg.timing.dt)) < tol else 0.0
         if kick:
             self.mem.kicked_at = tick
             if is_pass:
@@ -149,6 +152,6 @@ class HandlingMixin:
         a = S.angle_to(pos, goal)
         near = min(opponents, key=lambda o: S.dist(o, pos), default=None)
         if near is not None and S.dist(near, pos) < 2.0:
-            off = S.wrap(S.angle_to(pos, near) - a)
+            off = wrap_angle(S.angle_to(pos, near) - a)
             a -= math.copysign(0.6, off) if abs(off) < 1.2 else 0.0
         return pos[0] + 2.0 * math.cos(a), pos[1] + 2.0 * math.sin(a)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import WALL_PIECES, Vec
@@ -39,7 +40,7 @@ class SetPieceMixin:
                     # Inside the 2 m circle: out of it first, away from the spot but turned (by up to
                     # `wall_exit_turn`) towards the target, so that it leaves on the way round to it.
                     a = S.angle_to(spot, (x, y)) if S.dist((x, y), spot) > 1e-6 else S.angle_to(spot, target)
-                    turn = S.wrap(S.angle_to(spot, target) - a)
+                    turn = wrap_angle(S.angle_to(spot, target) - a)
                     a += S.clamp(turn, -self.p.wall_exit_turn, self.p.wall_exit_turn)
                     target = (spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a))
                 return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise, extra_obstacles=(spot,))

@@ -9,6 +9,7 @@ import random
 
 import pytest
 
+from arena.navigation.frames import wrap_angle
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RobotSeen, Sense, TeamPose
 from arena.sim.physics import NO_CHALLENGE_S, Physics
@@ -36,7 +37,7 @@ def test_circle_past_goes_round_with_the_body_between_opponent_and_ball():
     pos = (1.3, 0.6)  # close behind it, on the right
     way, heading, rot = S.circle_past(pos, opp, goal, 1.0)
     before, after = S.angle_to(opp, pos), S.angle_to(opp, way)
-    assert S.wrap(after - before) * rot > 0.5  # the waypoint is further round the opponent
+    assert wrap_angle(after - before) * rot > 0.5  # the waypoint is further round the opponent
     assert S.dist(way, opp) == pytest.approx(1.0)
     ball = (pos[0] + REACH * math.cos(heading), pos[1] + REACH * math.sin(heading))
     assert S.dist(ball, opp) > CHALLENGE  # side-on: the held ball is out of the opponent's reach
