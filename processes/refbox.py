@@ -43,6 +43,8 @@ class RefboxNode(Node):
         self.server = BridgeServer(host, port, cfg.refbox, self.log)
         self.log.warning("refbox: listening on tcp/%s:%d", host, self.server.port)
         self.forwarded = 0
+        self._clock = (0, time.monotonic())  # real time: (tick, wall time) of the last referee frame
+        self._ws_tick = 0  # worldstate ticks never go back (the recorder writes in tick order)
 
     def barrier(self) -> None:
         want = self.cfg.refbox.wait
@@ -63,22 +65,40 @@ class RefboxNode(Node):
             for c in frame.commands:
                 self.server.broadcast(c.name, c.team)
                 self.forwarded += 1
-        for team, address, r in self.server.drain():
-            if r.doc is None:
-                self.rejections.reject(self.ws_out[team].key, f"worldstate-{r.reason}", r.detail)
-            else:
-                msg = Worldstate(tick=k, team=team, address=address, age_ms=float(r.doc["ageMs"]), json=r.raw)
-                self.ws_out[team].send(msg)
+        self._worldstates(k)
         if self.tap is not None:
             self.tap.advance(k)
         self.last_tick = k
         self.timed(t0)
 
+    def _worldstates(self, k: int) -> None:
+        for team, address, r, at in self.server.drain():
+            if r.doc is None:
+                self.rejections.reject(self.ws_out[team].key, f"worldstate-{r.reason}", r.detail)
+                continue
+            self._ws_tick = max(self._ws_tick, self.tick_at(at, k))
+            msg = Worldstate(tick=self._ws_tick, team=team, address=address, age_ms=float(r.doc["ageMs"]), json=r.raw)
+            self.ws_out[team].send(msg)
+
+    def finish(self) -> None:
+        """After the last command: close the connections, keep what the teams sent until then."""
+        self.server.close()
+        self._worldstates(self.last_tick)
+
+    def tick_at(self, wall: float, k: int) -> int:
+        """The match tick at wall time `wall`: in real time, counted on from the last
+        referee frame (bridge bookkeeping only, never simulation); in lockstep,
+        whose ticks have no wall time, the tick being forwarded."""
+        if not self.cfg.realtime:
+            return k
+        tick, since = self._clock
+        return max(0, min(k, tick + round((wall - since) / self.cfg.timing.dt)))
+
     def lockstep(self) -> Waits:
         for k in self.schedule.ticks(self.cfg.total_ticks):
             yield self.ref_in, k
             self.act(k)
-        self.server.close()
+        self.finish()
 
     def loop_realtime(self) -> None:
         last = self.cfg.total_ticks
@@ -87,11 +107,12 @@ class RefboxNode(Node):
                 r = self.ref_in.recv_clock()
                 if r is None:
                     return
+                self._clock = (min(r, last), time.monotonic())
                 self.act(min(r, last))
                 if r >= last:
                     return
         finally:
-            self.server.close()
+            self.finish()
 
     def summary_extra(self) -> dict[str, object]:
         s = self.server

@@ -221,9 +221,11 @@ class WorldstateReader:
     """Bytes from one base station in, one `WorldstateResult` per NUL-terminated message out.
 
     As the RefBox: a message longer than `MAX_UNTERMINATED` without its NUL is
-    discarded with a `not-terminated` error. Unlike the RefBox, the rest of
-    that message (up to its NUL) is discarded too instead of being parsed as a
-    message of its own, so one overlong message is one error, not two.
+    discarded with a `not-terminated` error. Unlike the RefBox, whose outcome
+    depends on how TCP cut the stream, an overlong message is always that one
+    error: the rest of it (up to its NUL) is discarded too instead of being
+    parsed as a message of its own, and a message whose NUL arrives past the
+    limit in the same read is `not-terminated` as well.
     """
 
     def __init__(self, limit: int = MAX_UNTERMINATED):
@@ -242,17 +244,23 @@ class WorldstateReader:
                 self._skipping = False
             else:
                 self._buf += data[start:end]
-                out.append(validate_worldstate(self._buf.decode("utf-8", errors="replace")))
+                if len(self._buf) > self.limit:  # its NUL came, but too late (in the same read)
+                    out.append(self._too_long())
+                else:
+                    out.append(validate_worldstate(self._buf.decode("utf-8", errors="replace")))
             self._buf.clear()
             start = end + 1
         if not self._skipping:
             self._buf += data[start:]
             if len(self._buf) > self.limit:
-                head = self._buf[:60].decode("utf-8", errors="replace")
-                out.append(WorldstateResult(head, reason="not-terminated", detail=f"no NUL within {self.limit} bytes"))
+                out.append(self._too_long())
                 self._buf.clear()
                 self._skipping = True
         return out
+
+    def _too_long(self) -> WorldstateResult:
+        head = self._buf[:60].decode("utf-8", errors="replace")
+        return WorldstateResult(head, reason="not-terminated", detail=f"no NUL within {self.limit} bytes")
 
 
 # -------------------------------------------------------------- team table

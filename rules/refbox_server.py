@@ -64,7 +64,7 @@ class BridgeServer:
         self.targets = {t: self._default_target(t) for t in TEAMS}
         self._outq: queue.SimpleQueue[tuple[str, str, int]] = queue.SimpleQueue()
         self._lock = threading.Lock()
-        self._results: list[tuple[str, str, rp.WorldstateResult]] = []
+        self._results: list[tuple[str, str, rp.WorldstateResult, float]] = []
         self._stop = False
         self.connected = threading.Event()  # set whenever a client is accepted
         self.counts: Counter[str] = Counter()  # connections, refused, commands sent, worldstates
@@ -78,8 +78,8 @@ class BridgeServer:
         self._outq.put((command, team if command in rp.TEAM_COMMANDS else "", robot_id))
         self._wake_w.send(b"x")
 
-    def drain(self) -> list[tuple[str, str, rp.WorldstateResult]]:
-        """(team, address, result) of every message read since the last call."""
+    def drain(self) -> list[tuple[str, str, rp.WorldstateResult, float]]:
+        """(team, address, result, time.monotonic() when read) of every message read since the last call."""
         with self._lock:
             out, self._results = self._results, []
         return out
@@ -237,6 +237,10 @@ class BridgeServer:
         if not data:
             self._drop(client, "closed the connection")
             return
+        self._take(client, data)
+
+    def _take(self, client: Client, data: bytes) -> None:
+        now = time.monotonic()
         results = client.reader.feed(data)
         for r in results:
             if r.doc is None:
@@ -248,7 +252,7 @@ class BridgeServer:
                 self.counts[f"worldstates_{client.side}"] += 1
         if results:
             with self._lock:
-                self._results.extend((client.side, client.address, r) for r in results)
+                self._results.extend((client.side, client.address, r, now) for r in results)
 
     def _close_all(self, grace: float = 0.5) -> None:
         """End of match: half-close every connection, read what is still in flight, close.
@@ -265,12 +269,15 @@ class BridgeServer:
             still = []
             for c in open_:
                 try:
-                    if c.sock.recv(65536):
-                        still.append(c)
+                    data = c.sock.recv(65536)
                 except BlockingIOError:
                     still.append(c)
+                    continue
                 except OSError:
-                    pass
+                    continue
+                if data:  # what the base station sent before it saw our end: still counts
+                    self._take(c, data)
+                    still.append(c)
             open_ = still
             if open_:
                 time.sleep(0.02)

@@ -93,6 +93,8 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
     cfg = rec.cfg
     if pid.kind == "recorder" or pid not in cfg.processes():
         raise ReplayError(f"{process}: no such process in this recording ({cfg.robots} robots per team)")
+    if pid.kind == "refbox":
+        raise ReplayError("refbox: the RefBox bridge replays nothing: its worldstates came from outside the match")
     if cfg.realtime:
         raise ReplayError("this match ran with --realtime, which is not deterministic: only lockstep matches replay")
     cfg = cfg.replace(record="")  # the replayed node taps nothing
@@ -191,7 +193,8 @@ def _describe(r: ReplayResult) -> str:
 def main(path: str, processes: list[str], as_json: bool = False) -> int:
     try:
         rec = load(path)
-        names = [str(p) for p in rec.cfg.processes() if p.kind != "recorder"] if "all" in processes else processes
+        every = [str(p) for p in rec.cfg.processes() if p.kind not in ("recorder", "refbox")]
+        names = every if "all" in processes else processes
         results = [replay(rec, p) for p in names]
     except (RecordingError, ReplayError) as exc:
         print(f"arena replay: error: {exc}", file=sys.stderr)

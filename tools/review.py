@@ -105,6 +105,38 @@ def print_review(r: dict, console: Console | None = None) -> None:
                 f"{s['cpu_s']:.2f}" if s["cpu_s"] is not None else "-",
             )
         console.print(t)
+    if r.get("worldstate_accuracy"):
+        print_worldstate_accuracy(r["worldstate_accuracy"], console)
+
+
+def print_worldstate_accuracy(acc: dict, console: Console) -> None:
+    """One table per team that sent worldstates through the RefBox bridge (recording/analysis/worldstates.py)."""
+    for team, s in acc.items():
+        t = Table(
+            title=f"worldstate accuracy, team {team} ({s['worldstates']} worldstates)",
+            caption="against the ground truth at the tick each describes (docs/refbox.md)",
+        )
+        for col in ("what", "n", "mean", "p95", "max"):
+            t.add_column(col, justify="right")
+
+        def row(name: str, st: dict, unit: str, t: Table = t) -> None:
+            t.add_row(name, str(st["n"]), *(f"{st[k]:.3f} {unit}" for k in ("mean", "p95", "max")))
+
+        for n, r in s["robots"].items():
+            row(f"robot {n} position", r["position_m"], "m")
+            row(f"robot {n} heading", r["heading_rad"], "rad")
+        row("ball position", s["ball_m"], "m")
+        row("ageMs", s["age_ms"], "ms")
+        o = s["obstacles"]
+        pct = {k: "-" if o[k] is None else f"{100 * o[k]:.1f} %" for k in ("recall", "precision")}
+        t.add_row(f"obstacles within {o['radius_m']} m", str(o["reported"]), f"recall {pct['recall']}", "", "")
+        t.add_row("", "", f"precision {pct['precision']}", "", "")
+        console.print(t)
+        if s["ball_missing"] or s["unmatched_robots"]:
+            console.print(
+                f"team {team}: no ball in {s['ball_missing']} worldstates; "
+                f"{s['unmatched_robots']} robot entries with an unknown id or no pose"
+            )
 
 
 # ------------------------------------------------------------------- plots

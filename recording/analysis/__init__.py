@@ -7,7 +7,9 @@
   fence, contact and overlap between robots);
 * `review.py`: `analyse`, the review of a recording (score, goals, restarts,
   possession, distances, links, timing) with the facts of the same streams;
-* `geometry.py`: footprints and line crossings.
+* `geometry.py`: footprints and line crossings;
+* `worldstates.py`: `score`, the accuracy of the worldstates real base
+  stations sent through the RefBox bridge, against the ground truth.
 
 Part of recording/: it may import `arena.runtime` and `arena.schemas`.
 """

@@ -16,15 +16,17 @@ import dataclasses
 import math
 from collections import Counter
 
+from arena.recording.analysis import worldstates
 from arena.recording.analysis.facts import measure
 from arena.recording.reader import Recording
 from arena.runtime.stats import percentile
-from arena.schemas.messages import Referee, World
+from arena.schemas.messages import Referee, World, Worldstate
 from arena.schemas.vocabulary import SET_PIECES
 
 POSSESSION_RADIUS = 0.5  # [m] robot centre to ball centre: within this the nearest robot's team has the ball
 JUMP = 0.5  # [m] a move longer than this between two world frames is a placement, not driving
-NEEDED = frozenset({"world", "referee"})  # the channels a review reads
+WORLDSTATE_TOPICS = {t: f"refbox/{t}/worldstate" for t in ("a", "b")}  # the RefBox bridge's (docs/refbox.md)
+NEEDED = frozenset({"world", "referee", *WORLDSTATE_TOPICS.values()})  # the channels a review reads
 
 
 def spread(values: list[float]) -> dict[str, float]:
@@ -155,4 +157,7 @@ def analyse(rec: Recording) -> dict:
         "summaries": sorted(rec.summaries),
         "messages": dict(sorted(rec.counts.items())),
         "facts": dataclasses.asdict(facts) if facts is not None else None,
+        "worldstate_accuracy": worldstates.score(
+            {t: rec.decoded(topic, Worldstate) for t, topic in WORLDSTATE_TOPICS.items()}, worlds, dt
+        ),
     }

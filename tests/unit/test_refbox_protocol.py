@@ -110,11 +110,13 @@ def test_worldstates_split_and_joined_anyhow():
 
 
 def test_unterminated_message_is_dropped_once_and_the_stream_recovers():
-    reader = rp.WorldstateReader(limit=100)
-    out = reader.feed(b"x" * 60) + reader.feed(b"x" * 60)
+    reader = rp.WorldstateReader(limit=200)
+    out = reader.feed(b"x" * 120) + reader.feed(b"x" * 120)
     assert [r.reason for r in out] == ["not-terminated"]
     out = reader.feed(b"x" * 500 + b"\0" + enc(GOOD))
     assert [(r.reason, r.doc is not None) for r in out] == [("", True)]
+    out = reader.feed(b"y" * 199 + b"\0" + b"z" * 201 + b"\0")  # a NUL past the limit is too late
+    assert [r.reason for r in out] == ["malformed-json", "not-terminated"]
 
 
 def test_team_table_and_identification():
