@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 
+from arena.rules.refbox_follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
@@ -22,11 +23,14 @@ class RefereeNode(Node):
         self.events_in = self.inp("events", schedule=Schedule(p, p - 1), lag=1, sender="engine")
         self.ref_out = self.out("referee")
         self.box = RefereeBox(self.cfg)
+        # --refbox-follow: a human at a real MSL RefBox decides (docs/refbox.md); our rules only end the match.
+        self.follower = Follower(self.box, self.log) if self.cfg.refbox.follow else None
+        self.decide = self.follower.step if self.follower else self.box.step
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         events = [ev for frame in self.events_in.take(k) for ev in frame.events]
-        self.ref_out.send(self.box.frame(k, self.box.step(k, events)))
+        self.ref_out.send(self.box.frame(k, self.decide(k, events)))
         self.last_tick = k
         self.timed(t0)
 
@@ -48,4 +52,7 @@ class RefereeNode(Node):
                 return
 
     def summary_extra(self) -> dict[str, object]:
-        return self.box.summary()
+        out = self.box.summary()
+        if self.follower is not None:
+            out["refbox_follow"] = self.follower.summary()
+        return out

@@ -1,0 +1,239 @@
+"""Following a human referee: a real RefBox's commands turned into our referee's state.
+
+`arena match --refbox-follow HOST:PORT` (docs/refbox.md): our referee
+connects to the official MSL RefBox as a base station would
+(`RefboxClient`) and, instead of deciding, applies each command it receives
+with `follow`, a pure transition like referee_box.py's `process`. The engine
+keeps placing the ball and reporting ball events; the events no longer decide
+anything.
+
+The RefBox protocol carries no ball spot, so the spot of a set piece is
+worked out here from the last ball position the engine reported, with the
+same placement helpers our own referee uses (setpieces.py): kick-off on the
+centre spot; free kick, throw-in and drop ball where the ball was; a corner
+on the taker's attacking goal line and a goal kick on its own, on the ball's
+side; a penalty on the penalty mark in front of the defenders' goal. START
+restarts the command in force for its team. GOAL adds the goal and SUBGOAL
+takes one back. Teams come from `targetTeam` (its colour by the configured
+targets) or from the legacy letter's case; cyan is team a unless swapped.
+Commands our referee has no word for (cards, repairs, test mode, ...) are
+ignored and counted; the clock still ends the match (END_GAME at the last
+tick) if the RefBox has not.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import socket
+import threading
+import time
+
+from arena.rules import refbox_protocol as rp
+from arena.rules import setpieces as sp
+from arena.rules.referee_box import MSL_COMMANDS, TEAM_COMMANDS, RefereeState, Result, Rules, issue
+from arena.runtime.config import RefboxParams
+
+
+def team_of_command(cmd: rp.Command, params: RefboxParams) -> str:
+    """Our team ("a"/"b") a command is for, or "" (both, or a target we do not know)."""
+    colour = cmd.colour
+    if not colour and cmd.target:
+        colour = {params.target_cyan: "cyan", params.target_magenta: "magenta"}.get(cmd.target, "")
+    return rp.team_of(colour, params.swap) if colour else ""
+
+
+def spot_of(name: str, team: str, st: RefereeState, ball: tuple[float, float], rules: Rules) -> tuple[float, float]:
+    cfg = rules.cfg
+    bx, by = ball
+    half = cfg.field.length / 2
+    if name == "KICKOFF":
+        return 0.0, 0.0
+    if name == "FREEKICK":
+        return sp.free_kick_spot(bx, by, cfg)
+    if name == "THROWIN":
+        return sp.throw_in_spot(bx, by, cfg)
+    if name == "DROP_BALL":
+        return sp.drop_ball_spot(bx, by, cfg)
+    if name == "CORNER":
+        return sp.corner_spot(sp.attack_dir(team, st.attack_dir_a) * half, by, cfg)
+    if name == "GOALKICK":
+        return sp.goal_kick_spot(-sp.attack_dir(team, st.attack_dir_a) * half, by, cfg)
+    if name == "PENALTY":
+        return sp.attack_dir(team, st.attack_dir_a) * (half - cfg.field.penalty_mark_distance), 0.0
+    return 0.0, 0.0
+
+
+def follow(
+    st: RefereeState, tick: int, cmd: rp.Command, ball: tuple[float, float], rules: Rules, params: RefboxParams
+) -> tuple[RefereeState, list, str]:
+    """(new state, our commands, why ignored or "") for one command of the real RefBox."""
+    name = cmd.name
+    team = team_of_command(cmd, params)
+    if name == "SUBGOAL":
+        if team not in ("a", "b"):
+            return st, [], "SUBGOAL without a known team"
+        a, b = st.score
+        return dataclasses.replace(st, score=(max(0, a - 1), b) if team == "a" else (a, max(0, b - 1))), [], ""
+    if name not in MSL_COMMANDS:
+        return st, [], f"{name} is not a command of our referee"
+    if name in TEAM_COMMANDS and not team:
+        return st, [], f"{name} for unknown targetTeam {cmd.target!r}"
+    if name == "START":
+        st, c = issue(st, tick, "START", st.command_team, st.spot)
+        return st, [c], ""
+    if name == "GOAL":
+        a, b = st.score
+        st = dataclasses.replace(st, score=(a + 1, b) if team == "a" else (a, b + 1))
+    if name == "HALF_TIME" and st.stage == "FIRST_HALF":
+        st = dataclasses.replace(st, attack_dir_a=-st.attack_dir_a)  # the teams change ends, as in our referee
+    team = team if name in TEAM_COMMANDS else ""
+    st, c = issue(st, tick, name, team, spot_of(name, team, st, ball, rules) if name in sp.SET_PIECES else (0.0, 0.0))
+    return st, [c], ""
+
+
+def end_of_match(st: RefereeState, tick: int, rules: Rules) -> Result | None:
+    """END_GAME at the last tick when the RefBox has not ended the game."""
+    if tick < rules.total_ticks or st.stage == "END_GAME":
+        return None
+    st, c = issue(st, tick, "END_GAME")
+    return st, [c]
+
+
+class RefboxClient:
+    """A base station's end of the RefBox connection: connects (and reconnects), reads commands.
+
+    Runs on its own thread; `drain()` hands over what arrived. Nothing blocks the caller.
+    """
+
+    def __init__(self, host: str, port: int, log: logging.Logger, source: str = "", name: str = "refbox"):
+        self.host, self.port, self.source = host, port, source
+        self.log = log
+        self._lock = threading.Lock()
+        self._got: list[rp.Command] = []
+        self.errors: list[str] = []
+        self.connected = threading.Event()
+        self._stop = threading.Event()
+        self.sock: socket.socket | None = None
+        self.thread = threading.Thread(target=self._run, name=f"{name}-client", daemon=True)
+        self.thread.start()
+
+    def drain(self) -> list[rp.Command]:
+        with self._lock:
+            out, self._got = self._got, []
+        return out
+
+    def send(self, data: bytes) -> bool:
+        """Send to the RefBox (a worldstate); False when not connected or the send would block."""
+        sock = self.sock
+        if sock is None:
+            return False
+        try:
+            sock.sendall(data)
+            return True
+        except OSError:
+            return False
+
+    def close(self) -> None:
+        self._stop.set()
+        sock = self.sock
+        if sock is not None:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+        self.thread.join(timeout=2.0)
+
+    def _connect(self) -> socket.socket | None:
+        try:
+            src = (self.source, 0) if self.source else None
+            sock = socket.create_connection((self.host, self.port), timeout=1.0, source_address=src)
+        except OSError:
+            return None
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock.settimeout(0.5)
+        return sock
+
+    def _run(self) -> None:
+        warned = False
+        while not self._stop.is_set():
+            sock = self._connect()
+            if sock is None:
+                if not warned:
+                    self.log.warning("refbox: cannot reach the RefBox at %s:%d yet; retrying", self.host, self.port)
+                    warned = True
+                self._stop.wait(0.2)
+                continue
+            self.sock = sock
+            self.connected.set()
+            self.log.warning("refbox: connected to the RefBox at %s:%d", self.host, self.port)
+            reader = rp.CommandReader()
+            while not self._stop.is_set():
+                try:
+                    data = sock.recv(4096)
+                except TimeoutError:
+                    continue
+                except OSError:
+                    break
+                if not data:
+                    break
+                cmds = reader.feed(data)
+                if reader.errors:
+                    for e in reader.errors:
+                        self.log.error("refbox: from the RefBox: %s", e)
+                    self.errors.extend(reader.errors)
+                    reader.errors.clear()
+                if cmds:
+                    with self._lock:
+                        self._got.extend(cmds)
+            self.sock = None
+            sock.close()
+            if not self._stop.is_set():
+                self.log.warning(
+                    "refbox: the RefBox at %s:%d closed the connection; reconnecting", self.host, self.port
+                )
+                time.sleep(0.2)
+
+
+class Follower:
+    """Our referee box, driven by a real RefBox instead of its own rules: `step` has the
+    signature of `RefereeBox.step`, so the referee process just calls the one it was given."""
+
+    def __init__(self, box, log: logging.Logger):
+        self.box = box  # a RefereeBox: its state, counts and summary stay the match's record
+        self.params = box.rules.cfg.refbox
+        host, port = rp.parse_endpoint(self.params.follow)
+        self.client = RefboxClient(host, port, log, name="follow")
+        self.ball = (0.0, 0.0)
+        self.applied = 0
+        self.ignored: dict[str, int] = {}
+        self.log = log
+
+    def step(self, tick: int, events) -> list:
+        for ev in events:  # where the engine last saw the ball: the spot of the next set piece
+            self.ball = (ev.x, ev.y)
+        out = []
+        for cmd in self.client.drain():
+            st, cmds, why = follow(self.box.state, tick, cmd, self.ball, self.box.rules, self.params)
+            if why:
+                self.ignored[why] = self.ignored.get(why, 0) + 1
+                self.log.warning("refbox: ignored %s", why)
+                continue
+            self.box.state = st
+            self.applied += 1
+            out.extend(cmds)
+        end = end_of_match(self.box.state, tick, self.box.rules)
+        if end is not None:
+            self.box.state, cmds = end
+            out.extend(cmds)
+        self.box.counts.update(c.name for c in out)
+        if tick >= self.box.rules.total_ticks:
+            self.client.close()
+        return out
+
+    def summary(self) -> dict[str, object]:
+        return {
+            "applied": self.applied,
+            "ignored": dict(sorted(self.ignored.items())),
+            "errors": len(self.client.errors),
+        }

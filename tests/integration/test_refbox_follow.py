@@ -1,0 +1,86 @@
+"""--refbox-follow: a fake MSL RefBox (a TCP server written from the protocol description,
+importing nothing of ours) plays a scripted game; our referee mirrors it into the match."""
+
+from __future__ import annotations
+
+import json
+import socket
+import threading
+import time
+
+import msgpack
+from mcap.reader import make_reader
+
+from tests.integration.helpers import arena_json
+
+CYAN, MAGENTA = "224.16.32.201", "224.16.32.202"  # the targets `arena match` expects by default
+SCRIPT = [
+    ("FIRST_HALF", ""),
+    ("KICKOFF", CYAN),
+    ("START", ""),
+    ("STOP", ""),
+    ("FREEKICK", MAGENTA),
+    ("START", ""),
+    ("TESTMODE_ON", ""),  # not a command of our referee: ignored and counted
+    ("STOP", ""),
+    ("CORNER", CYAN),
+    ("START", ""),
+    ("GOAL", CYAN),
+    ("STOP", ""),
+    ("KICKOFF", MAGENTA),
+    ("START", ""),
+]
+
+
+class FakeRefBox(threading.Thread):
+    def __init__(self):
+        super().__init__(daemon=True)
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.peer = ""
+
+    def run(self) -> None:
+        self.server.settimeout(120)
+        conn, addr = self.server.accept()
+        self.peer = addr[0]
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        with conn:
+            conn.sendall(json.dumps({"command": "WELCOME", "targetTeam": CYAN}).encode() + b"\0")
+            for command, target in SCRIPT:
+                time.sleep(0.1)
+                conn.sendall(json.dumps({"command": command, "targetTeam": target}).encode() + b"\0")
+            time.sleep(30)  # stay connected while the match plays
+        self.server.close()
+
+
+def test_refbox_follow_plays_the_scripted_commands(tmp_path):
+    refbox = FakeRefBox()
+    refbox.start()
+    path = tmp_path / "follow.mcap"
+    result = arena_json(
+        *("match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "5"),
+        *("--refbox-follow", f"127.0.0.1:{refbox.port}", "--record", str(path)),
+    )
+    assert refbox.peer == "127.0.0.1"
+    assert result["score"] == [1, 0]
+    assert result["events"] == {
+        "FIRST_HALF": 1,
+        "KICKOFF": 2,
+        "START": 4,
+        "STOP": 3,
+        "FREEKICK": 1,
+        "CORNER": 1,
+        "GOAL": 1,
+        "END_GAME": 1,  # the match's own clock still ends it
+    }
+    with open(path, "rb") as f:
+        refs = [msgpack.unpackb(m.data) for _, ch, m in make_reader(f).iter_messages() if ch.topic == "referee"]
+    played = [(c["name"], c["team"]) for r in refs for c in r["commands"]]
+    expected = [(c, {CYAN: "a", MAGENTA: "b"}.get(t, "")) for c, t in SCRIPT if c != "TESTMODE_ON"]
+    # START carries the team of the set piece it starts, as our own referee's does
+    for i, (c, _) in enumerate(expected):
+        if c == "START":
+            expected[i] = ("START", expected[i - 1][1] if expected[i - 1][0] != "STOP" else "")
+    assert played[: len(expected)] == expected
+    corner = next(c for r in refs for c in r["commands"] if c["name"] == "CORNER")
+    assert (abs(corner["x"]), abs(corner["y"])) == (5.75, 3.75)  # team a attacks +x in the first half
