@@ -18,6 +18,11 @@ In real-time mode the engine paces ticks to the wall clock and never waits for
 a command: a robot without a fresh command keeps its last setpoint until
 `cmd_timeout`, then stops.
 
+A robot whose process died (liveliness lost, or silent past the watchdog) is
+parked: taken off the field beyond the fence for the rest of the match, with no
+collisions, and the referee gets a ROBOT_DEAD event (docs/architecture.md,
+"Faults").
+
 Inputs are validated on the way in: a `cmd` with non-finite numbers or the
 wrong number of wheel speeds for the robot model, and a `referee` frame with
 an unknown command or team (`check_referee`), are rejected, counted and
@@ -144,10 +149,17 @@ class EngineNode(Node):
         self.events_schedule = Schedule(p, p - 1)
         self.world_schedule = Schedule(cfg.timing.world_period, 0)
         self.pending_events: list = []
+        self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
 
     def check_cmd(self, cmd: Cmd) -> str | None:
         return check_cmd(cmd, self.wheels)
+
+    def park(self, r: tuple[str, int], k: int) -> None:
+        """A dead robot leaves the field: parked beyond the fence, no collisions (Physics.park_robot)."""
+        x, y = self.physics.park_robot(*r)
+        self.parked[r] = {"tick": k, "x": round(x, 3), "y": round(y, 3)}
+        self.log.warning("tick %d: robot %s/%d is dead, parked at (%.2f, %.2f)", k, r[0], r[1], x, y)
 
     def on_peer_dead(self, peer: str) -> None:
         """Tell the referee (G_Re) that a robot is gone; its wheels are stopped in the loop."""
@@ -226,8 +238,8 @@ class EngineNode(Node):
                 frames = ib.take(k)
                 if frames:
                     ph.set_command(r[0], r[1], frames[-1])
-                elif ib.dead:
-                    ph.set_command(r[0], r[1], Cmd(tick=k))  # a dead robot's wheels stop
+                elif ib.dead and r not in self.parked:
+                    self.park(r, k)
             t1 = time.perf_counter()
             self.pending_events.extend(ph.step())
             self._work_s.append(work + time.perf_counter() - t1)
@@ -256,6 +268,10 @@ class EngineNode(Node):
                     last_cmd[r] = k
                 elif k - last_cmd[r] > timeout_ticks:
                     ph.set_command(r[0], r[1], Cmd(tick=k))
+                    peer = f"robot/{r[0]}/{r[1]}"
+                    if peer in self.gone and r not in self.parked:  # its liveliness token vanished
+                        self._record_dead(peer, "its liveliness token vanished")
+                        self.park(r, k)
             self.pending_events.extend(ph.step())
             self.timed(t0)
             delay = start + (k + 1) * dt - time.monotonic()
@@ -267,4 +283,5 @@ class EngineNode(Node):
             "distance_m": {f"{t}/{n}": round(d, 3) for (t, n), d in sorted(self.physics.distance.items())},
             "ticks": self.last_tick,
             "placed": len(self.restarts.placed),
+            "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
         }

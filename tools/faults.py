@@ -43,7 +43,11 @@ def exit_reason(code: int) -> str:
 
 
 def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
-    """Dead processes as claimed by processes that were not lost themselves: name -> earliest tick."""
+    """Dead processes as claimed by processes that were not lost themselves: name -> tick.
+
+    The tick is the engine's when it gave up on the process (the match clock),
+    else the earliest claimant's.
+    """
     dead: dict[str, int] = {}
     for name, s in summaries.items():
         if name in lost:
@@ -51,6 +55,9 @@ def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
         for peer in s.dead:
             tick = s.dead_at.get(peer, s.tick)
             dead[peer] = min(tick, dead.get(peer, tick))
+    engine = summaries.get("engine")
+    if engine is not None and "engine" not in lost:
+        dead.update({p: t for p, t in engine.dead_at.items() if p in dead})  # the engine's tick is the match's
     return dead
 
 

@@ -523,6 +523,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "links": links,
         "events": dict(sorted(referee.extra.get("events", {}).items())) if referee else {},
         "distance_m": engine.extra.get("distance_m", {}) if engine else {},
+        "parked": engine.extra.get("parked", {}) if engine else {},
         "rejected": sum(rejected.values()),
         "rejected_reasons": dict(rejected),
         "dead": honest["dead"],

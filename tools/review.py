@@ -54,6 +54,8 @@ def print_review(r: dict, console: Console | None = None) -> None:
         )
     else:
         console.print("goals: none")
+    for f in r.get("faults", []):
+        console.print(f"[red]fault: {f['process']} at {f['t']:.1f} s (tick {f['tick']}): {f['reason']}[/]")
     console.print("restarts: " + (", ".join(f"{k} {v}" for k, v in r["restarts"].items()) or "none"))
     p = r["possession_percent"]
     console.print(

@@ -16,17 +16,19 @@ import dataclasses
 import math
 from collections import Counter
 
+import msgspec
+
 from arena.recording.analysis import worldstates
 from arena.recording.analysis.facts import measure
 from arena.recording.reader import Recording
 from arena.runtime.stats import percentile
-from arena.schemas.messages import Referee, World, Worldstate
+from arena.schemas.messages import EngineEvents, Referee, World, Worldstate
 from arena.schemas.vocabulary import SET_PIECES
 
 POSSESSION_RADIUS = 0.5  # [m] robot centre to ball centre: within this the nearest robot's team has the ball
 JUMP = 0.5  # [m] a move longer than this between two world frames is a placement, not driving
 WORLDSTATE_TOPICS = {t: f"refbox/{t}/worldstate" for t in ("a", "b")}  # the RefBox bridge's (docs/refbox.md)
-NEEDED = frozenset({"world", "referee", *WORLDSTATE_TOPICS.values()})  # the channels a review reads
+NEEDED = frozenset({"world", "referee", "engine/events", *WORLDSTATE_TOPICS.values()})  # the channels a review reads
 
 
 def spread(values: list[float]) -> dict[str, float]:
@@ -64,6 +66,39 @@ def _link_stats(rec: Recording) -> dict[str, dict]:
         acc["drop_percent"] = round(100.0 * acc["dropped"] / acc["frames"], 3) if acc["frames"] else 0.0
         acc["delay_ms"] = spread(d)
     return {"by_class": dict(sorted(per_class.items())), "by_process": per_process}
+
+
+def faults_of(rec: Recording) -> list[dict]:
+    """Processes that failed during the match, on the match's timeline.
+
+    The engine's `ROBOT_DEAD` events (on the wire, in the file, at the engine's
+    tick), then whatever else the summaries list as dead, at the tick their
+    first claimant gave up.
+    """
+    dt = rec.cfg.timing.dt
+    found: dict[str, dict] = {}
+    decode = msgspec.msgpack.Decoder(EngineEvents).decode
+    for payload in rec.payloads("engine/events"):
+        try:
+            events = decode(payload).events
+        except (msgspec.DecodeError, msgspec.ValidationError):
+            continue  # not an EngineEvents frame: nothing to say about it
+        for e in events:
+            if e.kind == "ROBOT_DEAD":
+                name = f"robot/{e.team}/{e.robot}"
+                found.setdefault(name, {"process": name, "tick": e.tick, "reason": "ROBOT_DEAD (the engine parked it)"})
+    claims: dict[str, dict] = {}
+    for s in rec.summaries.values():
+        for peer in s.dead:
+            tick = s.dead_at.get(peer, s.tick)
+            if peer not in claims or tick < claims[peer]["tick"]:
+                claims[peer] = {"process": peer, "tick": tick, "reason": f"{s.process} gave up waiting for it"}
+    for peer, f in claims.items():
+        found.setdefault(peer, f)  # the engine's event, on the match clock, comes first
+    out = sorted(found.values(), key=lambda f: (f["tick"], f["process"]))
+    for f in out:
+        f["t"] = round(f["tick"] * dt, 2)
+    return out
 
 
 def analyse(rec: Recording) -> dict:
@@ -147,6 +182,7 @@ def analyse(rec: Recording) -> dict:
         "planned_ticks": cfg.total_ticks,
         "planned_sim_seconds": round(cfg.total_ticks * dt, 3),
         "goals": goals,
+        "faults": faults_of(rec),
         "restarts": dict(sorted(restarts.items())),
         "commands": dict(sorted(commands.items())),
         "possession_percent": possession,

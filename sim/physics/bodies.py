@@ -68,3 +68,4 @@ class RobotBody:
     challenge_from: int = 0  # first tick at which it may challenge a holder again
     ctrl_set: tuple[float, float, float] = (0.0, 0.0, 0.0)  # last control velocity written
     carry_from: tuple[float, float] = (0.0, 0.0)  # [m] its centre when its dribbler took the ball
+    parked: bool = False  # taken off the field for good (its process died): no commands, no collisions

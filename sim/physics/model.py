@@ -103,6 +103,8 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, State):
         A kick fires at most once per call (when the ball is, or becomes, in reach).
         """
         r = self._by_id[(team, n)]
+        if r.parked:
+            return
         r.cmd = cmd
         r.twist = self._drive.twist(cmd)
         r.kick_armed = cmd.kick_speed > 0.0

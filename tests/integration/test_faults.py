@@ -8,16 +8,19 @@ NaN strategy is a real plugin found through its entry point by every process.
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
+import subprocess
 import textwrap
 
 import msgspec
 import zenoh
 
+from arena.recording.reader import load
 from arena.runtime.session import NetConfig, open_session
-from arena.schemas.messages import Referee
-from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for
+from arena.schemas.messages import Referee, World
+from tests.integration.helpers import ARENA, alive, cmdline, descendants, spawn, wait_for
 
 MATCH = ("match", "--home", "BS", "--away", "BS", "--json")
 
@@ -55,9 +58,11 @@ def finish(proc, timeout: float = 300) -> tuple[int, dict | None, str]:
 
 
 def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
-    """Issue 15 acceptance: kill -9 of robot b/1 at about tick 1500 of a 2 x 60 s match."""
+    """Issue 15 acceptance: kill -9 of robot b/1 at about tick 1500 of a recorded 2 x 60 s match."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    proc = spawn(*MATCH, "--half-time", "60", "--seed", "4", "--match", "crash", "--listen", endpoint)
+    mcap = tmp_path / "crash.mcap"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "4", "--match", "crash", "--listen", endpoint,
+                 "--record", str(mcap))  # fmt: skip
     reap.append(proc)
     victim = child(proc.pid, "--team b --robot 1")
     at = wait_for_tick(endpoint, "crash", 1500, proc)
@@ -71,7 +76,31 @@ def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
     assert fault["process"] == "robot/b/1" and "code -9" in fault["reason"]
     assert at <= fault["tick"] <= at + 500, (at, fault)
     assert "fault: robot/b/1 at tick" in err and "Traceback" not in err
+    parked = result["parked"]["b/1"]
+    assert fault["tick"] <= parked["tick"] <= fault["tick"] + 1
     assert result["distance_m"]["b/2"] > 5, "its team plays on"
+
+    # The ground truth in the recording: from its parking on, robot b/1 stands still
+    # beyond the fence, and neither the ball nor any robot ever comes near it.
+    rec = load(str(mcap))
+    cfg = rec.cfg
+    fence_x = cfg.field.length / 2 + cfg.field.runoff
+    reach = cfg.robot.size  # centre to centre: two robots' half sizes, or a robot's and more than a ball's
+    after = [w for w in rec.decoded("world", World) if w.tick > parked["tick"]]
+    assert len(after) > 4000
+    for w in after:
+        me = next(r for r in w.robots if (r.team, r.robot) == ("b", 1))
+        assert (round(me.x, 3), round(me.y, 3)) == (parked["x"], parked["y"]) and abs(me.x) > fence_x
+        assert math.hypot(w.ball_x - me.x, w.ball_y - me.y) > reach, w.tick
+        for r in w.robots:
+            if r is not me:
+                assert math.hypot(r.x - me.x, r.y - me.y) > reach, (w.tick, r)
+    review = subprocess.run([*ARENA, "review", str(mcap), "--json"], capture_output=True, text=True, timeout=120)
+    assert review.returncode == 0, review.stderr
+    faults = json.loads(review.stdout)["faults"]
+    assert [f["process"] for f in faults] == ["robot/b/1"] and abs(faults[0]["tick"] - fault["tick"]) <= 1
+    text = subprocess.run([*ARENA, "review", str(mcap)], capture_output=True, text=True, timeout=120).stdout
+    assert "fault: robot/b/1 at" in text
 
 
 def test_strict_stops_the_match_at_the_first_crash(reap, tmp_path):

@@ -1,0 +1,125 @@
+"""Invalid frames, conflicting senders, parked robots and the honest outcome, unit by unit."""
+
+from __future__ import annotations
+
+import math
+
+import msgspec
+import pytest
+
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
+from arena.schemas.validate import nonfinite, safe_default
+from arena.sim.physics import Physics
+from arena.tools.faults import blame, outcome
+from tests.unit.test_lockstep import Harness
+
+
+@pytest.mark.parametrize(
+    "msg",
+    [
+        Cmd(tick=3, vx=math.nan),
+        Cmd(tick=3, wheels=[1.0, -math.inf, 0.0, 0.0], mode="wheels"),
+        Order(tick=3, robot=1, own=[TeamPose(robot=1, x=math.inf, y=0.0)]),
+        Referee(tick=3, stage="FIRST_HALF", command="STOP", commands=[RefCommand(name="STOP", x=math.nan)]),
+    ],
+)
+def test_a_non_finite_float_anywhere_is_found(msg):
+    raw = encode(msg)
+    assert nonfinite(raw, msgspec.msgpack.decode(raw, type=type(msg)))
+
+
+def test_a_clean_message_costs_only_the_byte_scan():
+    raw = encode(Order(tick=3, robot=1, ball_x=1e308, own=[TeamPose(robot=1, x=1.0, y=2.0)]))
+    assert nonfinite(raw, msgspec.msgpack.decode(raw, type=Order)) is None
+
+
+def test_safe_defaults():
+    assert safe_default(Cmd(tick=7, vx=math.nan, kick_speed=5.0), None) == Cmd(tick=7)
+    assert safe_default(EngineEvents(tick=9), None) == EngineEvents(tick=9)
+    prev = Referee(tick=5, stage="FIRST_HALF", command="START", commands=[RefCommand(name="START")])
+    assert safe_default(Referee(tick=10, stage="?", command="?"), prev) == Referee(
+        tick=10, stage="FIRST_HALF", command="START"
+    )
+    assert safe_default(Order(tick=6, robot=1, ball_x=math.nan), None) is None
+    assert safe_default(Order(tick=11, robot=1, ball_x=math.nan), Order(tick=6, robot=1, ball_x=2.0)).ball_x == 2.0
+
+
+def test_an_invalid_frame_in_sequence_advances_its_link_with_wheels_stopped():
+    h = Harness()
+    h.inbound._check = lambda c: "too fast" if c.vx > 10 else None
+    h.put(encode(Cmd(tick=0, vx=1.0)))
+    h.put(encode(Cmd(tick=1, vx=math.nan, kick_speed=3.0)))
+    h.put(encode(Cmd(tick=2, vx=99.0)))
+    h.put(encode(Cmd(tick=3, vx=2.0)))
+    h.inbound.sync(4)
+    h.close()
+    assert h.inbound.last_seen == 3 and h.rej.by_reason == {"invalid": 2}
+    assert [(c.tick, c.vx, c.kick_speed) for c in h.inbound.take(4)] == [(0, 1.0, 0), (1, 0, 0), (2, 0, 0), (3, 2.0, 0)]
+
+
+def test_a_second_different_frame_for_a_tick_is_a_conflict_and_a_repeat_is_not():
+    h = Harness()
+    h.put(encode(Cmd(tick=0, vx=-5.0)))  # the forger is first
+    h.put(encode(Cmd(tick=0, vx=1.0)))  # the real robot
+    h.put(encode(Cmd(tick=0, vx=1.0)))  # a repeat of the forged one would be the same bytes: not this
+    h.put(encode(Cmd(tick=1)))
+    h.put(encode(Cmd(tick=1)))  # the same frame twice: only out of sequence
+    h.put(encode(Cmd(tick=2)))
+    h.inbound.sync(3)
+    h.close()
+    assert h.rej.conflicts == {h.inbound.key: 2}
+    assert h.rej.by_reason == {"conflict": 2, "out-of-sequence": 1}
+
+
+def test_a_parked_robot_leaves_the_field_for_good():
+    cfg = MatchConfig(seed=1)
+    ph = Physics(cfg)
+    ph.kickoff_positions("a")
+    x, y = ph.park_robot("b", 1)
+    assert abs(x) > cfg.field.length / 2 + cfg.field.runoff
+    ph.set_command("b", 1, Cmd(tick=0, vx=2.0))
+    ph.kickoff_positions("b")
+    ph.place_robot("b", 1, 0.0, 0.0, 0.0)
+    ph.start_play()
+    for _ in range(50):
+        ph.step()
+    px, py, _ = ph.robot_pose("b", 1)
+    assert (px, py) == pytest.approx((x, y), abs=1e-9)
+    assert ph.parked() == [("b", 1)]
+
+
+def _summary(process, dead=(), dead_at=None, tick=100, conflicts=None):
+    return Summary(tick=tick, process=process, pid=1, digest="", sent=0, rejected=0, dead=list(dead),
+                   dead_at=dead_at or {}, conflicts=conflicts or {})  # fmt: skip
+
+
+def test_a_process_that_was_lost_itself_blames_nobody():
+    """Issue 20: after a 10 s SIGSTOP, the stopped robot sees everyone vanish; only it is dead."""
+    sums = {
+        "engine": _summary("engine", ["robot/a/1"], {"robot/a/1": 40}),
+        "basestation/a": _summary("basestation/a", ["robot/a/1"], {"robot/a/1": 36}),
+        "robot/a/1": _summary("robot/a/1", ["basestation/a", "engine"], {"engine": 39}),
+    }
+    assert blame(sums, {"robot/a/1"}) == {"robot/a/1": 40}
+
+
+def test_outcomes():
+    cfg = MatchConfig(seed=1, half_time=1.0)
+    full = {str(p): _summary(str(p), tick=cfg.total_ticks) for p in cfg.processes()}
+    assert outcome(cfg, full, {}, {}, {})["outcome"] == "completed"
+    crashed = dict(full)
+    crashed.pop("robot/b/1")
+    crashed["engine"] = _summary("engine", ["robot/b/1"], {"robot/b/1": 20}, tick=cfg.total_ticks)
+    o = outcome(cfg, crashed, {"robot/b/1": "exited with code -9 (SIGKILL)"}, {}, {})
+    assert o["outcome"] == "completed_with_faults" and o["faults"] == [
+        {"process": "robot/b/1", "tick": 20, "reason": "exited with code -9 (SIGKILL)"}
+    ]
+    short = dict(full, engine=_summary("engine", tick=10))
+    assert outcome(cfg, short, {}, {}, {})["outcome_reasons"] == [f"the engine played 10 of {cfg.total_ticks} ticks"]
+    noref = dict(full)
+    noref.pop("referee")
+    o = outcome(cfg, noref, {"referee": "exited with code 1"}, {}, {}, void="referee exited with code 1")
+    assert o["void"] and o["outcome_reasons"] == ["referee exited with code 1"]
+    spoofed = dict(full, engine=_summary("engine", tick=cfg.total_ticks, conflicts={"robot/b/1/cmd": 3}))
+    assert outcome(cfg, spoofed, {}, {}, {})["conflicts"] == {"robot/b/1/cmd": 3}
