@@ -38,6 +38,71 @@ from arena.strategies import registry
 ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
 
 
+def plural(n: int, word: str, words: str | None = None) -> str:
+    """`1 leg`, `2 legs`, `1 match`, `3 matches`."""
+    return f"{n} {word if n == 1 else (words or word + 's')}"
+
+
+# Settings that decide what a match is: --resume refuses to mix results played with other values.
+BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "seed")
+
+
+def settings(args) -> dict:
+    """Everything needed to play the tournament again (tournament.json, report.md, --resume's check)."""
+    from arena.cli import package_version
+    from arena.runtime.links import parse_override
+
+    overrides: dict[str, dict[str, float]] = {}
+    for text in getattr(args, "link_param", []) or []:
+        cls, param, value = parse_override(text)
+        overrides.setdefault(cls, {})[param] = value
+    return {
+        "strategies": [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()],
+        "legs": args.legs,
+        "half_time": float(args.half_time),
+        "robots": args.robots,
+        "link": args.link,
+        "link_overrides": overrides,
+        "seed": args.seed,
+        "engine": getattr(args, "engine", "processes"),
+        "version": package_version(),
+    }
+
+
+def check_resume(out: Path, now: dict) -> None:
+    """ConfigError naming every setting that differs from the ones `out` was played with."""
+    from arena.runtime.config import ConfigError
+
+    path = out / "settings.json"
+    if not path.exists():
+        return  # an older tournament directory: nothing recorded to compare
+    try:
+        before = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ConfigError(f"--resume: cannot read {path}: {exc}") from None
+    flag = {"link_overrides": "link-param", "half_time": "half-time"}
+    diffs = [
+        f"--{flag.get(k, k)} {_show(before.get(k))} there, {_show(now[k])} now"
+        for k in BINDING
+        if before.get(k) != now[k]
+    ]
+    if diffs:
+        raise ConfigError(
+            f"--resume: {out} was played with different settings: {'; '.join(diffs)} "
+            "(give the same settings, or another --out)"
+        )
+
+
+def _show(value) -> str:
+    if isinstance(value, list):
+        return ",".join(short(v) for v in value)
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, dict):
+        return ",".join(f"{c}.{p}={v:g}" for c, ps in sorted(value.items()) for p, v in sorted(ps.items())) or "none"
+    return str(value)
+
+
 def short(name: str) -> str:
     return ABBREV.get(name, name)
 
@@ -235,7 +300,7 @@ def ratings(results: list[Result], teams: list[str], boot: int = 400, seed: int 
             n = sum(1 for r in ok if {r.home, r.away} == {upper["team"], lower["team"]})
             notes.append(
                 f"{short(upper['team'])} and {short(lower['team'])} cannot be told apart: their 95 % intervals "
-                f"overlap ({n} direct matches); more legs are needed to separate them."
+                f"overlap ({plural(n, 'direct match', 'direct matches')}); more legs are needed to separate them."
             )
     return rows, notes
 
@@ -321,8 +386,16 @@ def report(
     wall: float,
     seed: int,
     engine: str = "processes",
+    total: int | None = None,
+    setup: dict | None = None,
 ) -> dict:
-    """Write every table and chart to `out`; return the JSON summary. `engine`: which one played."""
+    """Write every table and chart to `out`; return the JSON summary. `engine`: which one played.
+
+    `total`: the matches the schedule has (more than `results` when interrupted);
+    `setup`: the tournament's settings (`settings()`), recorded in both outputs.
+    """
+    total = len(results) if total is None else total
+    setup = setup or {"strategies": strategies, "legs": legs, "seed": seed, "engine": engine}
     done = [r for r in results if r.status == "ok"]
     table = standings(results, strategies)
     cover = coverage(results, strategies)
@@ -344,10 +417,12 @@ def report(
     ):
         write_atomic(out / f"{name}.csv", csv_text(head, rows))
     md = [
-        f"# Tournament: {', '.join(short(s) for s in strategies)}, {legs} legs, seed {seed}",
+        f"# Tournament: {', '.join(short(s) for s in strategies)}, {plural(legs, 'leg')}, seed {seed}",
         "",
-        f"{len(done)} of {len(results)} matches played ({len(failed)} failed), {wall:.0f} s of wall time, "
-        f"engine {engine} (arena tournament --engine).",
+        f"{len(done)} of {plural(total, 'match', 'matches')} played ({len(failed)} failed), "
+        f"{wall:.0f} s of wall time, engine {engine} (arena tournament --engine).",
+        "",
+        "Settings: " + ", ".join(f"{k.replace('_', ' ')} {_show(v)}" for k, v in setup.items()) + ".",
         "",
         "## Table 1: scores per pairing and leg (first-named team's goals first)",
         "",
@@ -374,6 +449,9 @@ def report(
         "strategies": strategies,
         "legs": legs,
         "seed": seed,
+        "settings": setup,
+        "played": len(done),
+        "scheduled": total,
         "table": table,
         "coverage_ratio": {t: cover[t]["ratio"] for t in strategies},
         "coverage": cover,
@@ -632,7 +710,11 @@ def run(args) -> tuple[dict, bool]:
 
     strategies = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
     out = Path(args.out)
+    setup = settings(args)
+    if args.resume:
+        check_resume(out, setup)
     out.mkdir(parents=True, exist_ok=True)
+    write_atomic(out / "settings.json", json.dumps(setup, indent=2))
     fixtures = schedule(strategies, args.legs, args.seed)
     runner = Runner(args, out)
     have = load_results(runner.matches_dir) if args.resume else {}
@@ -682,7 +764,17 @@ def run(args) -> tuple[dict, bool]:
                 signal.signal(signal.SIGTERM, previous)
     runner.close()
     ordered = [results[fx.id] for fx in fixtures if fx.id in results]
-    summary = report(ordered, strategies, args.legs, out, time.monotonic() - t0, args.seed, engine=runner.engine)
+    summary = report(
+        ordered,
+        strategies,
+        args.legs,
+        out,
+        time.monotonic() - t0,
+        args.seed,
+        engine=runner.engine,
+        total=len(fixtures),
+        setup=setup,
+    )
     summary["skipped"] = len(fixtures) - len(todo)
     summary["interrupted"] = interrupted
     return summary, interrupted
@@ -712,6 +804,8 @@ def print_summary(summary: dict) -> None:
         c.print(f"[yellow]note:[/] {note}")
     for f in summary["failed"]:
         c.print(f"[red]failed:[/] {f['id']}: {f['reason']}")
+    if "played" in summary:
+        c.print(f"{summary['played']} of {plural(summary['scheduled'], 'match', 'matches')} played")
     c.print(
         f"tables, charts and per-match results in {summary['out']} "
         f"({summary['wall_seconds']:.0f} s, engine {summary.get('engine', 'processes')})"
