@@ -333,7 +333,9 @@ def build_parser() -> Parser:
     fa = add("facts", "play matches in process and measure them: rules and team-play facts per match and strategy")
     fa.add_argument("--seeds", type=int, default=20, metavar="N", help="matches, seeds first-seed.. (20)")
     fa.add_argument("--first-seed", type=int, default=0, metavar="S", help="first seed (0)")
-    fa.add_argument("--half-time", type=float, default=60.0, metavar="SECONDS", help="simulated half length (60)")
+    fa.add_argument(
+        "--half-time", type=half_time, default=60.0, metavar="SECONDS", help="simulated half length [s] (60)"
+    )
     fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
     fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
     fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once (default: up to 2)")
@@ -656,6 +658,8 @@ def cmd_review(args: argparse.Namespace) -> int:
 def cmd_facts(args: argparse.Namespace) -> int:
     from arena.tools import facts
 
+    if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
+        raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")
     return facts.main(
         seeds=args.seeds,
         first_seed=args.first_seed,

@@ -80,6 +80,11 @@ BAD = [
     (["bench", "nav", "--scenarios", "/nonexistent.toml"], "nonexistent.toml"),
     (["bench", "nav", "--only", "nosuch"], "nosuch"),
     (["bench", "frob"], "invalid choice: 'frob'"),
+    # arena facts
+    (["facts", "--half-time", "inf"], "finite number"),
+    (["facts", "--seeds", "0"], "must be at least 1"),
+    (["facts", "--round-robin", "AD"], "needs at least two different strategies"),
+    (["facts", "--home", "nope"], "unknown strategy 'nope'"),
     # arena review
     (["review", "/nonexistent.mcap"], "cannot read"),
     (["review", "{file}"], "not an MCAP file"),
