@@ -241,7 +241,7 @@ def play(args, runner, todo: list, on_result) -> bool:
 
 def finish(runner, fx, attempt: int, got: dict):
     """The Result of one attempt, written to --out; None if the match is to be played again."""
-    from arena.tools.tournament import Result, write_atomic
+    from arena.tools.tournament import Result, void_reason, write_atomic
 
     base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
     log = runner.logs_dir / f"{fx.id}.log"
@@ -253,6 +253,8 @@ def finish(runner, fx, attempt: int, got: dict):
         except json.JSONDecodeError:
             reason = "the match printed no JSON"
         else:
+            reason = void_reason(m)
+        if not reason:
             r = Result(
                 id=fx.id,
                 status="ok",
@@ -263,6 +265,7 @@ def finish(runner, fx, attempt: int, got: dict):
                 rtf=m["rtf"],
                 digest=m["digest"],
                 engine=m.get("engine", "processes"),
+                faults=m.get("faults", []),
                 **base,
             )
             write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))

@@ -153,6 +153,7 @@ class Result:
     rtf: float = 0.0
     digest: str = ""
     engine: str = "processes"  # which engine played it (arena match --engine)
+    faults: list[dict] = field(default_factory=list)  # a team's crashed process: the match counts (tools/faults.py)
 
     def goals(self, team: str) -> tuple[int, int]:
         """(for, against) for `team` in this match."""
@@ -401,6 +402,7 @@ def report(
     cover = coverage(results, strategies)
     rates, notes = ratings(results, strategies, seed=seed)
     failed = [{"id": r.id, "reason": r.reason} for r in results if r.status != "ok"]
+    faulty = [{"id": r.id, **f} for r in results if r.status == "ok" for f in r.faults]
 
     h1, rows1 = table1_rows(results, strategies, legs)
     cols2 = ["team", "W", "D", "L", "GF", "GA", "GD", "P"]
@@ -441,6 +443,9 @@ def report(
         md += ["Notes:", ""] + [f"- {n}" for n in notes] + [""]
     if failed:
         md += ["## Failed matches", ""] + [f"- {f['id']}: {f['reason']}" for f in failed] + [""]
+    if faulty:
+        md += ["## Matches played with faults (they count: a team's crash is the team's own)", ""]
+        md += [f"- {f['id']}: {f['process']} at tick {f['tick']}: {f['reason']}" for f in faulty] + [""]
     if done:
         charts(out, table, cover)
         md += ["![goal difference](goal_difference.png)", "", "![coverage](coverage.png)", ""]
@@ -459,12 +464,20 @@ def report(
         "notes": notes,
         "matches": [asdict(r) for r in results],
         "failed": failed,
+        "faults": faulty,
         "wall_seconds": round(wall, 2),
         "engine": engine,
         "out": str(out),
     }
     write_atomic(out / "tournament.json", json.dumps(summary, indent=2))
     return summary
+
+
+def void_reason(m: dict) -> str:
+    """Why a match's JSON is no result ("" if it is one): a void match never counts (tools/faults.py)."""
+    if m.get("outcome") == "void" or m.get("void"):
+        return "void: " + "; ".join(m.get("outcome_reasons") or ["no reason given"])
+    return ""
 
 
 # ----------------------------------------------------------------------- run
@@ -618,6 +631,9 @@ class Runner:
                 except json.JSONDecodeError:
                     reason = "the match printed no JSON"
                     continue
+                if void := void_reason(m):
+                    reason = void
+                    continue
                 r = Result(
                     id=fx.id,
                     status="ok",
@@ -628,6 +644,7 @@ class Runner:
                     rtf=m["rtf"],
                     digest=m["digest"],
                     engine=self.engine,
+                    faults=m.get("faults", []),
                     **base,
                 )
                 write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))

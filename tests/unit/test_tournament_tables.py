@@ -147,3 +147,21 @@ def test_table1_lists_each_pairings_score_first_named_team_first():
     header, rows = table1_rows(results, [AD, BS], legs=2)
     assert header == ["leg", "AD vs BS"]
     assert rows == [["1", "1-2"], ["2", "0-4"]]
+
+
+def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_path):
+    from arena.tools.tournament import report, void_reason
+
+    assert void_reason({"outcome": "void", "outcome_reasons": ["referee exited with code -9 (SIGKILL)"]}) == (
+        "void: referee exited with code -9 (SIGKILL)"
+    )
+    assert void_reason({"outcome": "completed_with_faults"}) == "" and void_reason({"score": [1, 0]}) == ""
+    faulty = match(AD, BS, 2, 1)
+    faulty.faults = [{"process": "robot/b/1", "tick": 1500, "reason": "exited with code -9 (SIGKILL)"}]
+    summary = report([faulty], [AD, BS], 1, tmp_path, 1.0, 0)
+    ad = next(r for r in summary["table"] if r["team"] == AD)
+    assert ad["W"] == 1, "a match played on with a crashed team process counts"
+    assert summary["faults"] == [{"id": faulty.id, **faulty.faults[0]}]
+    assert (
+        f"- {faulty.id}: robot/b/1 at tick 1500: exited with code -9 (SIGKILL)" in (tmp_path / "report.md").read_text()
+    )
