@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 
+from arena.rules.refbox_follow import ViaRefbox
 from arena.rules.referee_box import check_referee
 from arena.runtime.lockstep import Schedule, Waits
 from arena.runtime.node import Node
@@ -35,12 +36,20 @@ class BaseStationNode(Node):
         self.order_out = {n: self.out("order", team, n) for n in range(cfg.robots)}
         strategy = registry.get(cfg.strategy_of(team))
         self.brain = strategy.make_team(TeamContext(cfg=cfg, team=team, rng=self.rng("strategy")))
+        # --via-refbox (real time only): commands and score come over TCP from the RefBox bridge, as
+        # a real team's would; the zenoh referee frames are then only the clock (docs/refbox.md).
+        self.via = ViaRefbox(cfg, team, self.log) if cfg.refbox.via else None
+        self.latest: dict = {}
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         # Each robot's newest report, if a new one arrived since the last order.
         reports = {n: ib.latest for n, ib in self.report_in.items() if ib.take(k)}
         referee = self.ref_in.latest_by(k)
+        if self.via is not None:
+            referee = self.via.referee(k, reports)
+            self.latest.update(reports)
+            self.via.send_worldstate(k, self.latest)
         orders = self.brain.step(k, reports, referee)
         for n, out in self.order_out.items():
             out.send(orders[n])
@@ -55,6 +64,13 @@ class BaseStationNode(Node):
             self.act(k)
 
     def loop_realtime(self) -> None:
+        try:
+            self._loop_realtime()
+        finally:
+            if self.via is not None:
+                self.via.close()
+
+    def _loop_realtime(self) -> None:
         last = self.cfg.total_ticks
         while True:
             r = self.ref_in.recv_clock()

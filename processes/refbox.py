@@ -47,7 +47,8 @@ class RefboxNode(Node):
         self._ws_tick = 0  # worldstate ticks never go back (the recorder writes in tick order)
 
     def barrier(self) -> None:
-        want = self.cfg.refbox.wait
+        # Our own base stations (--via-refbox) must hear the first FIRST_HALF and KICKOFF too.
+        want = 2 if self.cfg.refbox.via else self.cfg.refbox.wait
         deadline = time.monotonic() + self.cfg.timing.startup_timeout
         while self.server.sides() < want:
             if time.monotonic() > deadline:

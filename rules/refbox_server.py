@@ -27,6 +27,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 from arena.rules import refbox_protocol as rp
+from arena.rules.refbox_follow import VIA_TEAMS
 from arena.runtime.config import RefboxParams
 
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
@@ -164,7 +165,7 @@ class BridgeServer:
     def _identify(self, ip: str) -> tuple[str, str, str, str]:
         """(side, protocol, name, why-not) for a new connection."""
         taken = {c.side for c in self.clients.values()}
-        table = self.params.teams
+        table = self.params.teams + (VIA_TEAMS if self.params.via else ())
         if table:
             entry = rp.identify(ip, table)
             if entry is None:

@@ -203,3 +203,36 @@ def test_lockstep_bridge_changes_no_digest():
     assert bridged["digest"] == plain["digest"]
     assert bridged["process_digests"] == plain["process_digests"]
     assert bridged["refbox"]["commands_forwarded"] == sum(plain["events"].values())
+
+
+def test_via_refbox_our_base_stations_through_the_bridge(tmp_path):
+    """--via-refbox: both of our base stations take their commands over TCP from the bridge and
+    send their world model back as worldstates, which review scores against the ground truth."""
+    path = tmp_path / "via.mcap"
+    result = arena_json(
+        *("match", "--home", "BS", "--away", "AD", "--realtime", "--half-time", "3", "--seed", "2"),
+        *("--refbox", f"tcp/127.0.0.1:{free_port()}", "--via-refbox", "--record", str(path)),
+    )
+    counts = result["refbox"]["counts"]
+    assert counts["connections"] == 2 and "refused" not in counts
+    # WELCOME and every command from the first on; END_GAME may find a base station already gone.
+    for team in ("a", "b"):
+        assert 0 <= result["refbox"]["commands_forwarded"] + 1 - counts[f"commands_to_{team}"] <= 1
+    assert counts["worldstates_a"] > 20 and counts["worldstates_b"] > 20
+    review = json.loads(
+        subprocess.run([*ARENA, "review", str(path), "--json"], capture_output=True, text=True, timeout=120).stdout
+    )["worldstate_accuracy"]
+    for team in ("a", "b"):
+        assert review[team]["worldstates"] == counts[f"worldstates_{team}"]
+        for robot in review[team]["robots"].values():
+            assert robot["position_m"]["mean"] < 0.3  # their own localisation, a few cm of sensor noise and lag
+
+
+def test_via_refbox_is_refused_in_lockstep():
+    r = subprocess.run(
+        [*ARENA, "match", "--home", "BS", "--away", "BS", "--refbox", "--via-refbox"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 2 and "--via-refbox needs --realtime" in r.stderr and "Traceback" not in r.stderr
