@@ -1,10 +1,10 @@
 """Base station process: the team's fused world model, strategy and roles.
 
-Inputs: every robot's `report` (Wi-Fi, every comm period, phase 0, lag 1) and
-the `referee` frames (wired, lag 1; a frame with a command that is not an MSL
-RefBox command, or aimed at a team that does not exist, is rejected by
-`check_referee`). Every comm period (phase 1) it runs the strategy's team
-brain and sends one `order` per robot over Wi-Fi.
+Inputs: every robot's `report` (Wi-Fi) and the `referee` frames (wired; a
+frame that does not decode, or whose set piece has no team, is rejected). At
+every tick of the `order` schedule it runs the strategy's team brain and sends
+one `order` per robot over Wi-Fi. Schedules and lags are the keys'
+(`KeySpec.timing`, schemas/README.md).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import time
 
 from arena.rules.refbox_follow import ViaRefbox
 from arena.rules.referee_box import check_referee
-from arena.runtime.lockstep import Schedule, Waits
+from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.strategies import registry
 from arena.strategies.base import TeamContext
@@ -24,15 +24,9 @@ class BaseStationNode(Node):
         super().__init__(*args, **kwargs)
         cfg = self.cfg
         team = self.pid.team
-        comm = cfg.timing.comm_period
-        self.schedule = Schedule(comm, 1 % comm)
-        self.report_in = {
-            n: self.inp("report", team, n, schedule=Schedule(comm, 0), lag=1, sender=f"robot/{team}/{n}")
-            for n in range(cfg.robots)
-        }
-        self.ref_in = self.inp(
-            "referee", schedule=Schedule(cfg.timing.referee_period, 0), lag=1, sender="referee", check=check_referee
-        )
+        self.order_schedule = self.schedule("order")
+        self.report_in = {n: self.inp("report", team, n) for n in range(cfg.robots)}
+        self.ref_in = self.inp("referee", check=check_referee)
         self.order_out = {n: self.out("order", team, n) for n in range(cfg.robots)}
         strategy = registry.get(cfg.strategy_of(team))
         self.brain = strategy.make_team(TeamContext(cfg=cfg, team=team, rng=self.rng("strategy")))
@@ -57,7 +51,7 @@ class BaseStationNode(Node):
         self.timed(t0)
 
     def lockstep(self) -> Waits:
-        for k in self.schedule.ticks(self.cfg.total_ticks):
+        for k in self.order_schedule.ticks(self.cfg.total_ticks):
             for ib in self.report_in.values():
                 yield ib, k
             yield self.ref_in, k
@@ -76,7 +70,7 @@ class BaseStationNode(Node):
             r = self.ref_in.recv_clock()
             if r is None:
                 return
-            k = self.schedule.first_after(r)
+            k = self.order_schedule.first_after(r)
             if k > last:
                 return
             for ib in self.report_in.values():

@@ -40,7 +40,7 @@ from arena.rules import setpieces
 from arena.rules.referee_box import check_referee
 from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
-from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
+from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
 from arena.sim.drive import Drive
@@ -134,20 +134,14 @@ class EngineNode(Node):
         self.sensor_rng = {
             r: NormalStream(np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r))) for r in self.robots
         }
-        self.cmd_in = {
-            (team, n): self.inp(
-                "cmd", team, n, schedule=EVERY_TICK, lag=1, sender=f"robot/{team}/{n}", check=self.check_cmd
-            )
-            for team, n in self.robots
-        }
-        p = cfg.timing.referee_period
-        self.ref_in = self.inp("referee", schedule=Schedule(p, 0), lag=1, sender="referee", check=check_referee)
+        self.cmd_in = {(team, n): self.inp("cmd", team, n, check=self.check_cmd) for team, n in self.robots}
+        self.ref_in = self.inp("referee", check=check_referee)
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
         self.world_out = self.out("world", viewers_only=True)
         self.events_out = self.out("events")
         self.field_out = self.out("field")
-        self.events_schedule = Schedule(p, p - 1)
-        self.world_schedule = Schedule(cfg.timing.world_period, 0)
+        self.events_schedule = self.schedule("events")
+        self.world_schedule = self.schedule("world")
         self.pending_events: list = []
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
         self.transport.serve(self.keys.config(), cfg.to_json().encode())

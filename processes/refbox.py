@@ -22,7 +22,7 @@ from arena.rules import refbox_protocol as rp
 from arena.rules.refbox_server import BridgeServer
 from arena.rules.referee_box import check_referee
 from arena.runtime.config import TEAMS
-from arena.runtime.lockstep import Schedule, Waits
+from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node, StartupError
 from arena.schemas.messages import Worldstate
 
@@ -31,12 +31,9 @@ class RefboxNode(Node):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         cfg = self.cfg
-        p = cfg.timing.referee_period
-        self.schedule = Schedule(p, 0)
+        self.ref_schedule = self.schedule("referee")
         # Lag 0 and no emulation: forward each frame at its own tick, END_GAME included.
-        self.ref_in = self.inp(
-            "referee", schedule=self.schedule, lag=0, sender="referee", check=check_referee, ideal=True
-        )
+        self.ref_in = self.inp("referee", check=check_referee, ideal=True, lag=0)
         self.ws_out = {t: self.out("worldstate", t) for t in TEAMS}
         host, port = rp.parse_endpoint(cfg.refbox.listen)
         # Listening before the start barrier: a base station can connect while the match starts.
@@ -96,7 +93,7 @@ class RefboxNode(Node):
         return max(0, min(k, tick + round((wall - since) / self.cfg.timing.dt)))
 
     def lockstep(self) -> Waits:
-        for k in self.schedule.ticks(self.cfg.total_ticks):
+        for k in self.ref_schedule.ticks(self.cfg.total_ticks):
             yield self.ref_in, k
             self.act(k)
         self.finish()

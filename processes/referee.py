@@ -1,7 +1,7 @@
 """Referee process: runs the RefereeBox (referee_box.py) on the engine's ball events (G_Re).
 
-Inputs: `engine/events` every referee period (lag 1). Output: `referee` every
-referee period, a snapshot of the box's state plus the commands issued since
+Input: `engine/events`. Output: `referee`, on their schedules (`KeySpec.timing`,
+schemas/README.md): a snapshot of the box's state plus the commands issued since
 the previous frame (Re_G for the engine, and for both base stations).
 """
 
@@ -11,16 +11,15 @@ import time
 
 from arena.rules.refbox_follow import Follower
 from arena.rules.referee_box import RefereeBox
-from arena.runtime.lockstep import Schedule, Waits
+from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 
 
 class RefereeNode(Node):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        p = self.cfg.timing.referee_period
-        self.schedule = Schedule(p, 0)
-        self.events_in = self.inp("events", schedule=Schedule(p, p - 1), lag=1, sender="engine")
+        self.ref_schedule = self.schedule("referee")
+        self.events_in = self.inp("events")
         self.ref_out = self.out("referee")
         self.box = RefereeBox(self.cfg)
         # --refbox-follow: a human at a real MSL RefBox decides (docs/refbox.md); our rules only end the match.
@@ -35,7 +34,7 @@ class RefereeNode(Node):
         self.timed(t0)
 
     def lockstep(self) -> Waits:
-        for k in self.schedule.ticks(self.cfg.total_ticks):
+        for k in self.ref_schedule.ticks(self.cfg.total_ticks):
             yield self.events_in, k
             self.act(k)
 
@@ -46,7 +45,7 @@ class RefereeNode(Node):
             e = self.events_in.recv_clock()
             if e is None:
                 return
-            k = self.schedule.first_after(e)
+            k = self.ref_schedule.first_after(e)
             self.act(min(k, last))
             if k >= last:
                 return

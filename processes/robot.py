@@ -1,16 +1,16 @@
 """Robot process: perception in, behaviour, command out (one per robot).
 
-Inputs: `sense` from the engine every tick (lag 0: the robot acts on what it
-senses now) and its base station's `order` (Wi-Fi, every comm period, phase 1,
-lag 1). Outputs: `cmd` every tick (the engine applies it from the next tick on,
-a one-tick actuation delay) and a `report` every comm period (phase 0).
+Inputs: `sense` from the engine (the robot acts on what it senses now) and
+its base station's `order` (Wi-Fi). Outputs: `cmd` (the engine applies it from
+the next tick on, a one-tick actuation delay) and `report`. Schedules and lags
+are the keys' (`KeySpec.timing`, schemas/README.md).
 """
 
 from __future__ import annotations
 
 import time
 
-from arena.runtime.lockstep import EVERY_TICK, Schedule, Waits
+from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.strategies import registry
 from arena.strategies.base import RobotContext
@@ -21,12 +21,9 @@ class RobotNode(Node):
         super().__init__(*args, **kwargs)
         cfg = self.cfg
         team, n = self.pid.team, self.pid.robot
-        comm = cfg.timing.comm_period
-        self.report_schedule = Schedule(comm, 0)
-        self.sense_in = self.inp("sense", team, n, schedule=EVERY_TICK, lag=0, sender="engine")
-        self.order_in = self.inp(
-            "order", team, n, schedule=Schedule(comm, 1 % comm), lag=1, sender=f"basestation/{team}"
-        )
+        self.report_schedule = self.schedule("report")
+        self.sense_in = self.inp("sense", team, n)
+        self.order_in = self.inp("order", team, n)
         self.cmd_out = self.out("cmd", team, n)
         self.report_out = self.out("report", team, n)
         strategy = registry.get(cfg.strategy_of(team))

@@ -20,7 +20,9 @@ from typing import Any
 
 import msgspec
 
-TEAMS = ("a", "b")
+from arena.schemas.keys import DEFAULT_PERIODS
+from arena.schemas.vocabulary import TEAMS
+
 MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox")
 
@@ -148,15 +150,19 @@ class RulesParams:
 class TimingParams:
     dt: float = 0.02  # [s] control tick (50 Hz)
     substeps: int = 5  # physics steps per tick (250 Hz)
-    comm_period: int = 5  # [ticks] robot <-> base station Wi-Fi period (10 Hz)
-    referee_period: int = 5  # [ticks] engine events -> referee -> everyone (10 Hz)
-    world_period: int = 1  # [ticks] ground-truth `world` for viewers and the recorder
+    comm_period: int = DEFAULT_PERIODS["comm"]  # [ticks] robot <-> base station Wi-Fi period (10 Hz)
+    referee_period: int = DEFAULT_PERIODS["referee"]  # [ticks] engine events -> referee -> everyone (10 Hz)
+    world_period: int = DEFAULT_PERIODS["world"]  # [ticks] ground-truth `world` for viewers and the recorder
     startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
     # [s] wall: last-resort bound on one lockstep wait. Dead and hung peers are
     # caught by liveliness (~2 s, runtime/session.py); this catches a peer that
     # is alive but silent. Long, because everyone downstream of a stalled peer
     # waits too and must not be taken for dead.
     wait_timeout: float = 60.0
+
+    def periods(self) -> dict[str, int]:
+        """The periods the key table's schedules name (schemas/keys.py `Timing`), in ticks."""
+        return {"tick": 1, "comm": self.comm_period, "referee": self.referee_period, "world": self.world_period}
 
 
 @dataclass(frozen=True)

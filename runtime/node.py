@@ -109,14 +109,20 @@ class Node:
         team: str = "",
         n: int | None = None,
         *,
-        schedule: Schedule,
-        lag: int,
-        sender: str,
         check: Callable[[M], str | None] | None = None,
         ideal: bool = False,
+        lag: int | None = None,
     ) -> Inbound[Any]:
-        """An inbound key; `ideal`: no link emulation (a listener outside the modelled links)."""
+        """An inbound key, with the schedule, lag and sender of its `KeySpec` (schemas/keys.py)
+        and the periods of this match's configuration.
+
+        `ideal`: no link emulation (a listener outside the modelled links), which may
+        also take the frames with a shorter `lag` than the key's.
+        """
         spec = KEY_BY_NAME[name]
+        schedule = self.schedule(name)
+        lag = spec.timing.lag if lag is None else lag
+        sender = spec.sender_id(team, n)
         key = self.keys.key(name, team, n)
         model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
         emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
@@ -141,6 +147,10 @@ class Node:
             self.transport.subscribe_callback(key, functools.partial(self.reactor.on_frame, ib))
         self.inbound.append(ib)
         return ib
+
+    def schedule(self, name: str) -> Schedule:
+        """The schedule of key `name` in this match: its `Timing` with the configured periods."""
+        return Schedule(*KEY_BY_NAME[name].timing.schedule(self.cfg.timing.periods()))
 
     def rng(self, *path: object):
         """This process's own RNG for `path` (one per component)."""

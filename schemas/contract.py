@@ -15,7 +15,7 @@ import msgspec
 from msgspec import inspect as mi
 
 from arena.schemas import messages as m
-from arena.schemas.keys import ACK, ALIVE, COLLECTOR, CONFIG, KEYS, SUMMARY, TAP, TAP_PERIOD
+from arena.schemas.keys import ACK, ALIVE, COLLECTOR, CONFIG, DEFAULT_PERIODS, KEYS, SUMMARY, TAP, TAP_PERIOD, KeySpec
 
 README = Path(__file__).with_name("README.md")
 
@@ -47,25 +47,16 @@ Teams are `"a"` (home) and `"b"` (away); robots are numbered 0..N-1 and robot
 sender sends exactly one message per key at every tick of the key's schedule,
 and a receiver acts on tick k only with every message due by k: a client must
 send one message per scheduled tick, with consecutive scheduled ticks. A
-message whose tick is not the next scheduled one is rejected. Schedules (in
-ticks, with the defaults comm period = referee period = 5):
+message whose tick is not the next scheduled one is rejected.
 
-| key | sent at ticks | delivered to the receiver at the earliest |
-|---|---|---|
-| `sense` | every tick | same tick |
-| `cmd` | every tick | next tick (the engine applies tick-k commands from k+1) |
-| `report` | 0, 5, 10, ... | next tick, later if the Wi-Fi link delays it |
-| `order` | 1, 6, 11, ... | next tick, later if the Wi-Fi link delays it |
-| `engine/events` | 4, 9, 14, ... | next tick |
-| `referee` | 0, 5, 10, ... | next tick |
-| `world` | every tick | (for viewers; nobody waits for it) |
+{SCHEDULES}
 
 Link emulation (latency, jitter, Gilbert-Elliott loss) is applied by the
 receiver; delays are rounded up to the receiver's next tick.
 
 ## Keys
 
-| data pair | key expression | message | sender -> receivers | rate | link class |
+| data pair | key expression | message | sender -> receivers | schedule | link class |
 |---|---|---|---|---|---|
 """
 
@@ -144,12 +135,50 @@ def _nested(t: mi.Type, out: list[type]) -> None:
         _nested(t.value_type, out)
 
 
+def _rate(k: KeySpec) -> str:
+    """The Keys table's schedule column: which period, from `KeySpec.timing`."""
+    if k.timing.period is None:
+        return k.note
+    if k.timing.period == "tick":
+        return "every tick"
+    return f"every {k.timing.period} period"
+
+
+def _sent_at(k: KeySpec, periods: dict[str, int]) -> str:
+    p, phase = k.timing.schedule(periods)
+    return "every tick" if p == 1 else f"{phase}, {phase + p}, {phase + 2 * p}, ..."
+
+
+def _delivered(k: KeySpec) -> str:
+    lag = k.timing.lag
+    when = {0: "same tick", 1: "next tick"}.get(lag, f"{lag} ticks later")
+    if k.link_class == "wifi":
+        when += ", later if the Wi-Fi link delays it"
+    return f"{when} ({k.note})" if k.note else when
+
+
+def schedules(periods: dict[str, int] | None = None) -> str:
+    """The schedule table, rendered from the keys' `Timing` and the periods (default: the configuration's)."""
+    periods = dict(DEFAULT_PERIODS if periods is None else periods)
+    named = ", ".join(f"{name} period = {p}" for name, p in periods.items() if name != "tick")
+    rows = [
+        f"Schedules (in ticks, with the default periods: {named}; a match's configuration may change them):",
+        "",
+        "| key | sent at ticks | delivered to the receiver at the earliest (lag) |",
+        "|---|---|---|",
+    ]
+    for k in KEYS:
+        if k.timing.period is not None:
+            rows.append(f"| `{k.pattern}` | {_sent_at(k, periods)} | {_delivered(k)} |")
+    return "\n".join(rows)
+
+
 def render() -> str:
-    lines = [HEADER.rstrip("\n")]
+    lines = [HEADER.rstrip("\n").replace("{SCHEDULES}", schedules())]
     for k in KEYS:
         lines.append(
             f"| {k.data_pair} | `arena/<match>/{k.pattern}` | [{k.message.__name__}](#{k.message.__name__.lower()}) "
-            f"| {k.sender} -> {k.receivers} | {k.rate} | {k.link_class} |"
+            f"| {k.sender} -> {k.receivers} | {_rate(k)} | {k.link_class} |"
         )
     lines.append(INFRA.rstrip("\n"))
     lines.append("")

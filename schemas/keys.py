@@ -7,6 +7,7 @@ recorder and the process wiring are derived from.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from arena.schemas import messages as m
@@ -21,16 +22,47 @@ def check_match_id(match: str) -> str:
     return match
 
 
+# The match's periods in ticks, by name. Each link's schedule names one of them;
+# the values are the defaults of runtime.config.TimingParams (which reads them
+# from here), and a match's own values come from its configuration.
+DEFAULT_PERIODS: dict[str, int] = {"tick": 1, "comm": 5, "referee": 5, "world": 1}
+
+
+@dataclass(frozen=True)
+class Timing:
+    """A link's schedule and lag, as data.
+
+    The sender sends one frame at every tick phase, phase + P, phase + 2P, ...,
+    where P is the match's period named `period` ("tick", "comm", "referee" or
+    "world"; see `DEFAULT_PERIODS`) and `phase` is taken modulo P (so -1 is the
+    last tick of each period). A frame sent at tick s is delivered at tick
+    s + `lag` at the earliest. `period=None`: not a lockstep link (sent once, or
+    whenever its sender likes); nobody waits for it.
+    """
+
+    period: str | None
+    phase: int = 0
+    lag: int = 1
+
+    def schedule(self, periods: Mapping[str, int]) -> tuple[int, int]:
+        """(period, phase) in ticks for a match whose periods are `periods`."""
+        if self.period is None:
+            raise ValueError("not a scheduled link")
+        p = periods[self.period]
+        return p, self.phase % p
+
+
 @dataclass(frozen=True)
 class KeySpec:
     name: str  # short name used in code and docs
     pattern: str  # relative to arena/<match>/, with <team> and <n> placeholders
     message: type[m.Base]
     data_pair: str  # the paper's name (Fig. 1 and 2)
-    sender: str
+    sender: str  # the sending process id, with <team> and <n> placeholders
     receivers: str
-    rate: str
+    timing: Timing
     link_class: str  # which link model applies on the receiving side
+    note: str = ""  # what the schedule table adds about delivery
 
     def rel(self, team: str = "", n: int | None = None) -> str:
         key = self.pattern.replace("<team>", team)
@@ -38,45 +70,58 @@ class KeySpec:
             key = key.replace("<n>", str(n))
         return key
 
+    def sender_id(self, team: str = "", n: int | None = None) -> str:
+        """The process id of the sender of this key for (team, n)."""
+        sid = self.sender.replace("<team>", team)
+        return sid.replace("<n>", str(n)) if n is not None else sid
+
+
+EVERY_TICK = Timing("tick", 0, lag=1)
 
 KEYS: tuple[KeySpec, ...] = (
-    KeySpec("field", "field", m.FieldSpec, "S_G / G_S", "engine", "all", "once, at tick 0", "wired"),
-    KeySpec("sense", "robot/<team>/<n>/sense", m.Sense, "G_R_n", "engine", "robot n", "every tick (50 Hz)", "sensor"),
-    KeySpec("cmd", "robot/<team>/<n>/cmd", m.Cmd, "R_n_G", "robot n", "engine", "every tick (50 Hz)", "sensor"),
+    KeySpec("field", "field", m.FieldSpec, "S_G / G_S", "engine", "all", Timing(None), "wired", "once, at tick 0"),
+    KeySpec(
+        "sense", "robot/<team>/<n>/sense", m.Sense, "G_R_n", "engine", "robot n", Timing("tick", 0, lag=0), "sensor"
+    ),
+    KeySpec(
+        "cmd",
+        "robot/<team>/<n>/cmd",
+        m.Cmd,
+        "R_n_G",
+        "robot/<team>/<n>",
+        "engine",
+        EVERY_TICK,
+        "sensor",
+        "the engine applies tick-k commands from k+1",
+    ),
     KeySpec(
         "report",
         "team/<team>/report/<n>",
         m.Report,
         "R_n_B",
-        "robot n",
+        "robot/<team>/<n>",
         "base station",
-        "every comm period (10 Hz)",
+        Timing("comm", 0),
         "wifi",
     ),
     KeySpec(
-        "order",
-        "team/<team>/order/<n>",
-        m.Order,
-        "B_R_n",
-        "base station",
-        "robot n",
-        "every comm period (10 Hz)",
-        "wifi",
+        "order", "team/<team>/order/<n>", m.Order, "B_R_n", "basestation/<team>", "robot n", Timing("comm", 1), "wifi"
     ),
     KeySpec(
-        "referee",
-        "referee",
-        m.Referee,
-        "Re_G, Re_B",
-        "referee",
-        "engine, base stations",
-        "every referee period (10 Hz)",
-        "wired",
+        "referee", "referee", m.Referee, "Re_G, Re_B", "referee", "engine, base stations", Timing("referee", 0), "wired"
     ),
+    KeySpec("events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", Timing("referee", -1), "wired"),
     KeySpec(
-        "events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", "every referee period (10 Hz)", "wired"
+        "world",
+        "world",
+        m.World,
+        "G_V",
+        "engine",
+        "recorder, viewers",
+        Timing("world", 0),
+        "ideal",
+        "for viewers; nobody waits for it",
     ),
-    KeySpec("world", "world", m.World, "G_V", "engine", "recorder, viewers", "every world period (50 Hz)", "ideal"),
     KeySpec(
         "worldstate",
         "refbox/<team>/worldstate",
@@ -84,8 +129,9 @@ KEYS: tuple[KeySpec, ...] = (
         "B_RefBox",
         "refbox",
         "recorder",
-        "as the team's base station sends it (--refbox only)",
+        Timing(None),
         "ideal",
+        "as the team's base station sends it (--refbox only)",
     ),
 )
 

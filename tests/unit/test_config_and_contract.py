@@ -97,3 +97,22 @@ def test_contract_has_one_row_per_key_and_a_section_per_message():
     for spec in KEYS:
         assert f"`arena/<match>/{spec.pattern}`" in text
         assert f"### {spec.message.__name__}" in text
+
+
+def test_link_timing_is_data_the_contract_and_the_nodes_read():
+    """Schedules and lags live in KeySpec.timing; the contract renders them, the periods come from the config."""
+    from pathlib import Path
+
+    from arena.runtime.config import TimingParams
+    from arena.schemas.keys import KEY_BY_NAME
+
+    assert TimingParams().periods() == {"tick": 1, "comm": 5, "referee": 5, "world": 1}
+    periods = TimingParams(comm_period=4, referee_period=10).periods()
+    assert KEY_BY_NAME["order"].timing.schedule(periods) == (4, 1)
+    assert KEY_BY_NAME["events"].timing.schedule(periods) == (10, 9)
+    assert KEY_BY_NAME["sense"].timing.lag == 0 and KEY_BY_NAME["cmd"].timing.lag == 1
+    table = contract.schedules(periods)
+    assert "| `team/<team>/order/<n>` | 1, 5, 9, ... |" in table
+    assert "| `engine/events` | 9, 19, 29, ... |" in table
+    source = Path(contract.__file__).read_text()
+    assert "0, 5, 10" not in source and "4, 9, 14" not in source, "no hand-typed timing in contract.py"
