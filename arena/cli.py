@@ -27,6 +27,7 @@ EXAMPLES = {
   arena match --home AD --away BS --link congested-wifi --link-param wifi.latency_ms=30
   arena match --home BS --away BS --external a/1      # start robot a/1 by hand (HIL)
   arena match --home BS --away BS --realtime --half-time 5
+  arena match --config match.toml      # field, robot, rules, timing, links from a file (arena config --print)
   arena match --home BS --away AD --half-time 60 --record match.mcap   # then: arena review match.mcap
   arena match --home BS --away BS --half-time 10 --strict   # any crashed process ends the match, exit 1
   arena match --home BS --away BS --realtime --half-time 300 --refbox   # base stations connect to TCP 28097
@@ -74,6 +75,10 @@ EXAMPLES = {
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
   arena replay match.mcap --process basestation/b --json
   arena replay match.mcap --process all                # every process of the match""",
+    "config": """examples:
+  arena config --print > match.toml           # every key with its default, unit and meaning
+  arena match --config match.toml --seed 3    # flags given on the command line win over the file
+  arena config --check match.toml             # one line naming the bad key, or the whole file completed""",
     "strategies": """examples:
   arena strategies                 # every strategy, built-in or plugin, and whether it passes the conformance suite
   arena strategies AD my-plugin    # only these
@@ -144,17 +149,18 @@ def package_version() -> str:
 def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = True) -> None:
     p.add_argument("--home", required=required, metavar="STRATEGY", help="team a's strategy (name or BS/BD/AS/AD)")
     p.add_argument("--away", required=required, metavar="STRATEGY", help="team b's strategy")
-    p.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team, goalkeeper included (3)")
+    # Defaults of None: the match's own default, or --config FILE's value, applies (match_config).
+    p.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team, goalkeeper included (3)")
     p.add_argument(
         "--half-time",
         type=half_time,
-        default=300.0,
+        default=None,
         metavar="SECONDS",
         help=f"simulated half length [s], at most {MAX_HALF_TIME:g} (300)",
     )
     if seed:
-        p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (0)")
-    p.add_argument("--link", default="ideal", metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
+        p.add_argument("--seed", type=int, default=None, metavar="N", help="master seed (0)")
+    p.add_argument("--link", default=None, metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
     p.add_argument(
         "--link-param",
         action="append",
@@ -184,7 +190,14 @@ def build_parser() -> Parser:
         )
 
     m = add("match", "play one match, every process its own OS process, and print the score")
-    _add_match_flags(m, required=True)
+    _add_match_flags(m, required=False)
+    m.add_argument(
+        "--config",
+        dest="config_file",
+        metavar="FILE.toml",
+        help="the match's configuration: field, robot, rules, timing, links (arena config --print writes one); "
+        "flags given here win",
+    )
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
     m.add_argument(
         "--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand"
@@ -359,6 +372,11 @@ def build_parser() -> Parser:
     )
     y.add_argument("--json", action="store_true", help="print JSON instead of text")
 
+    cf = add("config", "the match configuration file: print the defaults, or check a file (arena match --config)")
+    cg = cf.add_mutually_exclusive_group(required=True)
+    cg.add_argument("--print", dest="print_defaults", action="store_true", help="write the defaults as TOML to stdout")
+    cg.add_argument("--check", metavar="FILE.toml", help="validate FILE and print it completed with the defaults")
+
     st = add("strategies", "list the strategies: built-ins and installed plugins, with their conformance status")
     st.add_argument("names", nargs="*", metavar="NAME", help="only these strategies (names or aliases)")
     st.add_argument("--no-check", action="store_true", help="skip the conformance suite (~1.5 s per strategy)")
@@ -379,16 +397,27 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=(), 
     for text in args.link_param:
         cls, param, value = parse_override(text)
         overrides.setdefault(cls, {})[param] = value
-    resolve(args.link, overrides)  # validates preset, classes and values
-    home = registry.resolve_name(args.home) if args.home else "basic-static"
-    away = registry.resolve_name(args.away) if args.away else "basic-static"
-    cfg = MatchConfig(
-        seed=args.seed if args.seed is not None else 0,
+    base = MatchConfig()
+    if getattr(args, "config_file", None):
+        from arena.runtime import matchfile
+
+        base = matchfile.load(args.config_file)
+    link = args.link if args.link is not None else base.link
+    if args.link is None:  # the file's overrides, then the flags' on top
+        merged = {cls: dict(ps) for cls, ps in base.link_overrides.items()}
+        for cls, ps in overrides.items():
+            merged.setdefault(cls, {}).update(ps)
+        overrides = merged
+    resolve(link, overrides)  # validates preset, classes and values
+    home = registry.resolve_name(args.home or base.home)
+    away = registry.resolve_name(args.away or base.away)
+    cfg = base.replace(
+        seed=args.seed if args.seed is not None else base.seed,
         home=home,
         away=away,
-        robots=args.robots,
-        half_time=args.half_time,
-        link=args.link,
+        robots=args.robots if args.robots is not None else base.robots,
+        half_time=args.half_time if args.half_time is not None else base.half_time,
+        link=link,
         link_overrides=overrides,
         realtime=realtime,
         record=record,
@@ -425,6 +454,9 @@ def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
 def cmd_match(args: argparse.Namespace) -> int:
     from arena.tools import launcher
 
+    missing = [f for f, v in (("--home", args.home), ("--away", args.away)) if v is None]
+    if missing and not args.config_file:
+        raise ConfigError(f"the following arguments are required: {', '.join(missing)} (or give them in --config FILE)")
     record = record_path(args.record) if args.record else ""
     cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
     cfg = cfg.replace(refbox=refbox_params(args))
@@ -679,6 +711,14 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return replay.main(args.file, args.process, as_json=args.json)
 
 
+def cmd_config(args: argparse.Namespace) -> int:
+    from arena.runtime import matchfile
+
+    cfg = matchfile.load(args.check) if args.check else None
+    sys.stdout.write(matchfile.dump(cfg))
+    return 0
+
+
 def cmd_strategies(args: argparse.Namespace) -> int:
     from arena.strategies import registry
 
@@ -719,6 +759,7 @@ def main(argv: list[str] | None = None) -> int:
         "bench": cmd_bench,
         "schemas": cmd_schemas,
         "strategies": cmd_strategies,
+        "config": cmd_config,
         "tournament": cmd_tournament,
         "review": cmd_review,
         "facts": cmd_facts,

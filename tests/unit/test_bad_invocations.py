@@ -93,6 +93,11 @@ BAD = [
     (["replay", "/nonexistent.mcap", "--process", "a/1"], "cannot read"),
     (["replay", "{file}", "--process", "a/1"], "not an MCAP file"),
     (["replay", "/nonexistent.mcap"], "required: --process"),
+    # arena config
+    (["config"], "one of the arguments --print --check is required"),
+    (["config", "--check", "/nonexistent.toml"], "cannot read"),
+    (["config", "--check", "{file}"], "not valid TOML"),
+    (["match", "--config", "{file}"], "not valid TOML"),
     # arena strategies
     (["strategies", "tiki-taka"], "unknown strategy 'tiki-taka'"),
     (["strategies", "--check"], "unrecognized arguments: --check"),

@@ -1,0 +1,163 @@
+"""A match configuration file (TOML): `arena match --config FILE.toml`, `arena config --print`.
+
+The file holds the `MatchConfig` tree a user may want to change: the match
+(seed, strategies, robots, half time), `[links]` (the preset and per-class
+overrides), and `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and
+`[timing]`. Every key is optional; a missing one keeps its default. An unknown
+key, a wrong type or a value out of range is a `ConfigError` that names the key
+(`field.lenght`, `robot.mass`). `dump()` writes the defaults with each key's
+unit and meaning taken from the comments in runtime/config.py, so the printed
+file documents itself. Deployment matters (real time, --external, --record,
+the RefBox bridge) stay command-line flags.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import math
+import re
+import tomllib
+from typing import Any
+
+from arena.runtime.config import ConfigError, MatchConfig
+
+TOP = ("seed", "home", "away", "robots", "half_time")
+SECTIONS = ("field", "robot", "ball", "sensor", "rules", "timing")
+
+
+def _comments(cls: type) -> dict[str, str]:
+    """`name: type = value  # comment` lines of a dataclass's source: name -> comment."""
+    try:
+        source = inspect.getsource(cls)
+    except (OSError, TypeError):
+        return {}
+    return dict(re.findall(r"^\s+(\w+): [^=\n]+=[^#\n]*#\s*(.+)$", source, flags=re.M))
+
+
+def _known(section: str) -> dict[str, Any]:
+    return {f.name: f for f in dataclasses.fields(getattr(MatchConfig(), section))}
+
+
+def _check_keys(data: dict[str, Any], where: str) -> None:
+    allowed_top = set(TOP) | set(SECTIONS) | {"links"}
+    for key in data:
+        if key not in allowed_top:
+            raise ConfigError(f"{where}: unknown key {key!r} (known: {', '.join(sorted(allowed_top))})")
+    for section in SECTIONS:
+        table = data.get(section, {})
+        if not isinstance(table, dict):
+            raise ConfigError(f"{where}: {section} must be a table ([{section}])")
+        known = _known(section)
+        for key in table:
+            if key not in known:
+                raise ConfigError(f"{where}: unknown key {section}.{key} (known: {', '.join(known)})")
+
+
+def _check_values(cfg: MatchConfig, where: str) -> None:
+    """Every number finite; sizes, masses and times positive (the engine cannot play a 0 m field)."""
+    for section in SECTIONS:
+        params = getattr(cfg, section)
+        for f in dataclasses.fields(params):
+            value = getattr(params, f.name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                continue
+            if not math.isfinite(value) or value < 0:
+                raise ConfigError(f"{where}: {section}.{f.name} must be a finite number >= 0, got {value}")
+            if section in ("field", "ball", "timing") and value == 0:
+                raise ConfigError(f"{where}: {section}.{f.name} must be > 0")
+    fp = cfg.field
+    if fp.goal_width >= fp.width or fp.penalty_area_width >= fp.width or fp.penalty_area_depth * 2 >= fp.length:
+        raise ConfigError(f"{where}: field: the goal and the penalty areas must fit inside the field")
+
+
+def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
+    """A parsed TOML document as `MatchConfig.from_dict` input, keys checked."""
+    _check_keys(data, where)
+    out = {k: data[k] for k in TOP if k in data}
+    for section in SECTIONS:
+        if section in data:
+            out[section] = dict(data[section])
+    links = data.get("links", {})
+    if not isinstance(links, dict):
+        raise ConfigError(f"{where}: links must be a table ([links])")
+    if "preset" in links:
+        out["link"] = links["preset"]
+    overrides = {k: v for k, v in links.items() if k != "preset"}
+    for cls, params in overrides.items():
+        if not isinstance(params, dict):
+            raise ConfigError(f"{where}: unknown key links.{cls} (known: preset, and one table per link class)")
+    if overrides:
+        out["link_overrides"] = overrides
+    return out
+
+
+def load(path: str) -> MatchConfig:
+    """Read and validate FILE.toml; ConfigError naming the file and the bad key."""
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except OSError as exc:
+        raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"--config {path} is not valid TOML: {exc}") from None
+    raw = to_dict(data, path)
+    try:
+        cfg = MatchConfig.from_dict(raw)
+    except ConfigError as exc:
+        text = str(exc)
+        # msgspec says "... - at `$.field.length`": name the key as the file spells it
+        m = re.search(r"(.*?) - at `\$\.(.+?)`", text)
+        if m:
+            key = m.group(2).replace("link_overrides", "links")
+            raise ConfigError(f"{path}: {key}: {m.group(1).replace('invalid match configuration: ', '')}") from None
+        raise ConfigError(f"{path}: {text}") from None
+    from arena.runtime.links import resolve
+
+    try:
+        resolve(cfg.link, cfg.link_overrides)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: links: {exc}") from None
+    _check_values(cfg, path)
+    return cfg
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, int):
+        return str(value)
+    return '"' + str(value).replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def dump(cfg: MatchConfig | None = None) -> str:
+    """`cfg` (default: the defaults) as a commented TOML file that `load` reads back to the same values."""
+    cfg = cfg or MatchConfig()
+    top_notes = _comments(MatchConfig)
+    lines = [
+        "# soccer-arena match configuration: arena match --config FILE.toml",
+        "# Every key is optional (a missing one keeps this default); flags given on the command line win.",
+        "",
+    ]
+    for key in TOP:
+        note = top_notes.get(key)
+        lines.append(f"{key} = {_toml_value(getattr(cfg, key))}" + (f"  # {note}" if note else ""))
+    lines += ["", "[links]", f"preset = {_toml_value(cfg.link)}  # ideal | lan | wifi | congested-wifi"]
+    lines.append(
+        "# per-class overrides, e.g. [links.wifi] latency_ms = 30 (arena match --link-param wifi.latency_ms=30)"
+    )
+    for cls, params in sorted(cfg.link_overrides.items()):
+        lines += ["", f"[links.{cls}]"] + [f"{p} = {_toml_value(v)}" for p, v in sorted(params.items())]
+    for section in SECTIONS:
+        params = getattr(cfg, section)
+        notes = _comments(type(params))
+        doc = (inspect.getdoc(type(params)) or "").splitlines()
+        if doc and doc[0].startswith(type(params).__name__ + "("):
+            doc = []  # dataclass's generated signature, not a description
+        lines += [""] + ([f"# {doc[0]}"] if doc else []) + [f"[{section}]"]
+        for f in dataclasses.fields(params):
+            note = notes.get(f.name)
+            lines.append(f"{f.name} = {_toml_value(getattr(params, f.name))}" + (f"  # {note}" if note else ""))
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,62 @@
+"""Issue 19: `arena match --config FILE.toml` and `arena config --print`."""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+
+from arena.runtime import matchfile
+from arena.runtime.config import ConfigError, MatchConfig
+from tests.integration.helpers import ARENA, arena_json
+
+
+def test_the_printed_defaults_read_back_as_the_defaults(tmp_path):
+    r = subprocess.run([*ARENA, "config", "--print"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    path = tmp_path / "match.toml"
+    path.write_text(r.stdout)
+    assert matchfile.load(str(path)) == MatchConfig()
+    assert "length = 12.0  # [m] goal line to goal line" in r.stdout, "keys carry their units"
+
+
+def test_a_custom_field_size_plays_a_match(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(
+        'home = "AD"\naway = "BS"\nhalf_time = 2\n[field]\nlength = 9.0\nwidth = 6.0\npenalty_area_width = 4.0\n'
+    )
+    small = arena_json("match", "--config", str(path), "--seed", "2")
+    assert (small["home"], small["away"], small["half_time"], small["ticks"]) == (
+        "advance-dynamic",
+        "basic-static",
+        2.0,
+        200,
+    )
+    normal = arena_json("match", "--home", "AD", "--away", "BS", "--half-time", "2", "--seed", "2")
+    assert small["digest"] != normal["digest"], "the engine played on the file's field"
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[field]\nlenght = 9\n", "unknown key field.lenght"),
+        ('[field]\nlength = "long"\n', "field.length: Expected `float`, got `str`"),
+        ("[field]\nlength = -9\n", "field.length must be a finite number >= 0"),
+        ("[robot]\nmass = nan\n", "robot.mass must be a finite number"),
+        ("colour = 3\n", "unknown key 'colour'"),
+        ("[links]\npreset = '5g'\n", "unknown link preset '5g'"),
+        ("[links.wifi]\nwarp = 9\n", "unknown link parameter 'warp'"),
+        ("half_time = 1e12\n", "--half-time must be at most 3600 s"),
+        ("[timing]\nstartup_timeout = -1\n", "timing.startup_timeout"),
+        ("[field\n", "not valid TOML"),
+    ],
+)
+def test_a_bad_key_is_one_line_naming_it(tmp_path, text, needle):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=None) as caught:
+        matchfile.load(str(path))
+    assert needle in str(caught.value) and str(path) in str(caught.value)
+    r = subprocess.run([*ARENA, "match", "--config", str(path)], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert needle in r.stderr and "Traceback" not in r.stderr
