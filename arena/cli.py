@@ -35,14 +35,20 @@ EXAMPLES = {
   arena match --home BS --away BS --refbox --refbox-teams msl_teams.json --refbox-wait 2 --realtime
   arena match --home BS --away BS --realtime --refbox-follow 192.168.1.2:28097   # a human runs the RefBox
   arena match --home BS --away AD --realtime --half-time 30 --refbox --via-refbox   # ours through the bridge
-  arena match --home AD --away AD --half-time 60 --engine inprocess    # every node in one process, same digests""",
+  arena match --home AD --away AD --half-time 60 --engine inprocess    # every node in one process, same digests
+
+  arena match --home BS --away AD --half-time 60 --live          # watch in Foxglove: ws://127.0.0.1:8765
+  arena match --home BS --away AD --live 9000 --pace 4           # four times real time, port 9000
+  arena match --home BS --away BS --realtime --half-time 5 --live --live-host 0.0.0.0""",
     "run": """examples:
   # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
   arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
   # a recorder on another machine (the match was started with --record ... --external recorder)
-  arena run recorder --match demo --connect tcp/192.168.1.10:7447 --record out.mcap""",
+  arena run recorder --match demo --connect tcp/192.168.1.10:7447 --record out.mcap
+  # watch a running match in Foxglove (ws://127.0.0.1:8765); pause/step need arena match --live
+  arena run viewer --match demo --connect tcp/192.168.1.10:7447 --port 8765""",
     "up": """examples:
   arena up compose.yaml            # the services of compose.yaml as local processes
   arena up compose.yaml --json""",
@@ -66,7 +72,8 @@ EXAMPLES = {
     "review": """examples:
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
-  arena review match.mcap --plots plots/     # PNG charts and an animated GIF of the match""",
+  arena review match.mcap --plots plots/     # PNG charts and an animated GIF of the match
+  arena review match.mcap --html replay.html # one self-contained HTML page that replays the match""",
     "facts": """examples:
   arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
   arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
@@ -261,6 +268,23 @@ def build_parser() -> Parser:
         help="our base stations take referee commands over TCP from the bridge (needs --refbox and --realtime)",
     )
     m.add_argument("--engine", **ENGINE_FLAG)
+    m.add_argument(
+        "--live",
+        nargs="?",
+        type=int,
+        const=8765,
+        metavar="PORT",
+        help="start a viewer: the Foxglove app connects to ws://127.0.0.1:PORT (8765); in lockstep the "
+        "viewer's parameters pause, step and pace the match",
+    )
+    m.add_argument(
+        "--pace",
+        type=float,
+        metavar="X",
+        help="with --live in lockstep: X simulated seconds per wall second (1.0 = real time, the default "
+        "with --live; 0 = as fast as it goes). It only waits: the result is the same",
+    )
+    m.add_argument("--live-host", default="127.0.0.1", metavar="HOST", help="with --live: the address to serve on")
 
     r = add("run", "start one process of a match on its own (hardware-in-the-loop)")
     r.add_argument("kind", choices=[*KINDS, "router"], help="process kind")
@@ -282,6 +306,10 @@ def build_parser() -> Parser:
         "--record",
         metavar="PATH",
         help="recorder: write the MCAP file here; engine without --config: the match records",
+    )
+    r.add_argument("--host", default="127.0.0.1", metavar="HOST", help="viewer: the address to serve on (127.0.0.1)")
+    r.add_argument(
+        "--port", type=int, metavar="PORT", help="viewer: the Foxglove WebSocket port (the match's, or 8765)"
     )
     eng = r.add_argument_group("engine only: the match it hosts when no --config is given")
     _add_match_flags(eng, required=False, seed=False)
@@ -460,6 +488,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     record = record_path(args.record) if args.record else ""
     cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
     cfg = cfg.replace(refbox=refbox_params(args))
+    cfg = live_config(cfg, args.live, args.pace, args.live_host)
     if args.match:
         from arena.schemas.keys import check_match_id
 
@@ -484,6 +513,7 @@ def cmd_match(args: argparse.Namespace) -> int:
             log_dir=args.logs,
             announce=lambda text: print(text, file=sys.stderr, flush=True),
             strict=args.strict,
+            live_host=args.live_host,
         )
     except launcher.MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
@@ -553,6 +583,7 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig) -> int:
         ("--logs", args.logs),
         ("--refbox", args.refbox),
         ("--refbox-follow", args.refbox_follow),
+        ("--live", args.live is not None),
     ):
         if given:
             raise ConfigError(f"{flag} needs --engine processes (inprocess plays lockstep in one process)")
@@ -562,6 +593,33 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig) -> int:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 1
     return emit_match(result, args.json)
+
+
+def live_config(cfg: MatchConfig, live: int | None, pace: float | None, host: str = "127.0.0.1") -> MatchConfig:
+    """`--live [PORT]` and `--pace X`: a viewer, and in lockstep a paced, pausable engine."""
+    import dataclasses
+    import socket
+
+    if live is None:
+        if pace is not None:
+            raise ConfigError("--pace needs --live")
+        return cfg
+    if pace is not None and cfg.realtime:
+        raise ConfigError("--pace applies to lockstep; --realtime already plays at the wall clock's speed")
+    pace = 0.0 if cfg.realtime else (1.0 if pace is None else pace)
+    if 0 < live <= 65535:
+        # A port in use would stop the viewer after every other process had started: say so now.
+        with socket.socket() as s:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                s.bind((host, live))
+            except OSError as exc:
+                raise ConfigError(f"--live {live}: cannot serve on {host}:{live}: {exc.strerror}") from None
+    timing = cfg.timing
+    if not cfg.realtime:
+        # Everybody waits while the viewer pauses the engine: a pause is not a failure.
+        timing = dataclasses.replace(timing, wait_timeout=max(timing.wait_timeout, 3600.0))
+    return cfg.replace(live=live, pace=pace, timing=timing)
 
 
 def record_path(text: str) -> str:
@@ -599,6 +657,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             cfg = match_config(args, realtime=args.realtime, record=record_path(args.record) if args.record else "")
         if args.record and args.kind not in ("engine", "recorder"):
             raise ConfigError(f"--record does not apply to {args.kind}")
+        if args.port is not None and (args.kind != "viewer" or not 0 <= args.port <= 65535):
+            raise ConfigError("--port applies to the viewer only, 0..65535")
         record = record_path(args.record) if args.record and args.kind == "recorder" else None
         from arena.schemas.keys import check_match_id
 
@@ -607,7 +667,17 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"arena run: error: {exc}", file=sys.stderr)
         return 2
     return runner.main_guarded(
-        runner.run, pid, args.match, net, cfg, args.seed, args.realtime, args.startup_timeout, record
+        runner.run,
+        pid,
+        args.match,
+        net,
+        cfg,
+        args.seed,
+        args.realtime,
+        args.startup_timeout,
+        record,
+        args.host,
+        args.port,
     )
 
 

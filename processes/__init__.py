@@ -1,5 +1,5 @@
 """The process kinds and nothing else: one module per kind (engine, referee,
-basestation, robot, recorder, refbox), all shaped the same: a `Node` subclass with its
+basestation, robot, recorder, refbox, viewer), all shaped the same: a `Node` subclass with its
 wiring, `act` and its loops; argument parsing stays in arena/cli.py. The
 library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
 `arena.strategies`, `arena.runtime`, `arena.schemas`. Only `arena.tools` and
@@ -17,6 +17,7 @@ NODES = {
     "robot": ("arena.processes.robot", "RobotNode"),
     "recorder": ("arena.processes.recorder", "RecorderNode"),
     "refbox": ("arena.processes.refbox", "RefboxNode"),
+    "viewer": ("arena.processes.viewer", "ViewerNode"),
 }
 
 

@@ -42,6 +42,7 @@ from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
+from arena.runtime.pace import Pacer
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics
@@ -144,7 +145,28 @@ class EngineNode(Node):
         self.world_schedule = self.schedule("world")
         self.pending_events: list = []
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
+        self.pacer = self._live_pacer()
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
+
+    def _live_pacer(self) -> Pacer | None:
+        """A live lockstep match (`--live`): the viewer's pace, pause and steps (runtime/pace.py)."""
+        if self.cfg.live < 0 or self.cfg.realtime:
+            return None
+        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log)
+        key = self.keys.control()
+
+        def on_control(raw: bytes) -> None:
+            problem = pacer.control_raw(raw)
+            if problem:
+                self.rejections.reject(key, "malformed", problem)
+
+        if self.reactor is not None:
+            self.transport.subscribe_callback(key, on_control)
+            pacer.start(self.reactor.poke)
+        else:
+            channel = self.transport.subscribe(key)
+            pacer.pull_from(channel.try_recv)
+        return pacer
 
     def check_cmd(self, cmd: Cmd) -> str | None:
         return check_cmd(cmd, self.wheels)
@@ -210,6 +232,14 @@ class EngineNode(Node):
             total_ticks=cfg.total_ticks,
         )
 
+    def loop(self) -> None:
+        if self.pacer is not None:
+            # A live match: the viewer's state now (a pause set before the start holds tick 0).
+            raw = self.transport.query(self.keys.control(), timeout=2.0)
+            if raw is not None and self.pacer.control_raw(raw):
+                self.rejections.reject(self.keys.control(), "malformed", "the viewer's control state")
+        super().loop()
+
     def lockstep(self) -> Waits:
         # The field frame is part of the loop, not of `loop()`: whoever drives the
         # generator (Reactor, pull, the cooperative driver of tools/inprocess.py)
@@ -217,7 +247,10 @@ class EngineNode(Node):
         self.field_out.send(self.field_spec())
         last = self.cfg.total_ticks
         ph = self.physics
+        pacer = self.pacer
         for k in range(last + 1):
+            if pacer is not None:
+                yield pacer, k  # type: ignore[misc] - duck-types an Inbound: it only ever waits
             yield self.ref_in, k
             t0 = time.perf_counter()
             self.apply_referee(self.ref_in.take(k))
@@ -271,6 +304,13 @@ class EngineNode(Node):
             delay = start + (k + 1) * dt - time.monotonic()
             if delay > 0:
                 time.sleep(delay)
+
+    def run(self):
+        try:
+            return super().run()
+        finally:
+            if self.pacer is not None:
+                self.pacer.stop()
 
     def summary_extra(self) -> dict[str, object]:
         return {

@@ -173,7 +173,7 @@ class RecorderNode(Node):
         if not cfg.record:
             raise ConfigError("this match does not record: start it with --record FILE.mcap")
         self.path = cfg.record
-        self.peers = [str(p) for p in cfg.processes() if p.kind != "recorder"]
+        self.peers = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "viewer")]
         self.rank = {name: i for i, name in enumerate(self.peers)}
         self.tap_in = self.transport.subscribe(self.keys.tap_all())
         self.summary_in = self.transport.subscribe(self.keys.summary_all())

@@ -166,7 +166,8 @@ class SceneBuilder:
         rb = cfg.ball.radius
         self._ball = Vector3(x=2 * rb, y=2 * rb, z=2 * rb)
 
-    def update(self, world: World, ns: int) -> bytes:
+    def update(self, world: World, ns: int, extra: list[SceneEntity] | None = None) -> bytes:
+        """One `SceneUpdate`: field, robots, ball, score and clock; `extra` entities appended (a viewer's)."""
         ts = stamp(ns)
         size, height = self.cfg.robot.size, self.cfg.robot.height
         entities = [
@@ -242,7 +243,47 @@ class SceneBuilder:
                 ],
             )
         )
+        if extra:
+            entities.extend(extra)
         return SceneUpdate(entities=entities).encode()
+
+    def beliefs(
+        self, ns: int, seen: dict[tuple[str, int], tuple[float, float]], fused: dict[str, tuple[float, float, float]]
+    ) -> list[SceneEntity]:
+        """What the teams believe, drawn faintly: each robot's perceived ball (a small
+        translucent sphere in its team colour) and each base station's fused P_ball (a larger one)."""
+        ts = stamp(ns)
+        rb = self.cfg.ball.radius
+        out = []
+        for (team, n), (x, y) in sorted(seen.items()):
+            out.append(
+                SceneEntity(
+                    timestamp=ts,
+                    frame_id=FRAME,
+                    id=f"seen/{team}/{n}",
+                    spheres=[SpherePrimitive(pose=_pose(x, y, rb), size=self._ball, color=_colour(team, 0.35))],
+                )
+            )
+        big = Vector3(x=4 * rb, y=4 * rb, z=4 * rb)
+        for team, (x, y, z) in sorted(fused.items()):
+            out.append(
+                SceneEntity(
+                    timestamp=ts,
+                    frame_id=FRAME,
+                    id=f"p_ball/{team}",
+                    spheres=[SpherePrimitive(pose=_pose(x, y, z + rb), size=big, color=_colour(team, 0.2))],
+                    texts=[
+                        TextPrimitive(
+                            pose=_pose(x, y, z + 4 * rb + 0.1),
+                            billboard=True,
+                            font_size=LABEL_SIZE * 0.6,
+                            color=_colour(team, 0.6),
+                            text=f"P_ball {team}",
+                        )
+                    ],
+                )
+            )
+        return out
 
     def referee_log(self, ref: Referee, ns: int) -> list[bytes]:
         """One Log per command issued; the score rides on GOAL lines. Updates the score text."""

@@ -24,7 +24,7 @@ from arena.schemas.keys import DEFAULT_PERIODS
 from arena.schemas.vocabulary import TEAMS
 
 MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
-KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox")
+KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
 @dataclass(frozen=True)
@@ -204,6 +204,8 @@ class MatchConfig:
     realtime: bool = False
     external: tuple[str, ...] = ()  # processes started by hand, e.g. "robot/a/1"
     record: str = ""  # MCAP path, "" for none
+    live: int = -1  # [-] TCP port of the live viewer's Foxglove server (processes/viewer.py); -1: no viewer, 0: any
+    pace: float = 0.0  # [-] lockstep with a viewer: simulated seconds per wall second; 0: as fast as it goes
     field: FieldParams = FieldParams()
     robot: RobotParams = RobotParams()
     ball: BallParams = BallParams()
@@ -237,6 +239,8 @@ class MatchConfig:
             out.append(ProcessId("refbox"))
         if self.record:
             out.append(ProcessId("recorder"))
+        if self.live >= 0:
+            out.append(ProcessId("viewer"))
         return out
 
     # ------------------------------------------------------------- (de)serial
@@ -304,6 +308,12 @@ class MatchConfig:
                 "--via-refbox needs --realtime: the RefBox protocol carries no tick, so a command read from "
                 "TCP cannot be given the lockstep tick it belongs to (docs/refbox.md)"
             )
+        if not -1 <= self.live <= 65535:
+            raise ConfigError(f"--live port must be in 0..65535, got {self.live}")
+        if not (math.isfinite(self.pace) and 0.0 <= self.pace <= 1000.0):
+            raise ConfigError(f"--pace must be between 0 (unpaced) and 1000, got {self.pace}")
+        if self.pace > 0 and (self.live < 0 or self.realtime):
+            raise ConfigError("--pace applies to a lockstep match with --live only")
         for ext in self.external:
             pid = ProcessId.parse(ext)
             if pid not in self.processes():
@@ -345,10 +355,10 @@ class ProcessId:
                 return cls("robot", parts[1], int(parts[2]))
             if parts[0] == "basestation" and len(parts) == 2 and parts[1] in TEAMS:
                 return cls("basestation", parts[1])
-            if len(parts) == 1 and parts[0] in ("engine", "referee", "recorder", "refbox"):
+            if len(parts) == 1 and parts[0] in ("engine", "referee", "recorder", "refbox", "viewer"):
                 return cls(parts[0])
         except ValueError:
             pass
         raise ConfigError(
-            f"bad process name {text!r}: use a/1 or robot/a/1, basestation/a, engine, referee, refbox or recorder"
+            f"bad process name {text!r}: use a/1 or robot/a/1, basestation/a, engine, referee, refbox, recorder or viewer"
         )

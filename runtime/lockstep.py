@@ -213,6 +213,13 @@ class Reactor:
             if self._steps is not None:
                 self._advance()
 
+    def poke(self) -> None:
+        """Look again at what the loop waits for: something other than a frame (a pacer's
+        clock or a viewer's control, runtime/pace.py) may have made it ready."""
+        with self.lock:
+            if self._steps is not None:
+                self._advance()
+
     def _advance(self) -> None:
         try:
             while True:

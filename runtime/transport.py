@@ -58,7 +58,7 @@ class Transport(Protocol):
         """A put function for `key`. With `when_matched`, puts are skipped while no
         remote subscriber matches (for keys nobody in the lockstep waits on)."""
 
-    def subscribe(self, key: str) -> Channel: ...
+    def subscribe(self, key: str, latest: int = 0) -> Channel: ...
     def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
         """Run `callback(payload)` on the transport's own thread for every frame of `key`."""
 
@@ -67,7 +67,9 @@ class Transport(Protocol):
 
     def declare_alive(self, key: str) -> None: ...
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
-    def serve(self, key: str, payload: bytes) -> None: ...
+    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
+        """Answer queries on `key` with `payload`, or with what `payload()` returns at the time."""
+
     def query(self, key: str, timeout: float) -> bytes | None: ...
     def close(self) -> None: ...
 
@@ -105,10 +107,12 @@ class ZenohTransport:
         self._wake_lock = threading.Lock()
 
     def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
+        # A key nobody in the lockstep waits for (`world`, for viewers) never blocks its
+        # sender: a viewer that falls behind loses frames instead of slowing the match.
         pub = self.session.declare_publisher(
             key,
             encoding=zenoh.Encoding("application/msgpack"),
-            congestion_control=zenoh.CongestionControl.BLOCK,
+            congestion_control=zenoh.CongestionControl.DROP if when_matched else zenoh.CongestionControl.BLOCK,
             reliability=zenoh.Reliability.RELIABLE,
             express=False,
         )
@@ -128,8 +132,10 @@ class ZenohTransport:
 
         return put
 
-    def subscribe(self, key: str) -> Channel:
-        sub = self.session.declare_subscriber(key, zenoh.handlers.FifoChannel(self.FIFO))
+    def subscribe(self, key: str, latest: int = 0) -> Channel:
+        """`latest` > 0: keep only the newest `latest` frames (a viewer), never block zenoh."""
+        handler = zenoh.handlers.RingChannel(latest) if latest > 0 else zenoh.handlers.FifoChannel(self.FIFO)
+        sub = self.session.declare_subscriber(key, handler)
         self._keep.append(sub)
         # The wake-up for this subscription goes through a publisher of its own,
         # declared now on the main thread: `wake` runs on other threads (watchdog,
@@ -167,9 +173,10 @@ class ZenohTransport:
 
         self._keep.append(self.session.liveliness().declare_subscriber(key_expr, cb, history=True))
 
-    def serve(self, key: str, payload: bytes) -> None:
+    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
         def cb(query: zenoh.Query) -> None:
-            query.reply(key, payload)
+            keep_thread_state()
+            query.reply(key, payload if isinstance(payload, bytes) else payload())
 
         self._keep.append(self.session.declare_queryable(key, cb))
 
@@ -272,7 +279,7 @@ class MemoryTransport:
 
         return put
 
-    def subscribe(self, key: str) -> Channel:
+    def subscribe(self, key: str, latest: int = 0) -> Channel:  # noqa: ARG002 - unbounded here
         return self.bus.subscribe(self, key)
 
     def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
@@ -290,11 +297,12 @@ class MemoryTransport:
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None:
         self.bus.watch(key_expr, on_change)
 
-    def serve(self, key: str, payload: bytes) -> None:
+    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
         self.bus._served[key] = payload
 
     def query(self, key: str, timeout: float) -> bytes | None:
-        return self.bus._served.get(key)
+        payload = self.bus._served.get(key)
+        return payload if payload is None or isinstance(payload, bytes) else payload()
 
     def close(self) -> None:
         for key in self._tokens:

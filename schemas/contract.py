@@ -15,7 +15,19 @@ import msgspec
 from msgspec import inspect as mi
 
 from arena.schemas import messages as m
-from arena.schemas.keys import ACK, ALIVE, COLLECTOR, CONFIG, DEFAULT_PERIODS, KEYS, SUMMARY, TAP, TAP_PERIOD, KeySpec
+from arena.schemas.keys import (
+    ACK,
+    ALIVE,
+    COLLECTOR,
+    CONFIG,
+    CONTROL,
+    DEFAULT_PERIODS,
+    KEYS,
+    SUMMARY,
+    TAP,
+    TAP_PERIOD,
+    KeySpec,
+)
 
 README = Path(__file__).with_name("README.md")
 
@@ -65,12 +77,13 @@ Infrastructure keys (not data pairs):
 
 | key expression | what |
 |---|---|
-| `arena/<match>/{ALIVE}/<process>` | zenoh liveliness token of each process (`engine`, `referee`, `basestation/a`, `robot/a/1`, `recorder`); the match starts when all are present |
+| `arena/<match>/{ALIVE}/<process>` | zenoh liveliness token of each process (`engine`, `referee`, `basestation/a`, `robot/a/1`, `recorder`, `viewer`); the match starts when all are present |
 | `arena/<match>/{CONFIG}` | queryable served by the engine: the match configuration as JSON (UTF-8) |
 | `arena/<match>/{SUMMARY}/<process>` | `Summary`, once per process at the end of the match |
 | `arena/<match>/{COLLECTOR}` | liveliness token of a summary collector (`arena match`, `arena up`); while present, a process repeats its summary until acknowledged |
 | `arena/<match>/{ACK}/<process>` | the collector's acknowledgement of a summary (payload `ack`) |
 | `arena/<match>/{TAP}/<process>` | `TapBatch`, only in a recorded match: every frame the process sent, batched every {TAP_PERIOD} ticks, for the recorder (docs/recording.md) |
+| `arena/<match>/{CONTROL}` | `Control`, only in a live lockstep match (`arena match --live`): the viewer pauses, steps and paces the engine; waits only, never a different digest (docs/recording.md) |
 
 """
 

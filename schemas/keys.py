@@ -145,6 +145,7 @@ ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
 COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
 REFUSED = "refused"  # arena/<m>/refused/<process id>: a second process with that identity was turned away
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
+CONTROL = "control"  # arena/<m>/control: Control frames, viewer -> engine, live lockstep matches only
 TAP_PERIOD = 50  # [ticks] one tap batch per process every 1 s of simulated time (at 20 ms ticks)
 
 
@@ -179,6 +180,9 @@ class Keys:
 
     def tap_all(self) -> str:
         return f"{self.prefix}{TAP}/**"
+
+    def control(self) -> str:
+        return f"{self.prefix}{CONTROL}"
 
     def ack(self, process: str) -> str:
         return f"{self.prefix}{ACK}/{process}"

@@ -306,6 +306,21 @@ class TapBatch(Base):
     frames: list[TapFrame] = []
 
 
+class Control(Base):
+    """Viewer to engine, live lockstep matches only (`arena match --live`): pause, step, pace.
+
+    The engine only waits on it, so it never changes what anybody sends.
+    """
+
+    tick: Annotated[int, Meta(ge=0, description="the newest tick the viewer has seen (for the logs)")]
+    seq: Annotated[int, Meta(ge=0, description="increases with every frame of the viewer")]
+    paused: Annotated[bool, Meta(description="hold the engine before its next tick")] = False
+    step: Annotated[int, Meta(ge=0, le=1_000_000, description="paused: play this many more ticks, then hold")] = 0
+    pace: Annotated[
+        float, Meta(ge=-1.0, le=1000.0, description="simulated seconds per wall second, 0 unpaced, -1 unchanged")
+    ] = -1.0
+
+
 MESSAGE_TYPES: tuple[type[Base], ...] = (
     FieldSpec,
     Sense,
@@ -318,6 +333,7 @@ MESSAGE_TYPES: tuple[type[Base], ...] = (
     Worldstate,
     Summary,
     TapBatch,
+    Control,
 )
 
 _ENCODER = msgspec.msgpack.Encoder()

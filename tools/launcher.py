@@ -201,7 +201,9 @@ def new_match_id(seed: int) -> str:
     return f"m{seed}-{os.getpid()}-{os.urandom(3).hex()}"
 
 
-def run_argv(pid: ProcessId, match: str, connect: str, config_path: str | None = None, record: str = "") -> list[str]:
+def run_argv(
+    pid: ProcessId, match: str, connect: str, config_path: str | None = None, record: str = "", host: str = ""
+) -> list[str]:
     argv = [sys.executable, "-m", "arena", "run", pid.kind, "--match", match, "--connect", connect]
     if pid.team:
         argv += ["--team", pid.team]
@@ -209,6 +211,8 @@ def run_argv(pid: ProcessId, match: str, connect: str, config_path: str | None =
         argv += ["--robot", str(pid.robot)]
     if pid.kind == "recorder" and record:
         argv += ["--record", record]
+    if pid.kind == "viewer" and host:
+        argv += ["--host", host]
     if config_path:
         argv += ["--config", config_path]
     return argv
@@ -437,9 +441,9 @@ def supervise(
 
 def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
     """The match result (what `arena match --json` prints)."""
-    # The recorder sends no data, and the RefBox bridge's worldstates are what the
-    # teams sent (no process's input): the digest is the same with or without them.
-    order = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "refbox")]
+    # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
+    # what the teams sent (no process's input): the digest is the same with or without them.
+    order = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "refbox", "viewer")]
     sums = got.summaries
     combined = hashlib.blake2b(digest_size=16)
     for name in order:
@@ -560,6 +564,7 @@ def play_match(
     log_dir: str | None = None,
     announce=None,
     strict: bool = False,
+    live_host: str = "127.0.0.1",
 ) -> dict:
     """Play one match as separate processes and return its result dict.
 
@@ -589,7 +594,11 @@ def play_match(
             for p in cfg.processes():
                 if p in external:
                     continue
-                children.append(spawn(str(p), p, run_argv(p, match, connect, str(cfg_path), cfg.record), logs))
+                argv = run_argv(p, match, connect, str(cfg_path), cfg.record, live_host)
+                children.append(spawn(str(p), p, argv, logs))
+            if cfg.live >= 0 and announce is not None:
+                pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
+                announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
             joins = Joins(session, keys, external, announce)
             if external and announce is not None:
                 announce(instructions(sorted(external), match, endpoint, cfg))

@@ -91,7 +91,7 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
     except ConfigError as exc:
         raise ReplayError(str(exc)) from None
     cfg = rec.cfg
-    if pid.kind == "recorder" or pid not in cfg.processes():
+    if pid.kind in ("recorder", "viewer") or pid not in cfg.processes():
         raise ReplayError(f"{process}: no such process in this recording ({cfg.robots} robots per team)")
     if pid.kind == "refbox":
         raise ReplayError("refbox: the RefBox bridge replays nothing: its worldstates came from outside the match")
@@ -193,7 +193,7 @@ def _describe(r: ReplayResult) -> str:
 def main(path: str, processes: list[str], as_json: bool = False) -> int:
     try:
         rec = load(path)
-        every = [str(p) for p in rec.cfg.processes() if p.kind not in ("recorder", "refbox")]
+        every = [str(p) for p in rec.cfg.processes() if p.kind not in ("recorder", "refbox", "viewer")]
         names = every if "all" in processes else processes
         results = [replay(rec, p) for p in names]
     except (RecordingError, ReplayError) as exc:

@@ -130,6 +130,8 @@ def run(
     realtime: bool,
     startup_timeout: float,
     record: str | None = None,
+    host: str = "127.0.0.1",
+    port: int | None = None,
 ) -> int:
     """Run one process to the end of its match. Returns the exit code.
 
@@ -165,6 +167,14 @@ def run(
                     raise ConfigError(f"match {match!r} does not record: start it with --record FILE.mcap")
                 if record:
                     cfg = cfg.replace(record=record)
+            extra: dict[str, object] = {}
+            if pid.kind == "viewer":
+                # A viewer attached by hand to a match started without --live watches
+                # only (the engine has no pacer to pause) and nobody waits for it.
+                attached = cfg.live < 0
+                live = port if port is not None else (8765 if attached else cfg.live)
+                cfg = cfg.replace(live=live)
+                extra = {"host": host, "attached": attached}
             if pid not in cfg.processes():
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
             refuse_duplicate(session, keys, pid)
@@ -176,7 +186,7 @@ def run(
                 ref_sub = session.declare_subscriber(
                     keys.key("referee"), lambda s: last_ref[:1].clear() or last_ref.append(s.payload.to_bytes())
                 )
-            node = node_class(pid.kind)(pid, cfg, transport, keys)
+            node = node_class(pid.kind)(pid, cfg, transport, keys, **extra)
             node.on_waiting = lambda missing: tell(
                 f"waiting for: {', '.join(missing)} (up to {cfg.timing.startup_timeout:g} s)"
                 if missing

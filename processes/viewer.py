@@ -1,0 +1,293 @@
+"""Viewer process: watch a match as it plays, in the Foxglove app (docs/recording.md).
+
+`arena match --live [PORT]` starts it; `arena run viewer` attaches one to a
+match by hand. It serves the Foxglove WebSocket protocol (foxglove-sdk's
+server, which runs on the SDK's own threads) with:
+
+* `/scene` (`foxglove.SceneUpdate`, recording/scene.py): the field, robots by
+  team with id and role, the ball with its height, score and clock, and
+  faintly what the teams believe: each robot's perceived ball (its `report`)
+  and each base station's fused P_ball (its `order` to robot 0). The field is
+  part of every update, and the last update is sent again while the match
+  stands still, so a viewer that connects late sees the field at once;
+* `/referee_log` (`foxglove.Log`): every referee command and engine event;
+* `/match` (JSON): tick, time, stage, command in force, score, pause state;
+* parameters `paused`, `step` and `pace` (Foxglove's Parameters panel), which
+  in a lockstep match pause the engine, step it tick by tick and set its pace
+  (runtime/pace.py, through `Control` frames on `arena/<m>/control`).
+
+It is in nobody's lockstep and has none of its own: it subscribes with rings
+that keep the newest frames (a viewer that falls behind drops, never blocks),
+`world` is published with congestion control DROP, it sends no data key (its
+digest is empty and `arena match` leaves it out of the match digest), and it
+runs at a lower CPU priority. So the same loop (`watch`) serves lockstep and
+`--realtime` alike, and a match digests the same with and without it.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+
+import foxglove
+import msgspec
+from foxglove.messages import Log, SceneUpdate
+from foxglove.websocket import Capability, Parameter, ServerListener
+
+from arena.recording import scene
+from arena.runtime.config import TEAMS, ConfigError
+from arena.runtime.node import Node
+from arena.schemas.messages import Control, EngineEvents, Order, Referee, Report, World
+
+POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
+SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
+REPEAT_S = 0.5  # [s] wall: a match standing still (paused, starting) has its last scene sent again this often
+LINGER_S = 0.25  # [s] wall: at the end, wait this long for the last frames, then for the clients
+NICE = 10  # [-] added niceness (Linux): the lockstep processes come first
+RING = 4096  # [frames] referee and event frames kept between two polls (each carries commands)
+MATCH_TOPIC = "/match"
+MATCH_SCHEMA = {
+    "type": "object",
+    "properties": {
+        k: {"type": t}
+        for k, t in (
+            ("tick", "integer"),
+            ("t", "number"),
+            ("stage", "string"),
+            ("command", "string"),
+            ("score_a", "integer"),
+            ("score_b", "integer"),
+            ("paused", "boolean"),
+            ("pace", "number"),
+        )
+    },
+}
+
+
+class _Listener(ServerListener):
+    """The SDK's callbacks (its own threads) for the viewer's parameters; the rest keep the defaults."""
+
+    def __init__(self, node: ViewerNode):
+        self.node = node
+
+    def on_get_parameters(self, client, param_names, request_id=None):
+        return self.node.on_get_parameters(client, param_names, request_id)
+
+    def on_set_parameters(self, client, parameters, request_id=None):
+        return self.node.on_set_parameters(client, parameters, request_id)
+
+
+class ViewerNode(Node):
+    def __init__(self, *args, host: str = "127.0.0.1", attached: bool = False, **kwargs):
+        super().__init__(*args, **kwargs)
+        cfg, keys, tr = self.cfg, self.keys, self.transport
+        self.world_in = tr.subscribe(keys.key("world"), latest=1)
+        self.referee_in = tr.subscribe(keys.key("referee"), latest=RING)
+        self.events_in = tr.subscribe(keys.key("events"), latest=RING)
+        self.report_in = {t: tr.subscribe(keys.key("report", t, None).replace("<n>", "*"), latest=64) for t in TEAMS}
+        self.order_in = {t: tr.subscribe(keys.key("order", t, 0), latest=8) for t in TEAMS}
+        self.control_put = tr.publisher(keys.control())
+        # The engine asks for the viewer's state once before tick 0 (a pause set before
+        # the start holds tick 0); every change after that is put on the same key.
+        tr.serve(keys.control(), self._control_state)
+        self._dec_world = msgspec.msgpack.Decoder(World).decode
+        self._dec_ref = msgspec.msgpack.Decoder(Referee).decode
+        self._dec_events = msgspec.msgpack.Decoder(EngineEvents).decode
+        self._dec_report = msgspec.msgpack.Decoder(Report).decode
+        self._dec_order = msgspec.msgpack.Decoder(Order).decode
+        self.builder = scene.SceneBuilder(cfg)
+        self.seen: dict[tuple[str, int], tuple[float, float]] = {}
+        self.fused: dict[str, tuple[float, float, float]] = {}
+        self.world: World | None = None
+        self.ref: Referee | None = None
+        self.lockstep_control = not cfg.realtime and not attached  # the engine has a pacer
+        self.paused = False
+        self.pace = cfg.pace
+        self._seq = 0
+        self._control = Control(tick=0, seq=0, pace=self.pace)
+        self._lock = threading.Lock()
+        self.scenes = 0
+        self.logs = 0
+        self.ctx = ctx = foxglove.Context()  # kept: a dropped context closes its channels
+        self.scene_ch = foxglove.Channel(
+            scene.SCENE_TOPIC, context=ctx, message_encoding="protobuf", schema=SceneUpdate.get_schema()
+        )
+        self.log_ch = foxglove.Channel(
+            scene.LOG_TOPIC, context=ctx, message_encoding="protobuf", schema=Log.get_schema()
+        )
+        self.match_ch = foxglove.Channel(MATCH_TOPIC, context=ctx, schema=MATCH_SCHEMA)
+        caps = [Capability.Time] + ([Capability.Parameters] if self.lockstep_control else [])
+        try:
+            self.server = foxglove.start_server(
+                name=f"soccer-arena {keys.match}",
+                host=host,
+                port=max(0, cfg.live),
+                context=ctx,
+                capabilities=caps,
+                server_listener=_Listener(self),
+                message_backlog_size=256,
+            )
+        except RuntimeError as exc:
+            raise ConfigError(f"viewer: cannot serve on {host}:{max(0, cfg.live)}: {exc}") from None
+        self.port = self.server.port
+        self.log.warning("live viewer: ws://%s:%d (Foxglove: Open connection)", host, self.port)
+
+    # ------------------------------------------------- Foxglove parameters
+    def _parameters(self) -> list[Parameter]:
+        return [
+            Parameter("paused", value=self.paused),
+            Parameter("step", value=0),
+            Parameter("pace", value=float(self.pace)),
+        ]
+
+    def on_get_parameters(self, client, param_names, request_id=None):  # noqa: ARG002 - SDK callback
+        with self._lock:
+            return [p for p in self._parameters() if not param_names or p.name in param_names]
+
+    def on_set_parameters(self, client, parameters, request_id=None):  # noqa: ARG002 - SDK callback
+        """Runs on the SDK's thread: queue a `Control` frame for the main loop to send."""
+        if not self.lockstep_control:
+            return self._parameters()
+        with self._lock:
+            step = 0
+            for p in parameters:
+                value = p.get_value()
+                if p.name == "paused" and isinstance(value, bool):
+                    self.paused = value
+                elif p.name == "step" and isinstance(value, int | float) and 0 < value <= 1_000_000:
+                    step, self.paused = int(value), True
+                elif p.name == "pace" and isinstance(value, int | float) and 0 <= value <= 1000:
+                    self.pace = float(value)
+                else:
+                    self.rejections.reject("parameter", "invalid", f"{p.name}={value!r}")
+            self._seq += 1
+            tick = self.world.tick if self.world is not None else 0
+            self._control = Control(tick=tick, seq=self._seq, paused=self.paused, step=step, pace=self.pace)
+            self.control_put(msgspec.msgpack.encode(self._control))  # a put from another thread is safe
+            return self._parameters()
+
+    def _control_state(self) -> bytes:
+        with self._lock:
+            return msgspec.msgpack.encode(self._control)
+
+    # ----------------------------------------------------------------- work
+    def _drain(self) -> bool:
+        """Take what has arrived; True if the match moved on."""
+        moved = False
+        raw = last = None
+        while (raw := self.world_in.try_recv()) is not None:
+            last = raw
+        if last is not None:
+            self.world = self._dec_world(last)
+            moved = True
+        while (raw := self.referee_in.try_recv()) is not None:
+            try:
+                ref = self._dec_ref(raw)
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self.rejections.reject(self.keys.key("referee"), "malformed", str(exc)[:120])
+                continue
+            self.ref = ref
+            for b in self.builder.referee_log(ref, self._ns(ref.tick)):
+                self.log_ch.base.log(b, self._ns(ref.tick))
+                self.logs += 1
+        while (raw := self.events_in.try_recv()) is not None:
+            try:
+                ev = self._dec_events(raw)
+            except (msgspec.DecodeError, msgspec.ValidationError):
+                continue
+            for b in self.builder.events_log(ev, self._ns(ev.tick)):
+                self.log_ch.base.log(b, self._ns(ev.tick))
+        for team in TEAMS:
+            while (raw := self.report_in[team].try_recv()) is not None:
+                try:
+                    r = self._dec_report(raw)
+                except (msgspec.DecodeError, msgspec.ValidationError):
+                    continue
+                self.builder.roles[(team, r.robot)] = r.role or self.builder.roles.get((team, r.robot), "")
+                if r.ball.visible:
+                    self.seen[(team, r.robot)] = (r.ball.x, r.ball.y)
+                else:
+                    self.seen.pop((team, r.robot), None)
+            while (raw := self.order_in[team].try_recv()) is not None:
+                try:
+                    o = self._dec_order(raw)
+                except (msgspec.DecodeError, msgspec.ValidationError):
+                    continue
+                if o.ball_valid:
+                    self.fused[team] = (o.ball_x, o.ball_y, o.ball_z)
+                else:
+                    self.fused.pop(team, None)
+        return moved
+
+    def _ns(self, tick: int) -> int:
+        return round(tick * self.cfg.timing.dt * 1e9)
+
+    def act(self) -> None:
+        """One scene: what the match looks like now, to every subscribed client."""
+        w = self.world
+        if w is None:
+            return
+        ns = self._ns(w.tick)
+        self.server.broadcast_time(ns)
+        if self.scene_ch.base.has_sinks():
+            extra = self.builder.beliefs(ns, self.seen, self.fused)
+            self.scene_ch.base.log(self.builder.update(w, ns, extra), ns)
+            self.scenes += 1
+        ref = self.ref
+        self.match_ch.log(
+            {
+                "tick": w.tick,
+                "t": round(w.t, 3),
+                "stage": ref.stage if ref else "PRE_GAME",
+                "command": ref.command if ref else "STOP",
+                "score_a": ref.score_a if ref else 0,
+                "score_b": ref.score_b if ref else 0,
+                "paused": self.paused,
+                "pace": self.pace,
+            },
+            log_time=ns,
+        )
+        self.last_tick = w.tick
+
+    def _over(self) -> bool:
+        w = self.world
+        return (w is not None and w.tick >= self.cfg.total_ticks) or "engine" in self.gone
+
+    def watch(self) -> None:
+        every = 1.0 / SCENE_HZ
+        next_scene = last_scene = 0.0
+        while True:
+            moved = self._drain()
+            now = time.monotonic()
+            if (moved and now >= next_scene) or now - last_scene >= REPEAT_S:
+                self.act()
+                next_scene, last_scene = now + every, now
+            if self._over():
+                end = time.monotonic() + LINGER_S  # the last frames may still be on their way
+                while time.monotonic() < end:
+                    time.sleep(POLL_S)
+                    self._drain()
+                self.act()
+                time.sleep(LINGER_S)  # and the clients' backlogs drain before the server stops
+                return
+            time.sleep(POLL_S)
+
+    # ---------------------------------------------------------------- loops
+    def loop(self) -> None:
+        """The same watch loop in both modes: the viewer takes part in no lockstep."""
+        if threading.current_thread() is threading.main_thread():
+            os.nice(NICE)  # a process of its own (arena run viewer); never a test's thread
+        try:
+            self.watch()
+        finally:
+            self.server.stop()
+
+    def lockstep(self):
+        raise NotImplementedError("the viewer has no lockstep: see loop()")
+
+    def loop_realtime(self) -> None:
+        self.watch()
+
+    def summary_extra(self) -> dict[str, object]:
+        return {"port": self.port, "scenes": self.scenes, "referee_logs": self.logs}

@@ -1,0 +1,166 @@
+"""Pacing a lockstep match for a live viewer: real-time speed, pause, step.
+
+`arena match --live` starts a viewer (processes/viewer.py); in lockstep the
+engine then waits on a `Pacer` before each tick, as it waits on a link: the
+lockstep loop yields `(pacer, k)`, and the pacer is ready for tick k when
+
+* the match is not paused (or a step request still covers k), and
+* with a pace p > 0, the wall clock has reached `anchor + (k - k0) * dt / p`.
+
+The pacer only ever delays a tick; what the engine computes and sends at tick
+k is the same whenever it runs, so pacing and pausing never change a digest.
+The wall clock is read for waiting only, never for behaviour.
+
+The viewer sends `Control` frames on `arena/<m>/control`; the engine hands
+them to `control`. In reactive lockstep (runtime/lockstep.py, `Reactor`) the
+loop runs in zenoh's callbacks, so nothing may sleep there: a small thread of
+the pacer calls `poke` (the Reactor's) when a tick's time has come, and a
+control frame pokes it too. In pull mode `sync` blocks on the main thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+
+from arena.schemas.messages import Control
+
+BEHIND_S = 0.25  # [s] wall: further behind its schedule than this, the pacer restarts it from now (no sprint)
+POLL_S = 0.05  # [s] wall: pull mode, how often a paused engine looks for control frames
+
+
+class Pacer:
+    """Duck-types a lockstep `Inbound` (`ready`, `sync`, `woken`, `sender`, `_give_up`)."""
+
+    sender = "viewer"
+    key = "control"
+
+    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None):
+        self.dt = dt
+        self.pace = pace
+        self.log = log or logging.getLogger("arena.pace")
+        self.paused = False
+        self.until = -1  # paused: ticks up to this one may still play (steps)
+        self.played = -1  # the last tick this pacer let through
+        self.woken = False
+        self.dead = False
+        self._anchor: tuple[float, int] | None = None  # (wall time, tick) the schedule counts from
+        self._due: float | None = None  # reactive: the wall time at which to poke
+        self._seq = -1
+        self._cond = threading.Condition()
+        self._poke: Callable[[], None] | None = None
+        self._stop = False
+        self._thread: threading.Thread | None = None
+        self._pending: Callable[[], bytes | None] | None = None
+        self.controls = 0  # control frames applied
+
+    # ------------------------------------------------------------- the gate
+    def ready(self, k: int) -> bool:
+        with self._cond:
+            if self.paused and k > self.until:
+                self._due = None
+                return False
+            if self.pace > 0.0 and not self.paused:
+                now = time.monotonic()
+                if self._anchor is None:
+                    self._anchor = (now, k)
+                t0, k0 = self._anchor
+                due = t0 + (k - k0) * self.dt / self.pace
+                if due > now:
+                    self._due = due
+                    self._cond.notify_all()
+                    return False
+                if now - due > BEHIND_S:
+                    self._anchor = (now, k)
+            self._due = None
+            self.played = k
+            return True
+
+    def sync(self, k: int) -> None:
+        """Pull mode: block until tick k may play."""
+        while True:
+            if self._pending is not None:
+                while (raw := self._pending()) is not None:
+                    self.control_raw(raw)
+            if self.ready(k):
+                return
+            with self._cond:
+                left = POLL_S if self._due is None else min(POLL_S, self._due - time.monotonic())
+                if left > 0:
+                    self._cond.wait(left)
+
+    def _is_dead(self, peer: str) -> bool:  # noqa: ARG002 - Inbound's interface
+        return False
+
+    def _give_up(self, why: str) -> None:
+        """The Reactor's bound on one wait: a pause longer than wait_timeout resumes the match."""
+        self.log.warning("paused for too long (%s): playing on", why)
+        with self._cond:
+            self.paused = False
+            self._anchor = None
+
+    # --------------------------------------------------------------- control
+    def control(self, c: Control) -> None:
+        with self._cond:
+            if c.seq <= self._seq:
+                return  # a repeat or an old frame
+            self._seq = c.seq
+            if c.pace >= 0.0:
+                self.pace = c.pace
+            if c.paused and not self.paused:
+                self.until = self.played
+            self.paused = c.paused
+            if c.paused and c.step > 0:
+                self.until = max(self.until, self.played) + c.step
+            self._anchor = None  # the schedule restarts from the next tick
+            self.controls += 1
+            self._cond.notify_all()
+        if self._poke is not None:
+            self._poke()
+
+    def control_raw(self, raw: bytes, decode=None) -> str | None:
+        """Apply one wire frame; returns why it was rejected, or None."""
+        import msgspec
+
+        try:
+            c = (decode or msgspec.msgpack.Decoder(Control).decode)(raw)
+        except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+            return str(exc)[:120]
+        self.control(c)
+        return None
+
+    # ---------------------------------------------------------------- modes
+    def pull_from(self, recv: Callable[[], bytes | None]) -> None:
+        """Pull mode: `sync` drains `recv` (a channel's try_recv) for control frames."""
+        self._pending = recv
+
+    def start(self, poke: Callable[[], None]) -> None:
+        """Reactive mode: a thread pokes the loop when a paced tick is due."""
+        self._poke = poke
+        self._thread = threading.Thread(target=self._run, name="pacer", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                if self._stop:
+                    return
+                due = self._due
+                if due is None:
+                    self._cond.wait(0.5)
+                    continue
+                left = due - time.monotonic()
+                if left > 0:
+                    self._cond.wait(left)
+                    continue
+                self._due = None
+            self._poke()
+
+    def stop(self) -> None:
+        with self._cond:
+            self._stop = True
+            self._cond.notify_all()
+        if self._thread is not None:
+            self._thread.join(timeout=1.0)

@@ -1,0 +1,111 @@
+"""The live viewer (processes/viewer.py) over the real Foxglove WebSocket protocol.
+
+The client (foxglove_client.py) speaks the protocol itself on `websockets`.
+Each match leaves robot a/1 to be started by the test (`--external`), so the
+client is connected and subscribed before the first tick: nothing it should
+count can pass before it listens.
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+import subprocess
+import time
+
+from tests.integration.foxglove_client import FoxgloveClient, log_entry, scene_entities
+from tests.integration.helpers import ARENA, arena_json
+
+ROBOTS = {f"robot/{t}/{n}" for t in "ab" for n in range(3)}
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start_live(match: str, *flags: str):
+    """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1)."""
+    port, zport = free_port(), free_port()
+    endpoint = f"tcp/127.0.0.1:{zport}"
+    argv = [*ARENA, "match", "--home", "BS", "--away", "BS", "--live", str(port), "--external", "a/1"]
+    argv += ["--match", match, "--listen", endpoint, "--json", *flags]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    robot_argv = [*ARENA, "run", "robot", "--match", match, "--connect", endpoint, "--team", "a", "--robot", "1"]
+    return proc, f"ws://127.0.0.1:{port}", lambda: subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL)
+
+
+def finish(proc: subprocess.Popen, robot: subprocess.Popen | None) -> dict:
+    out, err = proc.communicate(timeout=120)
+    if robot is not None:
+        robot.wait(timeout=30)
+    assert proc.returncode == 0, err[-3000:]
+    return json.loads(out)
+
+
+def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command():
+    proc, url, start_robot = start_live("viewer-rt", "--realtime", "--half-time", "5")
+    robot = None
+    try:
+        client = FoxgloveClient(url, timeout=60)
+        assert {"/scene", "/referee_log", "/match"} <= set(client.channels)
+        assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
+        client.subscribe("/scene", "/referee_log", "/match")
+        robot = start_robot()
+        full, referee_logs, last_match = 0, [], None
+        for topic, _, payload in client.messages(60):
+            if topic == "/scene":
+                ids = set(scene_entities(payload))
+                if {"field", "ball", "score"} | ROBOTS <= ids:
+                    full += 1
+            elif topic == "/referee_log":
+                entry = log_entry(payload)
+                if entry["name"] == "referee":
+                    referee_logs.append(entry["message"])
+            elif topic == "/match":
+                last_match = json.loads(payload)
+        client.close()
+        result = finish(proc, robot)
+    finally:
+        for p in (proc, robot):
+            if p is not None and p.poll() is None:
+                p.kill()
+    assert result["realtime"] and result["ticks"] == 500
+    assert full >= 40, f"only {full} complete scene updates"
+    commands = sum(result["events"].values())
+    assert len(referee_logs) == commands, (referee_logs, result["events"])
+    assert [m.split()[0] for m in referee_logs].count("KICKOFF") == result["events"]["KICKOFF"]
+    assert last_match is not None and [last_match["score_a"], last_match["score_b"]] == result["score"]
+    assert last_match["stage"] == "END_GAME"
+
+
+def test_pause_step_resume_over_the_protocol_keeps_the_digest():
+    reference = arena_json("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--seed", "5")
+    proc, url, start_robot = start_live("viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0")
+    robot = None
+    try:
+        client = FoxgloveClient(url, timeout=60)
+        assert "parameters" in client.info["capabilities"]
+        client.subscribe("/match")
+        client.set_parameters(paused=True)
+        time.sleep(0.3)
+        robot = start_robot()  # the match starts, and holds before tick 0
+        held = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+        assert held == [], f"the engine played while paused: {held[-3:]}"
+        client.set_parameters(step=10)  # ticks 0..9
+        stepped = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+        assert stepped and max(stepped) == 9, stepped[-5:]
+        assert client.parameters.get("paused") is True
+        client.set_parameters(paused=False)
+        after = [json.loads(p)["tick"] for _, _, p in client.messages(60)]
+        client.close()
+        result = finish(proc, robot)
+    finally:
+        for p in (proc, robot):
+            if p is not None and p.poll() is None:
+                p.kill()
+    # unpaced, the viewer shows at most SCENE_HZ frames a second, and a late world frame may be dropped
+    assert after and 10 < after[-1] <= result["ticks"] == reference["ticks"]
+    assert result["digest"] == reference["digest"]
+    assert result["process_digests"] == reference["process_digests"]

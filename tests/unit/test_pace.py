@@ -1,0 +1,77 @@
+"""The live pacer (runtime/pace.py): it only ever delays a tick; and the CLI's --live/--pace checks."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import pytest
+
+from arena.runtime.config import ConfigError, MatchConfig
+from arena.runtime.pace import Pacer
+from arena.schemas.messages import Control, encode
+
+
+def test_unpaced_and_unpaused_every_tick_is_ready():
+    p = Pacer(0.02, 0.0)
+    assert all(p.ready(k) for k in range(1000))
+
+
+def test_pause_holds_the_next_tick_and_step_lets_exactly_n_through():
+    p = Pacer(0.02, 0.0)
+    assert p.ready(0) and p.ready(1)
+    p.control(Control(tick=1, seq=1, paused=True))
+    assert not p.ready(2)
+    p.control(Control(tick=1, seq=2, paused=True, step=3))
+    assert [p.ready(k) for k in (2, 3, 4)] == [True, True, True]
+    assert not p.ready(5)
+    p.control(Control(tick=4, seq=2, paused=False))  # a repeated seq is ignored
+    assert not p.ready(5)
+    p.control(Control(tick=4, seq=3, paused=False))
+    assert p.ready(5)
+
+
+def test_a_pace_waits_for_the_wall_clock():
+    p = Pacer(0.02, 1.0)
+    assert p.ready(0)
+    assert not p.ready(5)  # 0.1 s later at real-time pace
+    t0 = time.monotonic()
+    p.sync(5)
+    assert time.monotonic() - t0 >= 0.05
+
+
+def test_malformed_control_frames_are_rejected_not_applied():
+    p = Pacer(0.02, 0.0)
+    assert p.control_raw(b"\xc1") is not None
+    assert p.control_raw(encode(Control(tick=0, seq=0, paused=True))) is None
+    assert p.paused
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [dict(live=70000), dict(pace=-1.0), dict(pace=2.0), dict(live=8765, pace=2.0, realtime=True)],
+)
+def test_bad_live_configurations_are_config_errors(changes):
+    with pytest.raises(ConfigError):
+        MatchConfig(**changes).validate()
+
+
+def test_a_live_match_has_a_viewer_process():
+    assert "viewer" in [p.kind for p in MatchConfig(live=0).processes()]
+    assert "viewer" not in [p.kind for p in MatchConfig().processes()]
+
+
+@pytest.mark.parametrize(
+    "flags",
+    [["--pace", "2"], ["--live", "8765", "--realtime", "--pace", "2"], ["--live", "99999"], ["--live", "x"]],
+)
+def test_cli_rejects_bad_live_flags_with_one_line_and_exit_2(flags):
+    r = subprocess.run(
+        [sys.executable, "-m", "arena", "match", "--home", "BS", "--away", "BS", *flags],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 2
+    assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
