@@ -352,12 +352,15 @@ def supervise(
     waiting = set(expected)
     gone_at: dict[str, float] = {}  # liveliness token vanished (wall time)
 
+    lost_once: set[str] = set()  # lost its token mid-match, even if it came back (a 10 s SIGSTOP)
+
     def on_alive(key: str, alive: bool) -> None:
         peer = key.split("/alive/", 1)[-1]
         if alive:
             gone_at.pop(peer, None)
         elif peer not in got.summaries:
             gone_at.setdefault(peer, time.monotonic())
+            lost_once.add(peer)
 
     transport.watch_alive(keys.alive_all(), on_alive)
     by_name = {c.name: c for c in children}
@@ -435,6 +438,10 @@ def supervise(
     for name in list(gone_at):
         if name not in got.summaries and name not in got.lost and name not in got.crashed and name in expected:
             got.lost[name] = "stopped responding: its liveliness token vanished before its summary"
+    for name in sorted(lost_once & set(expected)):
+        # Back in time for its summary, but its peers lost it meanwhile; what it
+        # says of them (everyone vanished from its view) is no evidence.
+        got.lost.setdefault(name, "stopped responding for a while: its liveliness token vanished mid-match")
     got.ended = time.monotonic()
     return got
 

@@ -12,6 +12,7 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import textwrap
 
 import msgspec
@@ -200,3 +201,85 @@ def test_a_strategy_that_returns_nan_every_100_ticks_plays_to_the_end(reap, tmp_
     # Every robot of team a: one NaN command per 100 ticks, ticks 50, 150, ..., 5950.
     assert result["rejected_reasons"]["invalid"] == 3 * 60, result["rejected_reasons"]
     assert "out-of-sequence" not in result["rejected_reasons"]
+
+
+def test_a_robot_stopped_for_10_s_alone_is_blamed(reap, tmp_path):
+    """Issue 20: SIGSTOP robot a/1 for 10 s. It used to list engine and basestation/a as dead too."""
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "stop10", "--listen", endpoint)
+    reap.append(proc)
+    victim = child(proc.pid, "--team a --robot 1")
+    wait_for_tick(endpoint, "stop10", 1000, proc)
+    os.kill(victim, signal.SIGSTOP)
+    try:
+        proc.wait(10)
+    except subprocess.TimeoutExpired:
+        pass
+    os.kill(victim, signal.SIGCONT)
+    code, result, err = finish(proc)
+    assert code == 0, err
+    assert result["dead"] == ["robot/a/1"], result["dead"]
+    assert [f["process"] for f in result["faults"]] == ["robot/a/1"], result["faults"]
+    assert result["outcome"] == "completed_with_faults" and result["ticks"] == 6000
+    assert result["events"]["END_GAME"] == 1
+
+
+NO_SUMMARY = """
+import sys
+import time
+from arena.processes.robot import RobotNode
+from arena.cli import main
+
+# Plays every tick, then stays connected (its liveliness token stays) and never sends its Summary.
+RobotNode.deliver_summary = lambda self, payload, timeout=5.0: time.sleep(120)
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_an_external_robot_that_never_sends_its_summary_is_named_within_the_bound(reap, tmp_path):
+    """Issue 20: `arena match` used to wait for it forever."""
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "10", "--seed", "4", "--match", "mute", "--listen", endpoint,
+                 "--external", "a/1")  # fmt: skip
+    reap.append(proc)
+    robot = subprocess.Popen(
+        [sys.executable, "-c", NO_SUMMARY, "run", "robot", "--match", "mute", "--connect", endpoint,
+         "--team", "a", "--robot", "1"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    reap.append(robot)
+    code, result, err = finish(proc, 120)
+    assert code == 0, err
+    [fault] = result["faults"]
+    assert fault["process"] == "robot/a/1" and "sent no summary within 10 s" in fault["reason"]
+    assert result["outcome"] == "completed_with_faults" and result["ticks"] == 1000
+    assert result["distance_m"]["a/1"] > 0.5, "it did play"
+    assert "fault: robot/a/1" in err
+
+
+def test_two_senders_on_one_key_are_flagged_as_possible_spoofing(reap, tmp_path):
+    """Issue 15: a client answers every `sense` of robot b/1 with a forged `cmd` for the same tick."""
+    from arena.schemas.messages import Cmd, Sense, encode
+
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "20", "--seed", "4", "--match", "spoof", "--listen", endpoint)
+    reap.append(proc)
+    decode = msgspec.msgpack.Decoder(Sense).decode
+    wait_for(lambda: (tmp_path / "router.sock").exists(), 30, "the router socket")
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        pub = session.declare_publisher("arena/spoof/robot/b/1/cmd", congestion_control=zenoh.CongestionControl.DROP)
+        forged = [0]
+
+        def answer(sample):
+            pub.put(encode(Cmd(tick=decode(sample.payload.to_bytes()).tick, vx=-5.0, omega=3.0)))
+            forged[0] += 1
+
+        sub = session.declare_subscriber("arena/spoof/robot/b/1/sense", answer)
+        code, result, err = finish(proc, 120)
+        sub.undeclare()
+    assert code == 0, err
+    assert forged[0] > 100
+    conflicts = result["conflicts"].get("robot/b/1/cmd", 0)
+    assert conflicts > 0, result["rejected_reasons"]
+    assert result["rejected_reasons"]["conflict"] == sum(result["conflicts"].values())
+    assert "two senders on robot/b/1/cmd: possible spoofing" in err
