@@ -39,10 +39,16 @@ EXAMPLES = {
 
   arena match --home BS --away AD --half-time 60 --live          # watch in Foxglove: ws://127.0.0.1:8765
   arena match --home BS --away AD --live 9000 --pace 4           # four times real time, port 9000
-  arena match --home BS --away BS --realtime --half-time 5 --live --live-host 0.0.0.0""",
+  arena match --home BS --away BS --realtime --half-time 5 --live --live-host 0.0.0.0
+  # on the lab network: secure (TLS, a password per process, access control) as it listens on 0.0.0.0
+  arena match --home BS --away BS --listen tcp/0.0.0.0:7447 --external a/1 --credentials creds/
+  arena match --home BS --away BS --secure --listen tcp/127.0.0.1:7447   # the same on loopback""",
     "run": """examples:
-  # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --external a/1
+  # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --no-secure --external a/1
   arena run robot --match m7-1234-abcdef --connect tcp/192.168.1.10:7447 --team a --robot 1
+  # a secure match (it listens on 0.0.0.0): the credentials file arena match wrote for robot/a/1
+  arena run robot --match m7-1234-abcdef --connect tls/192.168.1.10:7447 --team a --robot 1 \\
+      --credentials robot-a-1.json5
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
   # a recorder on another machine (the match was started with --record ... --external recorder)
@@ -222,6 +228,19 @@ def build_parser() -> Parser:
     )
     m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
     m.add_argument(
+        "--secure",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="every process a zenoh user with its own password, key-level access control generated from the key "
+        "table, TLS with a fresh CA on TCP (default: on when --listen is not a loopback address)",
+    )
+    m.add_argument(
+        "--credentials",
+        metavar="DIR",
+        help="write every principal's credentials file (DIR/robot-b-1.json5, ..., viewer.json5) here "
+        "(default: the match's private temp dir)",
+    )
+    m.add_argument(
         "--strict",
         action="store_true",
         help="stop the match at the first failed process and exit 1 (CI, strategy development); "
@@ -298,6 +317,12 @@ def build_parser() -> Parser:
     r.add_argument("--realtime", action="store_true", help="the match runs in real-time mode")
     r.add_argument("--config", metavar="FILE", help="match configuration JSON (default: ask the engine)")
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
+    r.add_argument(
+        "--credentials",
+        metavar="FILE",
+        help="this process's credentials file from arena match (a zenoh config fragment: user, password, "
+        "TLS root, MAC key); a secure match needs it",
+    )
     r.add_argument(
         "--startup-timeout", type=seconds, default=60.0, metavar="S", help="wait this long [s] for the match (60)"
     )
@@ -514,6 +539,8 @@ def cmd_match(args: argparse.Namespace) -> int:
             announce=lambda text: print(text, file=sys.stderr, flush=True),
             strict=args.strict,
             live_host=args.live_host,
+            secure=args.secure,
+            credentials=args.credentials,
         )
     except launcher.MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
@@ -648,8 +675,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     if args.kind == "router":
         return runner.main_guarded(runner.run_router, args.match, net)
+    keyring = None
     try:
         pid = runner.process_id(args.kind, args.team, args.robot)
+        if args.credentials:
+            import dataclasses
+
+            base, mode, keyring = runner.load_credentials(args.credentials, pid, args.match)
+            net = dataclasses.replace(net, base=base, mode=mode or net.mode)
         cfg = None
         if args.config:
             cfg = runner.load_config(args.config)
@@ -678,6 +711,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         record,
         args.host,
         args.port,
+        keyring,
     )
 
 

@@ -27,6 +27,7 @@ from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
 from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
+from arena.runtime.mac import SIGNED_DATA, Keyring
 from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
@@ -57,6 +58,9 @@ class Node:
         self.transport = transport
         self.keys = keys
         self.log = logging.getLogger(f"arena.{self.name}")
+        # This process's MAC key and the keys of the senders it verifies (runtime/mac.py);
+        # the transport carries them because they come with the session's credentials.
+        self.keyring: Keyring = getattr(transport, "keyring", None) or Keyring(self.name)
         self.links = resolve(cfg.link, cfg.link_overrides)
         self.digest = hashlib.blake2b(digest_size=16)
         self.rejections = Rejections(self.log)
@@ -86,7 +90,7 @@ class Node:
         self.tap: Tap | None = None
         self._tap_handoff: Handoff | None = None
         if cfg.record and pid.kind not in ("recorder", "viewer"):  # they send no data
-            put = transport.publisher(keys.tap(self.name))
+            put = transport.publisher(keys.tap(self.name), sign=self.keyring.signer(keys.tap(self.name)))
             self._tap_handoff = Handoff(put) if self.reactive else None
             self.tap = Tap(self.name, self._tap_handoff or put)
 
@@ -95,7 +99,8 @@ class Node:
         """An outbound key. `viewers_only`: nobody in the lockstep waits for it, so it
         is not put on the wire while nobody listens (it still counts in the digest)."""
         key = self.keys.key(name, team, n)
-        put = self.transport.publisher(key, when_matched=viewers_only)
+        sign = self.keyring.signer(key) if self.keys.rel(key) in SIGNED_DATA else None
+        put = self.transport.publisher(key, when_matched=viewers_only, sign=sign)
         if self.tap is None:
             ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
         else:
@@ -126,10 +131,12 @@ class Node:
         key = self.keys.key(name, team, n)
         model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
         emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
+        verify = self.keyring.verifier(sender, key) if self.keys.rel(key) in SIGNED_DATA else None
+        on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {sender}")
         ib: Inbound[Any] = Inbound(
             key=key,
             msg_type=spec.message,
-            channel=None if self.reactor else self.transport.subscribe(key),
+            channel=None if self.reactor else self.transport.subscribe(key, verify=verify, on_forged=on_forged),
             schedule=schedule,
             lag=lag,
             link_class=spec.link_class,
@@ -144,7 +151,7 @@ class Node:
         )
         ib.strict = not self.cfg.realtime
         if self.reactor is not None:
-            self.transport.subscribe_callback(key, functools.partial(self.reactor.on_frame, ib))
+            self.transport.subscribe_callback(key, functools.partial(self.reactor.on_frame, ib), verify, on_forged)
         self.inbound.append(ib)
         return ib
 
@@ -212,6 +219,13 @@ class Node:
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )
                 self._alive_cond.wait(min(left, 0.5))
+        if self.tap is not None:
+            # Through a router (client mode), a peer's liveliness token can arrive
+            # before its subscriber declaration: the first tap batch would be
+            # filtered out at the source. Start once the recorder is matched.
+            tap_key = self.keys.tap(self.name)
+            while not self.transport.has_subscribers(tap_key) and time.monotonic() < deadline:
+                time.sleep(0.01)
         if told is not None and self.on_waiting is not None:
             self.on_waiting([])
 
@@ -269,7 +283,9 @@ class Node:
         (a process started on its own) nobody waits.
         """
         ack = self.transport.subscribe(self.keys.ack(self.name))
-        put = self.transport.publisher(self.keys.summary(self.name))
+        put = self.transport.publisher(
+            self.keys.summary(self.name), sign=self.keyring.signer(self.keys.summary(self.name))
+        )
         deadline = time.monotonic() + timeout
         while True:
             put(payload)

@@ -71,9 +71,10 @@ class NetConfig:
     listen: tuple[str, ...] = ()
     multicast: bool = False  # multicast scouting; off keeps matches apart
     extra: tuple[tuple[str, str], ...] = field(default=())  # (json5 path, json5 value) from --cfg
+    base: str = ""  # a credentials fragment (JSON), the starting point (runtime/credentials.py)
 
     def zenoh_config(self) -> zenoh.Config:
-        c = zenoh.Config()
+        c = zenoh.Config.from_json5(self.base) if self.base else zenoh.Config()
         c.insert_json5("mode", json.dumps(self.mode))
         c.insert_json5("scouting/multicast/enabled", "true" if self.multicast else "false")
         c.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
@@ -99,9 +100,22 @@ class NetConfig:
 ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),net:(handover:rx),app:(handover:rx))"
 
 
+# A client (a secure match, containers) sends everything over its one link to the
+# router, tap batches of ~100 kB included. With tx handed over to rx, a reactive
+# node's BLOCK put on zenoh's only thread waited for queue room that only that
+# thread could make: in secure recorded matches the engine stalled until its lease
+# expired (3 of 3 runs). A transmit thread of its own ends that (3 of 3 complete).
+# The router of a secure match, which carries every frame, gets one too (with one
+# thread: rtf 1.4 against 6-11 in a 2 x 5 s secure match on loopback TLS).
+CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1),net:(handover:rx),app:(handover:rx))"
+
+
 def open_session(net: NetConfig) -> zenoh.Session:
     """Open a zenoh session; use as `with open_session(net) as session:`."""
-    os.environ.setdefault("ZENOH_RUNTIME", ONE_THREAD_RUNTIME)
+    if os.environ.get("ZENOH_RUNTIME") in (None, ONE_THREAD_RUNTIME, CLIENT_RUNTIME):
+        # Ours, not the user's (children inherit the launcher's environment): choose per mode.
+        relays = net.mode == "client" or any(path == "access_control" for path, _ in net.extra)
+        os.environ["ZENOH_RUNTIME"] = CLIENT_RUNTIME if relays else ONE_THREAD_RUNTIME
     for ep in net.listen:
         check_endpoint("--listen", ep)
     for ep in net.connect:

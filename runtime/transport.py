@@ -53,17 +53,37 @@ class Channel(Protocol):
     def try_recv(self) -> bytes | None: ...
 
 
-class Transport(Protocol):
-    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
-        """A put function for `key`. With `when_matched`, puts are skipped while no
-        remote subscriber matches (for keys nobody in the lockstep waits on)."""
+# verify(payload, attachment) -> bool, and what to call for a frame that fails it (runtime/mac.py)
+Verify = Callable[[bytes, bytes | None], bool]
+Sign = Callable[[bytes], bytes]
 
-    def subscribe(self, key: str, latest: int = 0) -> Channel: ...
-    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
+
+class Transport(Protocol):
+    def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:
+        """A put function for `key`. With `when_matched`, puts are skipped while no
+        remote subscriber matches (for keys nobody in the lockstep waits on).
+        With `sign`, every put carries `sign(payload)` as its attachment (a MAC)."""
+
+    def subscribe(
+        self, key: str, latest: int = 0, verify: Verify | None = None, on_forged: Callable[[], None] | None = None
+    ) -> Channel:
+        """`latest` > 0: keep only the newest `latest` frames (a viewer), never block zenoh.
+        With `verify`, frames that fail it are dropped and `on_forged()` is called instead."""
+
+    def subscribe_callback(
+        self,
+        key: str,
+        callback: Callable[[bytes], None],
+        verify: Verify | None = None,
+        on_forged: Callable[[], None] | None = None,
+    ) -> None:
         """Run `callback(payload)` on the transport's own thread for every frame of `key`."""
 
     def wake(self, key: str) -> None:
         """Deliver WAKE to this process's own subscribers of `key` only."""
+
+    def has_subscribers(self, key: str) -> bool:
+        """Whether a remote subscriber matches this process's publisher of `key` (True if unknown)."""
 
     def declare_alive(self, key: str) -> None: ...
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
@@ -75,6 +95,11 @@ class Transport(Protocol):
 
 
 # ---------------------------------------------------------------------- zenoh
+def _attachment(sample: zenoh.Sample) -> bytes | None:
+    a = sample.attachment
+    return None if a is None else a.to_bytes()
+
+
 class _ZenohChannel:
     __slots__ = ("_sub",)
 
@@ -89,6 +114,38 @@ class _ZenohChannel:
         return None if s is None else s.payload.to_bytes()
 
 
+class _VerifiedChannel:
+    """A channel that hands on only frames whose MAC checks out (and local wake-ups)."""
+
+    __slots__ = ("_sub", "_verify", "_on_forged")
+
+    def __init__(self, sub: zenoh.Subscriber, verify: Verify, on_forged: Callable[[], None] | None):
+        self._sub = sub
+        self._verify = verify
+        self._on_forged = on_forged
+
+    def _check(self, s: zenoh.Sample) -> bytes | None:
+        payload = s.payload.to_bytes()
+        if payload == WAKE or self._verify(payload, _attachment(s)):
+            return payload
+        if self._on_forged is not None:
+            self._on_forged()
+        return None
+
+    def recv(self) -> bytes:
+        while True:
+            payload = self._check(self._sub.recv())
+            if payload is not None:
+                return payload
+
+    def try_recv(self) -> bytes | None:
+        while (s := self._sub.try_recv()) is not None:
+            payload = self._check(s)
+            if payload is not None:
+                return payload
+        return None
+
+
 class ZenohTransport:
     """Lockstep traffic is RELIABLE with congestion control BLOCK: nothing is dropped by zenoh.
 
@@ -100,13 +157,19 @@ class ZenohTransport:
     FIFO = 1 << 14  # frames buffered per subscription
     callbacks = True  # subscribe_callback works (Node.reactive)
 
-    def __init__(self, session: zenoh.Session):
+    def __init__(self, session: zenoh.Session, keyring: object = None):
         self.session = session
+        self.keyring = keyring  # runtime/mac.Keyring of this process, if it has credentials
         self._keep: list[object] = []  # declared entities live as long as the transport
         self._wakers: dict[str, zenoh.Publisher] = {}
         self._wake_lock = threading.Lock()
+        self._pubs: dict[str, zenoh.Publisher] = {}
 
-    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:
+    def has_subscribers(self, key: str) -> bool:
+        pub = self._pubs.get(key)
+        return pub is None or pub.matching_status.matching
+
+    def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:
         # A key nobody in the lockstep waits for (`world`, for viewers) never blocks its
         # sender: a viewer that falls behind loses frames instead of slowing the match.
         pub = self.session.declare_publisher(
@@ -117,8 +180,17 @@ class ZenohTransport:
             express=False,
         )
         self._keep.append(pub)
+        self._pubs[key] = pub
+        raw_put = pub.put
+        if sign is not None:
+            pub_put = pub.put
+
+            def signed_put(payload: bytes) -> None:
+                pub_put(payload, attachment=sign(payload))
+
+            raw_put = signed_put
         if not when_matched:
-            return pub.put
+            return raw_put
         matched = [pub.matching_status]
 
         def on_change(status: zenoh.MatchingStatus) -> None:
@@ -128,11 +200,13 @@ class ZenohTransport:
 
         def put(payload: bytes) -> None:
             if matched[0]:
-                pub.put(payload)
+                raw_put(payload)
 
         return put
 
-    def subscribe(self, key: str, latest: int = 0) -> Channel:
+    def subscribe(
+        self, key: str, latest: int = 0, verify: Verify | None = None, on_forged: Callable[[], None] | None = None
+    ) -> Channel:
         """`latest` > 0: keep only the newest `latest` frames (a viewer), never block zenoh."""
         handler = zenoh.handlers.RingChannel(latest) if latest > 0 else zenoh.handlers.FifoChannel(self.FIFO)
         sub = self.session.declare_subscriber(key, handler)
@@ -142,12 +216,30 @@ class ZenohTransport:
         # liveliness callback), and a session call there can collide with the
         # main thread's ("Already mutably borrowed").
         self._wakers[key] = self.session.declare_publisher(key, allowed_destination=zenoh.Locality.SESSION_LOCAL)
-        return _ZenohChannel(sub)
+        return _ZenohChannel(sub) if verify is None else _VerifiedChannel(sub, verify, on_forged)
 
-    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
-        def on_sample(sample: zenoh.Sample) -> None:
-            keep_thread_state()
-            callback(sample.payload.to_bytes())
+    def subscribe_callback(
+        self,
+        key: str,
+        callback: Callable[[bytes], None],
+        verify: Verify | None = None,
+        on_forged: Callable[[], None] | None = None,
+    ) -> None:
+        if verify is None:
+
+            def on_sample(sample: zenoh.Sample) -> None:
+                keep_thread_state()
+                callback(sample.payload.to_bytes())
+
+        else:
+
+            def on_sample(sample: zenoh.Sample) -> None:
+                keep_thread_state()
+                payload = sample.payload.to_bytes()
+                if payload == WAKE or verify(payload, _attachment(sample)):
+                    callback(payload)
+                elif on_forged is not None:
+                    on_forged()
 
         # indirect=False: run on zenoh's receive thread itself. The default hands
         # every sample to a Python thread of its own, one more wake-up per frame.
@@ -196,6 +288,7 @@ class ZenohTransport:
             if undeclare is not None:
                 undeclare()
         self._keep.clear()
+        self._pubs.clear()
 
 
 # --------------------------------------------------------------------- memory
@@ -271,7 +364,8 @@ class MemoryTransport:
         self.bus = bus
         self._tokens: list[str] = []
 
-    def publisher(self, key: str, when_matched: bool = False) -> Callable[[bytes], None]:  # noqa: ARG002
+    def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:  # noqa: ARG002
+        # No attachments on the memory bus: it runs in one trusted process (unit tests).
         bus = self.bus
 
         def put(payload: bytes) -> None:
@@ -279,16 +373,19 @@ class MemoryTransport:
 
         return put
 
-    def subscribe(self, key: str, latest: int = 0) -> Channel:  # noqa: ARG002 - unbounded here
+    def subscribe(self, key: str, latest: int = 0, verify=None, on_forged=None) -> Channel:  # noqa: ARG002 - unbounded here
         return self.bus.subscribe(self, key)
 
-    def subscribe_callback(self, key: str, callback: Callable[[bytes], None]) -> None:
+    def subscribe_callback(self, key: str, callback: Callable[[bytes], None], verify=None, on_forged=None) -> None:  # noqa: ARG002
         # A callback would run in the sender's thread, inside the sender's own
         # tick: nodes on a memory bus pull from channels instead (Node.reactive).
         raise NotImplementedError("MemoryTransport delivers to channels only")
 
     def wake(self, key: str) -> None:
         self.bus.deliver(key, WAKE, only=self)
+
+    def has_subscribers(self, key: str) -> bool:  # noqa: ARG002
+        return True
 
     def declare_alive(self, key: str) -> None:
         self._tokens.append(key)

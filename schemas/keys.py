@@ -108,7 +108,14 @@ KEYS: tuple[KeySpec, ...] = (
         "order", "team/<team>/order/<n>", m.Order, "B_R_n", "basestation/<team>", "robot n", Timing("comm", 1), "wifi"
     ),
     KeySpec(
-        "referee", "referee", m.Referee, "Re_G, Re_B", "referee", "engine, base stations", Timing("referee", 0), "wired"
+        "referee",
+        "referee",
+        m.Referee,
+        "Re_G, Re_B",
+        "referee",
+        "engine, base stations, refbox, viewers",
+        Timing("referee", 0),
+        "wired",
     ),
     KeySpec("events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", Timing("referee", -1), "wired"),
     KeySpec(
@@ -136,6 +143,59 @@ KEYS: tuple[KeySpec, ...] = (
 )
 
 KEY_BY_NAME = {k.name: k for k in KEYS}
+
+TEAM_NAMES = ("a", "b")
+VIEWER = "viewer"  # a read-only principal (world, referee, field), not a process of the match
+
+
+def process_names(robots: int, record: bool = True) -> list[str]:
+    """Every process of a match with `robots` per team, in `MatchConfig.processes()` order."""
+    names = ["engine", "referee"] + [f"basestation/{t}" for t in TEAM_NAMES]
+    names += [f"robot/{t}/{n}" for t in TEAM_NAMES for n in range(robots)]
+    return names + (["recorder"] if record else [])
+
+
+def _who(role: str, team: str, n: int) -> list[str]:
+    """The processes a `sender`/`receivers` word of the key table stands for."""
+    role = role.strip().replace("<team>", team).replace("<n>", str(n))
+    if role.startswith(("robot/", "basestation/")):
+        return [role]
+    if role == "robot n":
+        return [f"robot/{team}/{n}"]
+    if role == "base station":
+        return [f"basestation/{team}"]
+    if role == "base stations":
+        return [f"basestation/{t}" for t in TEAM_NAMES]
+    if role == "viewers":
+        return [VIEWER]
+    if role in ("engine", "referee", "recorder", "refbox"):
+        return [role]
+    raise ValueError(f"key table: unknown party {role!r}")
+
+
+def routes(robots: int) -> list[tuple[str, str, tuple[str, ...]]]:
+    """(key relative to arena/<m>/, sender, receivers) for every concrete data key of a match.
+
+    Derived from the `sender` and `receivers` columns of `KEYS` alone; the
+    access control of a secure match (runtime/acl.py) and the recorder's
+    check of who may send what are built from it.
+    """
+    everyone = process_names(robots) + [VIEWER]
+    out = []
+    for spec in KEYS:
+        teams = TEAM_NAMES if "<team>" in spec.pattern else ("",)
+        numbers = range(robots) if "<n>" in spec.pattern else (0,)
+        for team in teams:
+            for n in numbers:
+                rel = spec.rel(team, n if "<n>" in spec.pattern else None)
+                (sender,) = _who(spec.sender, team, n)
+                if spec.receivers == "all":
+                    receivers = [p for p in everyone if p != sender]
+                else:
+                    receivers = [p for word in spec.receivers.split(",") for p in _who(word, team, n)]
+                out.append((rel, sender, tuple(receivers)))
+    return out
+
 
 # Infrastructure keys (not data pairs of the paper).
 ALIVE = "alive"  # liveliness tokens: arena/<m>/alive/<process id>

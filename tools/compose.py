@@ -23,8 +23,10 @@ import yaml
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys
+from arena.schemas.keys import Keys, process_names
 from arena.tools import launcher
+
+MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
 
 _VAR = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)(?::?-([^}]*))?\}")
 
@@ -119,7 +121,8 @@ def up(path: str, timeout: float = 600.0) -> dict:
         with open_session(NetConfig(mode="client", connect=(env["ARENA_CONNECT"],))) as session:
             transport = ZenohTransport(session)
             keys = Keys(match)
-            collector = launcher.open_collector(transport, keys)
+            # The configuration (how many robots) comes from the engine later: listen for any.
+            collector = launcher.open_collector(transport, keys, process_names(MAX_ROBOTS))
             for name, argv in services.items():
                 if name != router:
                     children.append(launcher.spawn(name, _process_of(argv), _argv(argv), tmp, env=env))

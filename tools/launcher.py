@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import compileall
 import ctypes
+import functools
 import hashlib
 import importlib.util
+import ipaddress
 import os
 import shutil
 import signal
@@ -29,6 +31,7 @@ import msgspec
 import zenoh
 
 from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.credentials import Secrets
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
@@ -202,9 +205,17 @@ def new_match_id(seed: int) -> str:
 
 
 def run_argv(
-    pid: ProcessId, match: str, connect: str, config_path: str | None = None, record: str = "", host: str = ""
+    pid: ProcessId,
+    match: str,
+    connect: str,
+    config_path: str | None = None,
+    record: str = "",
+    host: str = "",
+    credentials: str | None = None,
 ) -> list[str]:
     argv = [sys.executable, "-m", "arena", "run", pid.kind, "--match", match, "--connect", connect]
+    if credentials:
+        argv += ["--credentials", credentials]
     if pid.team:
         argv += ["--team", pid.team]
     if pid.kind == "robot":
@@ -291,6 +302,7 @@ class Progress:
 class Collected:
     summaries: dict[str, Summary] = field(default_factory=dict)
     pids: dict[str, int] = field(default_factory=dict)
+    forged: Counter = field(default_factory=Counter)  # rejected summaries per key
     started: float = 0.0
     ended: float = 0.0
     crashed: dict[str, str] = field(default_factory=dict)  # name -> why (exit code)
@@ -299,11 +311,58 @@ class Collected:
     void: str = ""  # why the match is void, found while supervising
 
 
-def open_collector(transport: ZenohTransport, keys: Keys):
-    """Subscribe to the summaries and announce a collector, before any process starts."""
-    channel = transport.subscribe(keys.summary_all())
-    transport.declare_alive(keys.collector())
-    return channel
+class Collector:
+    """The summaries of a match, one subscription per process, each verified with that process's key.
+
+    A Summary counts only if its MAC checks out (runtime/mac.py), it names the
+    process whose key it is on, it is plausible, and it is the first one; any
+    other counts under `forged` (the launcher's own counter, per key).
+    """
+
+    def __init__(self, transport: ZenohTransport, keys: Keys, names: list[str]):
+        self.keys = keys
+        self.forged: Counter[str] = Counter()
+        self.channels = {}
+        ring = getattr(transport, "keyring", None)
+        for name in names:
+            key = keys.summary(name)
+            verify = ring.verifier(name, key) if ring is not None else None
+            on_forged = functools.partial(self.count, name, "no valid MAC")
+            self.channels[name] = transport.subscribe(key, verify=verify, on_forged=on_forged)
+        transport.declare_alive(keys.collector())
+
+    def count(self, name: str, why: str) -> None:
+        key = f"summary/{name}"
+        self.forged[key] += 1
+        if self.forged[key] <= 3:
+            print(f"arena match: warning: forged {key} rejected ({why})", file=sys.stderr, flush=True)
+
+    def poll(self):
+        for name, ch in self.channels.items():
+            while (raw := ch.try_recv()) is not None:
+                yield name, raw
+
+
+def implausible(s: Summary, name: str, cfg: MatchConfig, names: list[str]) -> str | None:
+    """Why a Summary cannot be the one `name` sent, or None."""
+    if s.process != name or name not in names:
+        return f"it names {s.process!r}, not a process of this match"
+    if not 0 <= s.tick <= cfg.total_ticks:
+        return f"tick {s.tick} outside 0..{cfg.total_ticks}"
+    if s.sent != sum(s.sent_by_key.values()) or s.sent < 0:
+        return "sent differs from the sum of sent_by_key"
+    if s.rejected != sum(s.rejected_reasons.values()) or s.rejected < 0:
+        return "rejected differs from the sum of rejected_reasons"
+    if not set(s.dead) <= set(names) or name in s.dead:
+        return "dead names unknown processes"
+    if len(s.digest) != 32 or any(c not in "0123456789abcdef" for c in s.digest):
+        return "digest is not 32 hex digits"
+    return None
+
+
+def open_collector(transport: ZenohTransport, keys: Keys, names: list[str]) -> Collector:
+    """Subscribe to every process's summary and announce a collector, before any process starts."""
+    return Collector(transport, keys, names)
 
 
 # [s] a process whose liveliness token vanished, or that exited, gets this long
@@ -377,20 +436,36 @@ def supervise(
         if name.split("/")[0] in VOIDING and not got.void:
             got.void = f"{name} {why}"
 
+    got.forged = sums.forged
+    acks: dict[str, object] = {}
     with progress:
         while waiting - set(got.summaries) and not got.void:
-            raw = sums.try_recv()
-            if raw is not None:
+            polled = False
+            for name, raw in sums.poll():
+                polled = True
                 try:
                     s = decode_summary(raw)
                 except (msgspec.DecodeError, msgspec.ValidationError):
-                    continue  # not ours to judge; the rest of the match goes on
-                if s.process not in got.summaries:
-                    got.summaries[s.process] = s
-                    last_summary = time.monotonic()
-                    if s.process == "engine":
-                        engine_done = time.monotonic()
-                transport.publisher(keys.ack(s.process))(b"ack")
+                    sums.count(name, "not a Summary")
+                    continue
+                first = got.summaries.get(name)
+                if first is not None:
+                    if msgspec.msgpack.encode(first) != msgspec.msgpack.encode(s):
+                        sums.count(name, "a second, different summary")
+                    else:
+                        acks[name](b"ack")  # the sender repeats it until acknowledged
+                    continue
+                why = implausible(s, name, cfg, expected)
+                if why is not None:
+                    sums.count(name, why)
+                    continue
+                got.summaries[name] = s
+                last_summary = time.monotonic()
+                if name == "engine":
+                    engine_done = time.monotonic()
+                acks[name] = transport.publisher(keys.ack(name))
+                acks[name](b"ack")
+            if polled:
                 continue
             if refs is not None:
                 last = None
@@ -476,6 +551,8 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
     rejected = Counter()
     for s in sums.values():
         rejected.update(s.rejected_reasons)
+    if got.forged:
+        rejected["forged"] += sum(got.forged.values())
     pid_of = {c.name: c.popen.pid for c in children}
     processes = []
     for p in cfg.processes():
@@ -540,6 +617,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "dead": honest["dead"],
         "faults": honest["faults"],
         "conflicts": honest["conflicts"],
+        "forged_summaries": dict(sorted(got.forged.items())),
         "sent_by_key": dict(sorted(sent_by_key.items())),
         "recording": recording,
         "refbox": sums["refbox"].extra if "refbox" in sums else None,
@@ -547,19 +625,51 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
     }
 
 
-def instructions(external: list[ProcessId], match: str, endpoint: str, cfg: MatchConfig) -> str:
+def instructions(
+    external: list[ProcessId],
+    match: str,
+    endpoint: str,
+    cfg: MatchConfig,
+    credentials: dict[str, Path] | None = None,
+    secure: bool = False,
+) -> str:
     """What to type on the robot's computer: a command per --external process, with an address it can reach."""
     endpoints, client = robot_endpoints(endpoint)
     n = len(external)
     lines = [f"waiting for {n} external process{'es' if n != 1 else ''}; start {'each' if n != 1 else 'it'} with:"]
     for p in external:
-        argv = run_argv(p, match, endpoints[0], record=cfg.record)[3:]
-        if client:
+        cred = str(credentials[str(p)]) if credentials else None
+        argv = run_argv(p, match, endpoints[0], record=cfg.record, credentials=cred)[3:]
+        if client and not secure:  # a secure match's credentials file says client mode
             argv += ["--mode", "client"]
         lines.append("  arena " + " ".join(argv))
+    if credentials:
+        lines.append("  (--credentials: that process's own key; copy the file to its computer and to nobody else)")
     if len(endpoints) > 1:
         lines.append(f"  (this machine is also reachable as: {', '.join(e.split('/', 1)[1] for e in endpoints[1:])})")
     return "\n".join(lines)
+
+
+def loopback_only(endpoint: str | None) -> bool:
+    """True for a unix socket or a TCP/TLS/UDP/QUIC endpoint on a loopback address."""
+    if endpoint is None or endpoint.startswith("unixsock-stream/"):
+        return True
+    address = endpoint.split("/", 1)[-1].split("#", 1)[0]
+    host = address.rsplit(":", 1)[0].strip("[]")
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False  # a host name: assume it is reachable from elsewhere
+
+
+def secure_endpoint(endpoint: str) -> tuple[str, bool]:
+    """The endpoint a secure match listens on (tcp becomes tls) and whether it uses TLS."""
+    proto, _, rest = endpoint.partition("/")
+    if proto == "tcp":
+        return "tls/" + rest, True
+    return endpoint, proto in ("tls", "quic")
 
 
 def play_match(
@@ -572,10 +682,16 @@ def play_match(
     announce=None,
     strict: bool = False,
     live_host: str = "127.0.0.1",
+    secure: bool | None = None,
+    credentials: str | None = None,
 ) -> dict:
     """Play one match as separate processes and return its result dict.
 
     `announce(text)` is called with instructions for `--external` processes.
+    `secure`: authenticated principals, access control and TLS (runtime/acl.py,
+    runtime/credentials.py); None means on whenever `listen` is not loopback.
+    `credentials`: the directory for every principal's credentials file
+    (default: the match's private temp dir).
     A failed process is a fault in the result (`outcome`, `faults`: see
     tools/faults.py); with `strict`, it raises MatchError instead, as does a
     match that cannot start.
@@ -586,29 +702,37 @@ def play_match(
     keys = Keys(match)
     tmp = Path(tempfile.mkdtemp(prefix="arena-"))
     endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
+    secure = (not loopback_only(listen)) if secure is None else secure
+    tls = False
+    if secure:
+        endpoint, tls = secure_endpoint(endpoint)
     connect = endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
     cfg_path = tmp / "config.json"
     cfg_path.write_text(cfg.to_json())
     logs = Path(log_dir) if log_dir else tmp
     logs.mkdir(parents=True, exist_ok=True)
+    names = [str(p) for p in cfg.processes()]
+    secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
+    cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials")
+    router_extra = tuple(secrets.router_settings(tmp)) if secure else ()
     children: list[Child] = []
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     try:
-        with open_session(NetConfig(mode="router", listen=(endpoint,))) as session:
-            transport = ZenohTransport(session)
-            collector = open_collector(transport, keys)
+        with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
+            transport = ZenohTransport(session, secrets.keyring("launcher"))
+            collector = open_collector(transport, keys, names)
             external = {ProcessId.parse(e) for e in cfg.external}
             for p in cfg.processes():
                 if p in external:
                     continue
-                argv = run_argv(p, match, connect, str(cfg_path), cfg.record, live_host)
+                argv = run_argv(p, match, connect, str(cfg_path), cfg.record, live_host, str(cred_paths[str(p)]))
                 children.append(spawn(str(p), p, argv, logs))
             if cfg.live >= 0 and announce is not None:
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
             joins = Joins(session, keys, external, announce)
             if external and announce is not None:
-                announce(instructions(sorted(external), match, endpoint, cfg))
+                announce(instructions(sorted(external), match, endpoint, cfg, cred_paths, secure))
             try:
                 joins.wait(cfg.timing.startup_timeout, children)
                 got = supervise(
@@ -633,6 +757,7 @@ def play_match(
             except subprocess.TimeoutExpired:
                 pass
         result = assemble(cfg, got, time.monotonic() - t_start, children)
+        result["secure"] = secure
         if result["outcome"] != "completed" and log_dir is None:
             keep = True  # a fault's evidence
             result["logs"] = str(tmp)

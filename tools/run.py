@@ -13,6 +13,7 @@ Where the match configuration comes from:
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import signal
@@ -26,6 +27,8 @@ import zenoh
 
 from arena.processes import node_class
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
+from arena.runtime.credentials import load_fragment
+from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open_session
 from arena.runtime.transport import ZenohTransport
@@ -51,6 +54,22 @@ def process_id(kind: str, team: str | None, robot: int | None) -> ProcessId:
     if kind == "basestation":
         return ProcessId("basestation", team or "")
     return ProcessId(kind)
+
+
+def load_credentials(path: str, pid: ProcessId, match: str) -> tuple[str, str | None, Keyring]:
+    """(fragment JSON, zenoh mode it asks for, keyring) from `--credentials FILE`, checked against who we are."""
+    try:
+        frag = load_fragment(path)
+        arena = frag["metadata"]["arena"]
+        keyring = Keyring.from_hex(arena["process"], arena.get("keys", {}))
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    if arena["process"] != str(pid):
+        raise ConfigError(f"--credentials {path} belongs to {arena['process']}, not {pid}")
+    if arena.get("match") != match:
+        raise ConfigError(f"--credentials {path} belongs to match {arena.get('match')!r}, not {match!r}")
+    mode = frag.get("mode")
+    return json.dumps(frag), mode if mode in ("peer", "client") else None, keyring
 
 
 def load_config(path: str) -> MatchConfig:
@@ -132,6 +151,7 @@ def run(
     record: str | None = None,
     host: str = "127.0.0.1",
     port: int | None = None,
+    keyring: Keyring | None = None,
 ) -> int:
     """Run one process to the end of its match. Returns the exit code.
 
@@ -153,7 +173,7 @@ def run(
     where = ", ".join(net.connect or net.listen)
     last_ref: list[bytes] = []
     with open_until(net, startup_timeout, where, tell) as session:
-        transport = ZenohTransport(session)
+        transport = ZenohTransport(session, keyring)
         ref_sub = None
         try:
             if cfg is None:

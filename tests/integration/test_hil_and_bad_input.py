@@ -172,15 +172,18 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
         result = _result(match)
     assert rounds >= 10, f"only {rounds} rounds of bad frames before the match ended"
     reasons = result["rejected_reasons"]
-    assert reasons.get("invalid", 0) >= 3, reasons  # at least one per receiver: engine and two base stations
+    assert reasons.get("invalid", 0) >= 2, reasons  # at least one per base station
     # Team c and command CELEBRATE never decode (the wire types are Literal), whatever the tick.
-    assert 3 <= reasons.get("malformed", 0) <= 3 * 4 * rounds, reasons
+    assert 2 <= reasons.get("malformed", 0) <= 2 * 4 * rounds, reasons
     logs = tmp_path / "logs"
-    for process in ("engine", "basestation_a", "basestation_b"):
+    for process in ("basestation_a", "basestation_b"):
         log = (logs / f"{process}.log").read_text()
         assert "rejected input on arena/refnoise/referee: invalid:" in log, process
         assert "malformed: Invalid enum value 'c'" in log, process
-    assert "malformed: Invalid enum value 'CELEBRATE'" in (logs / "engine.log").read_text()
+    # The engine holds the referee's MAC key (runtime/mac.py): frames without a
+    # valid MAC never reach its checks, whatever their content.
+    assert reasons.get("forged", 0) >= 3 * rounds, reasons
+    assert "rejected input on arena/refnoise/referee: forged: not from referee" in (logs / "engine.log").read_text()
     assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
 
 

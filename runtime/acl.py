@@ -1,0 +1,105 @@
+"""Access control of a secure match, generated from the key table.
+
+`schemas.keys.routes()` says, for every concrete key, who sends it and who
+receives it. From that alone, each principal (one per process, plus the
+read-only `viewer`) gets a zenoh `access_control` policy, matched on its
+`transport/auth/usrpwd` user name, default permission deny:
+
+* `put` (ingress) only on the keys it sends, its own `summary/<p>` and `tap/<p>`;
+* `declare_subscriber` (ingress) only on the keys it receives and its own
+  `ack/<p>` (the recorder: `tap/**` and `summary/**`);
+* `put` (egress) only on the keys it may read, so the router never forwards
+  a frame to a principal that may not read it; subscriber declarations
+  (egress) on the whole match, so a sender learns of every matching
+  subscriber, wildcards included (who listens is no secret);
+* its own liveliness token `alive/<p>`, and reading `alive/**` and the
+  collector's token (the start barrier and dead-peer detection);
+* querying the engine's `config` queryable (the engine: serving it);
+* the viewer: reading `world`, `referee` and `field` only, and the live
+  viewer's `control` (pause, step, pace) to the engine.
+
+The router (hosted by `arena match` / `arena run router`) enforces it for
+every process, since in a secure match every process is a client of it
+(runtime/credentials.py says why).
+"""
+
+from __future__ import annotations
+
+from arena.schemas.keys import ACK, ALIVE, COLLECTOR, CONFIG, CONTROL, REFUSED, SUMMARY, TAP, VIEWER, routes
+
+
+def user_of(principal: str) -> str:
+    """The zenoh user name (and credentials file stem) of a principal: `robot/b/1` -> `robot-b-1`."""
+    return principal.replace("/", "-")
+
+
+def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]]:
+    """Key expressions per (message, flow) for one principal; `prefix` is `arena/<match>/`."""
+    table = routes(robots)
+    sends = [prefix + rel for rel, sender, _ in table if sender == principal]
+    receives = [prefix + rel for rel, _, receivers in table if principal in receivers]
+    own_out = [f"{prefix}{x}/{principal}" for x in (SUMMARY, TAP, REFUSED)]
+    own_in = [f"{prefix}{ACK}/{principal}"]
+    if principal == "recorder":
+        own_in += [f"{prefix}{TAP}/**", f"{prefix}{SUMMARY}/**"]
+    writes = sends + own_out
+    reads = receives + own_in
+    barrier = [f"{prefix}{ALIVE}/**", f"{prefix}{COLLECTOR}"]
+    config = [f"{prefix}{CONFIG}"]
+    perms = {
+        "put/ingress": writes,
+        # Who subscribes is no secret (the key table is public), and a sender
+        # must learn of wildcard subscribers (the recorder's `tap/**`) too.
+        "declare_subscriber/egress": [f"{prefix}**"],
+        "declare_subscriber/ingress": reads,
+        "put/egress": reads,
+        "liveliness_token/ingress": [f"{prefix}{ALIVE}/{principal}"],
+        "liveliness_token/egress": barrier,
+        "declare_liveliness_subscriber/ingress": barrier,
+        "liveliness_query/ingress": barrier,
+        "query/ingress": config,
+        "reply/egress": config,
+        "declare_queryable/egress": config,
+    }
+    control = [f"{prefix}{CONTROL}"]  # the live viewer's pause/step/pace, to the engine
+    if principal == "engine":
+        perms.update({"declare_queryable/ingress": config, "reply/ingress": config, "query/egress": config})
+        perms["declare_subscriber/ingress"] = [*reads, *control]
+        perms["put/egress"] = [*reads, *control]
+        perms["query/ingress"] = [*config, *control]
+        perms["reply/egress"] = [*config, *control]
+    if principal == VIEWER:
+        perms["put/ingress"] = [*writes, *control]
+        perms.update({"declare_queryable/ingress": control, "reply/ingress": control, "query/egress": control})
+    return {k: v for k, v in perms.items() if v}
+
+
+def principals(processes: list[str]) -> list[str]:
+    """The principals of a match: its processes (`MatchConfig.processes()`) and the viewer."""
+    return [*processes, VIEWER] if VIEWER not in processes else list(processes)
+
+
+def access_control(prefix: str, robots: int, processes: list[str]) -> dict:
+    """The router's `access_control` section (zenoh 1.x format), default deny."""
+    rules: list[dict] = []
+    subjects: list[dict] = []
+    policies: list[dict] = []
+    for p in principals(processes):
+        user = user_of(p)
+        ids = []
+        for what, key_exprs in permissions(p, prefix, robots).items():
+            message, flow = what.split("/")
+            rid = f"{user}:{message}:{flow}"
+            rules.append(
+                {"id": rid, "messages": [message], "flows": [flow], "permission": "allow", "key_exprs": key_exprs}
+            )
+            ids.append(rid)
+        subjects.append({"id": user, "usernames": [user]})
+        policies.append({"id": f"{user}:policy", "rules": ids, "subjects": [user]})
+    return {
+        "enabled": True,
+        "default_permission": "deny",
+        "rules": rules,
+        "subjects": subjects,
+        "policies": policies,
+    }

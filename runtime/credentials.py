@@ -1,0 +1,181 @@
+"""Per-match credentials: zenoh users and passwords, a per-event TLS CA, MAC keys.
+
+`arena match` makes one `Secrets` per match and writes, for every principal,
+one zenoh configuration fragment `<user>.json5` (schemas/README.md,
+"Security"): everything a C, C++ or Rust client needs besides the router's
+address. The file is plain JSON (valid JSON5), readable by the owner only:
+
+    {"mode": "client",                                   # secure matches only
+     "transport": {"auth": {"usrpwd": {"user": ..., "password": ...}},
+                   "link": {"tls": {"root_ca_certificate_base64": ...,
+                                    "verify_name_on_connect": false}}},
+     "metadata": {"arena": {"match": ..., "process": ..., "keys": {process: hex}}}}
+
+`metadata` is free-form in zenoh's configuration and stays local (zenoh shows
+it only in the session's own admin space, off by default); `keys` holds the
+process's own MAC key and the keys of the senders it verifies (runtime/mac.py).
+
+Why clients through the router in secure mode: zenoh enforces access control
+on the node that receives a message, by the user name its transport
+authenticated. Between peers, each peer would have to hold every user's
+password (to authenticate the others) and would enforce only its own ACL, and
+a team's robot computer is not ours to trust. So every process is a client of
+the router, which holds the only dictionary and the only ACL.
+
+TLS: the CA is made fresh for every match (EC P-256, the `cryptography`
+package), signs exactly one certificate, the router's, and its private key is
+dropped at once. A client that trusts only this CA can talk only to this
+match's router, so the host name check adds nothing and is off (the router's
+address is often an IP from a venue's DHCP).
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime
+import ipaddress
+import json
+import os
+import secrets
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from arena.runtime.acl import access_control, principals, user_of
+from arena.runtime.mac import Keyring, new_key
+
+OFFICIAL_VERIFIES = {"engine": ["referee"], "referee": ["engine"], "viewer": ["engine", "referee"]}
+
+
+@dataclass
+class Secrets:
+    match: str
+    robots: int
+    processes: list[str]  # MatchConfig.processes(), as names
+    secure: bool
+    passwords: dict[str, str] = field(default_factory=dict)
+    mac_keys: dict[str, bytes] = field(default_factory=dict)
+    ca_pem: bytes = b""
+    router_cert_pem: bytes = b""
+    router_key_pem: bytes = b""
+
+    @classmethod
+    def new(cls, match: str, robots: int, processes: list[str], secure: bool, tls: bool = False) -> Secrets:
+        s = cls(match, robots, list(processes), secure)
+        for p in principals(s.processes):
+            s.passwords[p] = secrets.token_urlsafe(24)
+            s.mac_keys[p] = new_key()
+        if tls:
+            s.ca_pem, s.router_cert_pem, s.router_key_pem = make_tls()
+        return s
+
+    def keyring(self, principal: str) -> Keyring:
+        if principal in ("recorder", "launcher"):
+            verifies = list(self.mac_keys)
+        else:
+            verifies = [principal, *OFFICIAL_VERIFIES.get(principal, [])]
+        return Keyring(principal, {p: self.mac_keys[p] for p in verifies if p in self.mac_keys})
+
+    def fragment(self, principal: str) -> dict:
+        ring = self.keyring(principal)
+        frag: dict = {}
+        if self.secure:
+            frag["mode"] = "client"
+            usrpwd = {"user": user_of(principal), "password": self.passwords[principal]}
+            frag["transport"] = {"auth": {"usrpwd": usrpwd}}
+            if self.ca_pem:
+                tls = {"root_ca_certificate_base64": base64.b64encode(self.ca_pem).decode()}
+                frag["transport"]["link"] = {"tls": tls | {"verify_name_on_connect": False}}
+        keys = {p: k.hex() for p, k in ring.keys.items()}
+        frag["metadata"] = {"arena": {"match": self.match, "process": principal, "keys": keys}}
+        return frag
+
+    def write(self, directory: Path) -> dict[str, Path]:
+        """Write every principal's fragment (mode 0600) into `directory`; returns their paths."""
+        directory.mkdir(parents=True, exist_ok=True)
+        out = {}
+        for p in principals(self.processes):
+            path = directory / f"{user_of(p)}.json5"
+            _write_private(path, json.dumps(self.fragment(p), indent=2) + "\n")
+            out[p] = path
+        return out
+
+    def router_settings(self, directory: Path) -> list[tuple[str, str]]:
+        """(json5 path, json5 value) for the router's zenoh configuration (secure matches)."""
+        dictionary = directory / "router-users.txt"
+        _write_private(dictionary, "".join(f"{user_of(p)}:{pw}\n" for p, pw in self.passwords.items()))
+        acl = access_control(f"arena/{self.match}/", self.robots, self.processes)
+        items = [
+            ("transport/auth/usrpwd/dictionary_file", json.dumps(str(dictionary))),
+            ("access_control", json.dumps(acl)),
+        ]
+        if self.router_cert_pem:
+            for name, pem in (
+                ("listen_certificate", self.router_cert_pem),
+                ("listen_private_key", self.router_key_pem),
+            ):
+                items.append((f"transport/link/tls/{name}_base64", json.dumps(base64.b64encode(pem).decode())))
+        return items
+
+
+def _write_private(path: Path, text: str) -> None:
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+
+
+def load_fragment(path: str) -> dict:
+    """A credentials fragment written by `arena match`; ValueError with a one-line reason if unusable."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as exc:
+        raise ValueError(f"cannot read --credentials {path}: {exc.strerror}") from None
+    except ValueError:
+        raise ValueError(f"--credentials {path} is not a credentials file written by arena match") from None
+    arena = data.get("metadata", {}).get("arena") if isinstance(data, dict) else None
+    if not isinstance(arena, dict) or not isinstance(arena.get("process"), str):
+        raise ValueError(f"--credentials {path} has no metadata.arena.process: not written by arena match")
+    return data
+
+
+def make_tls(hosts: tuple[str, ...] = ("127.0.0.1", "localhost")) -> tuple[bytes, bytes, bytes]:
+    """A fresh CA and the router's certificate signed by it: (ca_pem, cert_pem, key_pem)."""
+    from cryptography import x509
+    from cryptography.hazmat.primitives import hashes, serialization
+    from cryptography.hazmat.primitives.asymmetric import ec
+    from cryptography.x509.oid import NameOID
+
+    now = datetime.datetime.now(datetime.UTC)
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca_name = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, f"arena match CA {secrets.token_hex(4)}")])
+    ca = (
+        x509.CertificateBuilder()
+        .subject_name(ca_name)
+        .issuer_name(ca_name)
+        .public_key(ca_key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(now - datetime.timedelta(minutes=5))
+        .not_valid_after(now + datetime.timedelta(days=2))
+        .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
+        .sign(ca_key, hashes.SHA256())
+    )
+    key = ec.generate_private_key(ec.SECP256R1())
+    names: list[x509.GeneralName] = []
+    for h in hosts:
+        try:
+            names.append(x509.IPAddress(ipaddress.ip_address(h)))
+        except ValueError:
+            names.append(x509.DNSName(h))
+    cert = (
+        x509.CertificateBuilder()
+        .subject_name(x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "arena router")]))
+        .issuer_name(ca_name)
+        .public_key(key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(now - datetime.timedelta(minutes=5))
+        .not_valid_after(now + datetime.timedelta(days=2))
+        .add_extension(x509.SubjectAlternativeName(names), critical=False)
+        .sign(ca_key, hashes.SHA256())
+    )
+    pem = serialization.Encoding.PEM
+    key_pem = key.private_bytes(pem, serialization.PrivateFormat.PKCS8, serialization.NoEncryption())
+    return ca.public_bytes(pem), cert.public_bytes(pem), key_pem

@@ -1,0 +1,91 @@
+"""Message authentication: who really sent an owned message (the inner wall).
+
+zenoh tells a subscriber nothing it can trust about a sample's sender: the
+source info is written by the sender itself, and without `--secure` anybody
+who reaches the router can put on any key. So the messages a match's *result*
+depends on carry a MAC, in the sample's zenoh attachment (the payload, and so
+every digest and every recorded byte, stays exactly what it was):
+
+    attachment = BLAKE2b(key=K_sender, digest_size=16)(key_expr || 0x00 || payload)
+
+`key_expr` is the full key put on (`arena/<match>/engine/events`), `K_sender`
+the sender's own 32-byte key. Every process of a match gets a fresh random key
+from the launcher (in its credentials fragment, schemas/README.md "Security"),
+and a receiver that must trust a sender gets that sender's key too:
+
+* `summary/<p>`: verified by the collector (`arena match`) and the recorder;
+* `tap/<p>`: verified by the recorder;
+* `engine/events`: verified by the referee; `referee`: verified by the engine;
+* `world`: verified by whoever holds the engine's key (the viewer's fragment).
+
+A message on one of these keys with a missing or wrong MAC is dropped and
+counted under the reason `forged`. A process with no key (started by hand
+without `--credentials`) sends no MAC, and a receiver with no key for a
+sender accepts what comes: that is the match of earlier versions, no worse.
+Replays of genuine messages are caught by what is already there: ticks and
+batch numbers in sequence, one Summary per process.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import hmac
+import os
+from collections.abc import Callable
+
+TAG_BYTES = 16
+KEY_BYTES = 32
+# Keys whose frames are MAC'd by their sender (relative to arena/<match>/, see schemas/keys.py).
+SIGNED_DATA = ("engine/events", "referee", "world")
+
+
+def new_key() -> bytes:
+    return os.urandom(KEY_BYTES)
+
+
+def tag(key: bytes, key_expr: str, payload: bytes) -> bytes:
+    h = hashlib.blake2b(key=key, digest_size=TAG_BYTES)
+    h.update(key_expr.encode())
+    h.update(b"\0")
+    h.update(payload)
+    return h.digest()
+
+
+class Keyring:
+    """This process's own key and the keys of the senders it verifies."""
+
+    def __init__(self, process: str = "", keys: dict[str, bytes] | None = None):
+        self.process = process
+        self.keys = dict(keys or {})
+
+    @classmethod
+    def from_hex(cls, process: str, keys: dict[str, str]) -> Keyring:
+        try:
+            raw = {p: bytes.fromhex(k) for p, k in keys.items()}
+        except (ValueError, TypeError, AttributeError):
+            raise ValueError("credentials: a key is not hex") from None
+        if any(len(k) != KEY_BYTES for k in raw.values()):
+            raise ValueError(f"credentials: every key must be {KEY_BYTES} bytes")
+        return cls(process, raw)
+
+    @property
+    def own(self) -> bytes | None:
+        return self.keys.get(self.process)
+
+    def signer(self, key_expr: str) -> Callable[[bytes], bytes] | None:
+        """attachment(payload) for a key this process sends, or None without a key."""
+        k = self.own
+        if k is None:
+            return None
+        return lambda payload: tag(k, key_expr, payload)
+
+    def verifier(self, sender: str, key_expr: str) -> Callable[[bytes, bytes | None], bool] | None:
+        """ok(payload, attachment) for frames of `sender` on `key_expr`; None: no key, accept all."""
+        k = self.keys.get(sender)
+        if k is None:
+            return None
+
+        def ok(payload: bytes, attachment: bytes | None) -> bool:
+            return attachment is not None and hmac.compare_digest(attachment, tag(k, key_expr, payload))
+
+        return ok
