@@ -412,6 +412,7 @@ def build_parser() -> Parser:
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
     v.add_argument("file", help="an MCAP file written by arena match --record")
     v.add_argument("--plots", metavar="DIR", help="also write PNG charts and an animated GIF into DIR")
+    v.add_argument("--goalkeepers", action="store_true", help="with --plots: keep the goalkeepers in the heatmaps")
     v.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
 
     y = add("replay", "re-run one process against its recorded inputs and compare its outputs")
@@ -788,7 +789,7 @@ def cmd_review(args: argparse.Namespace) -> int:
 
     if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
         raise ConfigError(f"--plots {args.plots} exists and is not a directory")
-    return review.main(args.file, plots=args.plots, as_json=args.json)
+    return review.main(args.file, plots=args.plots, as_json=args.json, goalkeepers=args.goalkeepers)
 
 
 def cmd_facts(args: argparse.Namespace) -> int:

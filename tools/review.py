@@ -20,14 +20,13 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
 from rich.console import Console
 from rich.table import Table
 
 from arena.recording.analysis import NEEDED, analyse
-from arena.recording.analysis.review import JUMP
 from arena.recording.reader import Recording, RecordingError, load
 from arena.schemas.messages import World
+from arena.tools import plots as pictures
 
 GIF_FRAMES = 100  # [-] at most this many frames in the animation (Pillow encodes ~30 ms each)
 GIF_FPS = 10  # [1/s]
@@ -180,8 +179,11 @@ def _draw_field(ax, cfg, grass: bool = True) -> None:
     ax.set_ylabel("y [m]")
 
 
-def write_plots(rec: Recording, review: dict, out_dir: str) -> list[str]:
-    """PNG charts and an animated GIF of the match; returns the paths written."""
+def write_plots(rec: Recording, review: dict, out_dir: str, goalkeepers: bool = False) -> list[str]:
+    """PNG charts and an animated GIF of the match; returns the paths written.
+
+    Trajectories and heatmaps are tools/plots.py's; `goalkeepers` puts them in the heatmaps.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -193,47 +195,9 @@ def write_plots(rec: Recording, review: dict, out_dir: str) -> list[str]:
     cfg = rec.cfg
     worlds: list[World] = rec.decoded("world", World)
     written = []
-    names = sorted({f"{r.team}/{r.robot}" for w in worlds for r in w.robots})
-    tracks = {n: ([], []) for n in names}
-    ball = ([], [])
-    for w in worlds:
-        _extend(ball, w.ball_x, w.ball_y)
-        for r in w.robots:
-            _extend(tracks[f"{r.team}/{r.robot}"], r.x, r.y)
-
-    fig, ax = plt.subplots(figsize=(10, 7))
-    _draw_field(ax, cfg)
-    for n, (xs, ys) in tracks.items():
-        ax.plot(xs, ys, color=TEAM_COLOURS[n[0]], lw=0.8, alpha=0.7, label=n)
-    ax.plot(ball[0], ball[1], color="orange", lw=0.8, alpha=0.9, label="ball")
-    ax.legend(loc="upper right", fontsize=7, ncol=2)
-    ax.set_title(f"trajectories: {cfg.home} (a) vs {cfg.away} (b), seed {cfg.seed}")
-    written.append(_save(fig, out / "trajectories.png"))
-
-    fig, axes = plt.subplots(1, 3, figsize=(18, 5))
-    f = cfg.field
-    extent = [[-f.length / 2 - f.runoff, f.length / 2 + f.runoff], [-f.width / 2 - f.runoff, f.width / 2 + f.runoff]]
-    for ax, (title, xs, ys) in zip(
-        axes,
-        [
-            ("ball", ball[0], ball[1]),
-            *(
-                (
-                    f"team {team}",
-                    [x for n in names if n[0] == team for x in tracks[n][0]],
-                    [y for n in names if n[0] == team for y in tracks[n][1]],
-                )
-                for team in "ab"
-            ),
-        ],
-    ):
-        ok = ~np.isnan(np.asarray(xs, dtype=float))
-        h, xe, ye = np.histogram2d(np.asarray(xs)[ok], np.asarray(ys)[ok], bins=[28, 20], range=extent)
-        ax.imshow(h.T, origin="lower", extent=[xe[0], xe[-1], ye[0], ye[-1]], cmap="magma", aspect="equal")
-        _draw_field(ax, cfg, grass=False)
-        ax.set_title(f"heatmap: {title}")
-        ax.set_xlabel("x [m]")
-    written.append(_save(fig, out / "heatmap.png"))
+    if worlds:
+        written.append(pictures.trajectories(worlds, cfg, out / "trajectories.png", _draw_field))
+        written.append(pictures.heatmap(worlds, cfg, out / "heatmap.png", _draw_field, goalkeepers))
 
     fig, ax = plt.subplots(figsize=(9, 4))
     end = review["sim_seconds"]
@@ -261,16 +225,6 @@ def write_plots(rec: Recording, review: dict, out_dir: str) -> list[str]:
     if worlds:
         written.append(_animate(worlds, cfg, out / "match.gif"))
     return written
-
-
-def _extend(track: tuple[list[float], list[float]], x: float, y: float) -> None:
-    """Append a point; a jump (a restart placement) breaks the line instead of drawing it."""
-    xs, ys = track
-    if xs and not math.isnan(xs[-1]) and math.hypot(x - xs[-1], y - ys[-1]) > JUMP:
-        xs.append(math.nan)
-        ys.append(math.nan)
-    xs.append(x)
-    ys.append(y)
 
 
 def _save(fig, path: Path) -> str:
@@ -310,7 +264,7 @@ def _animate(worlds: list[World], cfg, path: Path) -> str:
     return str(path)
 
 
-def main(path: str, plots: str | None = None, as_json: bool = False) -> int:
+def main(path: str, plots: str | None = None, as_json: bool = False, goalkeepers: bool = False) -> int:
     try:
         rec = load(path, keep=NEEDED)
     except RecordingError as exc:
@@ -318,7 +272,7 @@ def main(path: str, plots: str | None = None, as_json: bool = False) -> int:
         return 2
     review = analyse(rec)
     if plots:
-        review["plots"] = write_plots(rec, review, plots)
+        review["plots"] = write_plots(rec, review, plots, goalkeepers)
     if as_json:
         print(json.dumps(review, indent=2))
     else:

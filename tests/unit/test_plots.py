@@ -1,0 +1,56 @@
+"""Issue 19 part 5: the trajectory and heatmap pictures' data (tools/plots.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import RobotState, World
+from arena.tools import plots
+
+CFG = MatchConfig(half_time=1.0)  # 50 ticks a half
+
+
+def world(tick: int, a0=(-5.0, 0.0), a1=(-1.0, 1.0), b1=(2.0, -1.0), ball=(0.5, 0.25)) -> World:
+    robots = [
+        RobotState(team="a", robot=0, x=a0[0], y=a0[1], theta=0.0),
+        RobotState(team="a", robot=1, x=a1[0], y=a1[1], theta=0.0),
+        RobotState(team="b", robot=1, x=b1[0], y=b1[1], theta=0.0),
+    ]
+    return World(tick=tick, t=tick * 0.02, ball_x=ball[0], ball_y=ball[1], robots=robots)
+
+
+def test_every_robot_has_its_own_colour_in_its_teams_hue():
+    colours = {(t, n): plots.robot_colour(t, n, 6) for t in "ab" for n in range(6)}
+    assert len(set(colours.values())) == 12
+    for t in "ab":
+        dark = [sum(colours[(t, n)][:3]) for n in range(6)]
+        assert dark == sorted(dark), "a lower number is a darker shade (the goalkeeper darkest)"
+    blue_a = [c[2] - c[0] for (t, _), c in colours.items() if t == "a"]
+    red_b = [c[0] - c[1] for (t, _), c in colours.items() if t == "b"]
+    assert min(blue_a) > 0 and min(red_b) > 0, "team a blue, team b magenta"
+
+
+def test_tracks_split_by_half_and_break_at_a_placement():
+    worlds = [world(k, a1=(-1.0 + 0.01 * k, 1.0)) for k in range(40)]
+    worlds += [world(k, a1=(3.0, 3.0)) for k in range(40, 50)]  # placed: a 4 m jump
+    worlds += [world(k, a1=(-3.0, 0.0)) for k in range(50, 100)]
+    first, _ = plots.split_tracks(worlds, 0, CFG.half_ticks)
+    xs, _ = first["a/1"]
+    assert len(xs) == 51 and math.isnan(xs[40]), "the jump is a gap, not a line"
+    second, ball = plots.split_tracks(worlds, CFG.half_ticks, 2 * CFG.half_ticks + 1)
+    assert second["a/1"][0] == [-3.0] * 50 and len(ball[0]) == 50
+
+
+def test_heatmap_points_attack_to_the_right_in_both_halves_and_leave_out_goalkeepers():
+    worlds = [world(10), world(60)]  # first half, second half
+    xs, ys = plots.mirrored_points(worlds, CFG, "a", goalkeepers=False)
+    assert list(xs) == [-1.0, 1.0] and list(ys) == [1.0, -1.0]
+    xs, _ = plots.mirrored_points(worlds, CFG, "a", goalkeepers=True)
+    assert sorted(xs) == [-5.0, -1.0, 1.0, 5.0]
+    xs, _ = plots.mirrored_points(worlds, CFG, "b", goalkeepers=False)
+    assert list(xs) == [-2.0, 2.0], "team b attacks -x in the first half: mirrored there"
+    xs, ys = plots.mirrored_points(worlds, CFG, "", goalkeepers=False)
+    assert np.allclose(xs, [0.5, -0.5]) and np.allclose(ys, [0.25, -0.25])
