@@ -54,7 +54,9 @@ EXAMPLES = {
   # a recorder on another machine (the match was started with --record ... --external recorder)
   arena run recorder --match demo --connect tcp/192.168.1.10:7447 --record out.mcap
   # watch a running match in Foxglove (ws://127.0.0.1:8765); pause/step need arena match --live
-  arena run viewer --match demo --connect tcp/192.168.1.10:7447 --port 8765""",
+  arena run viewer --match demo --connect tcp/192.168.1.10:7447 --port 8765
+  # the RefBox bridge on the laptop the base stations reach (the match was started with --refbox ... --external refbox)
+  arena run refbox --match demo --connect tcp/192.168.1.10:7447""",
     "up": """examples:
   arena up compose.yaml            # the services of compose.yaml as local processes
   arena up compose.yaml --json""",
@@ -443,7 +445,9 @@ def build_parser() -> Parser:
     return top
 
 
-def match_config(args: argparse.Namespace, realtime: bool = False, external=(), record: str = "") -> MatchConfig:
+def match_config(
+    args: argparse.Namespace, realtime: bool = False, external=(), record: str = "", refbox=None
+) -> MatchConfig:
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
 
@@ -475,6 +479,7 @@ def match_config(args: argparse.Namespace, realtime: bool = False, external=(), 
         link_overrides=overrides,
         realtime=realtime,
         record=record,
+        **({"refbox": refbox} if refbox is not None else {}),
         external=tuple(
             ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e))
             for e in external
@@ -512,8 +517,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     if missing and not args.config_file:
         raise ConfigError(f"the following arguments are required: {', '.join(missing)} (or give them in --config FILE)")
     record = record_path(args.record) if args.record else ""
-    cfg = match_config(args, realtime=args.realtime, external=args.external, record=record)
-    cfg = cfg.replace(refbox=refbox_params(args))
+    cfg = match_config(args, realtime=args.realtime, external=args.external, record=record, refbox=refbox_params(args))
     cfg = live_config(cfg, args.live, args.pace, args.live_host)
     if args.match:
         from arena.schemas.keys import check_match_id
@@ -550,7 +554,7 @@ def cmd_match(args: argparse.Namespace) -> int:
 
 
 def refbox_params(args: argparse.Namespace):
-    """The RefBox flags of `arena match` as `RefboxParams`; bad values are a ConfigError."""
+    """The RefBox flags of `arena match` as `RefboxParams` (None without any); bad values are a ConfigError."""
     from pathlib import Path
 
     from arena.rules import refbox_protocol as rp
@@ -582,12 +586,16 @@ def refbox_params(args: argparse.Namespace):
             changes["follow"] = args.refbox_follow
     except rp.ProtocolError as exc:
         raise ConfigError(str(exc)) from None
-    changes["swap"] = args.refbox_swap
-    changes["wait"] = args.refbox_wait
-    changes["via"] = args.via_refbox
+    if args.refbox_swap:
+        changes["swap"] = True
+    if args.refbox_wait:
+        changes["wait"] = args.refbox_wait
+    if args.via_refbox:
+        changes["via"] = True
     if args.refbox_wait and not args.refbox:
         raise ConfigError("--refbox-wait needs --refbox")
-    return RefboxParams(**changes)
+    # No RefBox flag: keep what a --config file says (or the defaults).
+    return RefboxParams(**changes) if changes else None
 
 
 def one_line(text: str) -> str:
