@@ -35,6 +35,13 @@ class BaseStationNode(Node):
         self.via = ViaRefbox(cfg, team, self.log) if cfg.refbox.via else None
         self.latest: dict = {}
 
+    def on_peer_dead(self, peer: str) -> None:
+        """One of our robots is dead: it gets no more orders (`Outbound.mute`)."""
+        kind, _, rest = peer.partition("/")
+        team, _, n = rest.partition("/")
+        if kind == "robot" and team == self.pid.team and n.isdigit() and int(n) in self.order_out:
+            self.order_out[int(n)].mute()
+
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         # Each robot's newest report, if a new one arrived since the last order.

@@ -174,6 +174,7 @@ class EngineNode(Node):
     def park(self, r: tuple[str, int], k: int) -> None:
         """A dead robot leaves the field: parked beyond the fence, no collisions (Physics.park_robot)."""
         x, y = self.physics.park_robot(*r)
+        self.sense_out[r].mute()  # nobody reads it any more
         self.parked[r] = {"tick": k, "x": round(x, 3), "y": round(y, 3)}
         self.log.warning("tick %d: robot %s/%d is dead, parked at (%.2f, %.2f)", k, r[0], r[1], x, y)
 

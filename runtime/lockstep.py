@@ -151,6 +151,10 @@ class Watchdog:
             self._thread.join(timeout=1.0)
 
 
+def _drop(payload: bytes) -> None:  # noqa: ARG001 - a muted Outbound's put
+    return None
+
+
 class Outbound(Generic[M]):
     """One outbound key: encodes, adds the frame to the process digest, publishes."""
 
@@ -163,6 +167,16 @@ class Outbound(Generic[M]):
         self._digest = digest
         self._encode = msgspec.msgpack.Encoder().encode
         self.sent = 0
+
+    def mute(self) -> None:
+        """Stop putting this key on the wire: its only receiver is dead (digest and count go on).
+
+        A process runs its lockstep on zenoh's one network thread and puts with
+        congestion control BLOCK; a put towards a stopped peer that comes back
+        (SIGCONT) can then block that thread long enough for every lease on it
+        to expire. Nobody waits for these frames any more, so none is sent.
+        """
+        self._put = _drop
 
     def send(self, msg: M) -> bytes:
         """Encode, digest and put `msg`; returns the payload (for a tap, runtime/tap.py)."""

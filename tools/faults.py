@@ -8,9 +8,10 @@ The launcher observes three kinds of failure, each with the process's name:
 * `missing`: a process that never delivered its summary within the bound.
 
 The processes themselves report whom they gave up waiting for (`Summary.dead`,
-with their tick in `dead_at`). A process that was itself lost sees everyone
-else vanish, so its claims are not evidence: `dead` is what the processes that
-stayed connected claim (issue 20, "correct blame").
+with their tick in `dead_at`). A process that was itself cut off sees everyone
+else vanish, so its claims are not evidence: `blame` keeps only the claims the
+launcher's own view of the liveliness tokens confirms (issue 20, "correct
+blame").
 
 The outcome:
 
@@ -43,20 +44,29 @@ def exit_reason(code: int) -> str:
 
 
 def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
-    """Dead processes as claimed by processes that were not lost themselves: name -> tick.
+    """Who is dead: name -> tick.
+
+    A claim "X is dead" (in a summary's `dead`) is credible when the launcher,
+    a neutral observer, saw X's liveliness token vanish (`lost`), or X has no
+    summary. A process that claims peers dead whom nobody else lost was itself
+    cut off (stopped, unplugged): everyone vanished from its view at once. It
+    is the one blamed, at its earliest such claim, and its claims are dropped.
 
     The tick is the engine's when it gave up on the process (the match clock),
     else the earliest claimant's.
     """
     dead: dict[str, int] = {}
     for name, s in summaries.items():
-        if name in lost:
-            continue
         for peer in s.dead:
             tick = s.dead_at.get(peer, s.tick)
-            dead[peer] = min(tick, dead.get(peer, tick))
+            if name in lost and peer not in lost:
+                continue  # a lost process's view of the others is no evidence
+            if peer in lost or peer not in summaries:
+                dead[peer] = min(tick, dead.get(peer, tick))
+            else:
+                dead[name] = min(tick, dead.get(name, tick))
     engine = summaries.get("engine")
-    if engine is not None and "engine" not in lost:
+    if engine is not None and "engine" not in dead:
         dead.update({p: t for p, t in engine.dead_at.items() if p in dead})  # the engine's tick is the match's
     return dead
 
@@ -76,7 +86,8 @@ def outcome(
     for name in order:
         why = crashed.get(name) or lost.get(name) or missing.get(name)
         if why is None and name in dead:
-            why = "stopped responding: its peers gave up waiting for it"
+            claimed = any(name in s.dead for s in summaries.values())
+            why = "stopped responding: its peers gave up waiting for it" if claimed else "lost contact with its peers"
         if why is None:
             continue
         faults.append({"process": name, "tick": dead.get(name), "reason": why})

@@ -123,3 +123,13 @@ def test_outcomes():
     assert o["void"] and o["outcome_reasons"] == ["referee exited with code 1"]
     spoofed = dict(full, engine=_summary("engine", tick=cfg.total_ticks, conflicts={"robot/b/1/cmd": 3}))
     assert outcome(cfg, spoofed, {}, {}, {})["conflicts"] == {"robot/b/1/cmd": 3}
+
+
+def test_a_process_that_lost_everyone_while_nobody_lost_it_is_the_one_blamed():
+    """The other outcome of a 10 s SIGSTOP: the others just waited, the stopped robot saw them all vanish."""
+    sums = {
+        "engine": _summary("engine"),
+        "basestation/a": _summary("basestation/a"),
+        "robot/a/1": _summary("robot/a/1", ["basestation/a", "engine"], {"engine": 1012, "basestation/a": 1011}),
+    }
+    assert blame(sums, set()) == {"robot/a/1": 1011}
