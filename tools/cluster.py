@@ -189,6 +189,13 @@ def task_cpus(args) -> float:
 
 def play(args, runner, todo: list, on_result) -> bool:
     """Play `todo` on the cluster; call on_result(Result) as each arrives. Returns interrupted."""
+    # Ray's driver prints cluster events ("Raylet is terminated ...") to
+    # sys.stdout, which is for the tournament's --json: they go to a log.
+    with open(runner.logs_dir / "ray-driver.log", "a") as log, contextlib.redirect_stdout(log):
+        return _play(args, runner, todo, on_result)
+
+
+def _play(args, runner, todo: list, on_result) -> bool:
     from arena.tools import tournament as T
 
     cpus = task_cpus(args)

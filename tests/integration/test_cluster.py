@@ -8,6 +8,7 @@ runs as a separate `arena` process that joins the cluster by its address.
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
 import time
@@ -66,12 +67,20 @@ def test_two_nodes_same_digests_as_local_jobs(cluster, tmp_path):
     assert saved["table"] == remote["table"]
 
 
+SIX = tournament("--strategies", "AD,AS,BD,BS")
+
+
+@pytest.fixture(scope="module")
+def local_six(tmp_path_factory):
+    """The 6-match round-robin played with local jobs, once for the tests that compare with it."""
+    return arena_json(*SIX, "--jobs", "2", "--out", str(tmp_path_factory.mktemp("local")))
+
+
 @pytest.mark.slow
-def test_six_match_round_robin_equals_local(cluster, tmp_path):
+def test_six_match_round_robin_equals_local(cluster, local_six, tmp_path):
     c, _ = cluster
-    args = tournament("--strategies", "AD,AS,BD,BS")
-    local = arena_json(*args, "--jobs", "2", "--out", str(tmp_path / "local"))
-    remote = arena_json(*args, "--ray", c.address, "--out", str(tmp_path / "ray"))
+    local = local_six
+    remote = arena_json(*SIX, "--ray", c.address, "--out", str(tmp_path / "ray"))
     assert len(digests(local)) == 6
     assert digests(remote) == digests(local)
     assert remote["table"] == local["table"]
@@ -85,13 +94,13 @@ def raylet_pid(node) -> int:
 
 
 @pytest.mark.slow
-def test_worker_node_removed_mid_task(cluster, tmp_path, reap):
+def test_worker_node_removed_mid_task(cluster, local_six, tmp_path, reap):
     """A node dies while its match plays: Ray reruns the task on the other node; every match counted once."""
     c, workers = cluster
     victim = c.add_node(num_cpus=2)  # the fixture's nodes stay for the other tests
     c.wait_for_nodes()
     out = tmp_path / "ray"
-    proc = spawn(*tournament("--strategies", "AD,AS,BD,BS", "--ray", c.address, "--out", str(out), "--json"))
+    proc = spawn(*SIX, "--ray", c.address, "--out", str(out), "--json")
     reap.append(proc)
     on_victim = wait_for(
         lambda: [p for p in descendants(raylet_pid(victim)) if " arena match " in cmdline(p)],
@@ -99,6 +108,8 @@ def test_worker_node_removed_mid_task(cluster, tmp_path, reap):
         "a match to run on the node to be removed",
     )
     time.sleep(1.0)  # well inside the match (10 s halves take several seconds)
+    argv = cmdline(on_victim[0]).split()
+    killed = (argv[argv.index("--home") + 1], argv[argv.index("--away") + 1], int(argv[argv.index("--seed") + 1]))
     c.remove_node(victim, allow_graceful=False)
     wait_for(lambda: not any(" arena match " in cmdline(p) for p in on_victim), 20, "the match to die with its node")
     stdout, stderr = proc.communicate(timeout=300)
@@ -107,8 +118,13 @@ def test_worker_node_removed_mid_task(cluster, tmp_path, reap):
     assert len(summary["matches"]) == 6
     check_tables(summary, 3)
     assert len(list((out / "matches").glob("*.json"))) == 6
-    local = arena_json(*tournament("--strategies", "AD,AS,BD,BS", "--jobs", "2", "--out", str(tmp_path / "local")))
-    assert digests(summary) == digests(local)
+    assert digests(summary) == digests(local_six)
+    assert summary["table"] == local_six["table"]
+    (replayed,) = [m for m in summary["matches"] if (m["home"], m["away"], m["seed"]) == killed]
+    assert replayed["attempts"] == 1, "a node's death is Ray's retry, not a second attempt of the match"
+    log = (out / "logs" / f"{replayed['id']}.log").read_text()
+    assert "[cluster] played on node" in log and victim.node_id[:12] not in log, log
+    assert "Traceback" not in stderr
 
 
 def test_no_cluster_at_address_is_one_line_and_exit_2(tmp_path):
@@ -167,3 +183,29 @@ assert "ray" not in sys.modules and "arena.tools.cluster" not in sys.modules, "R
 """
     r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr[-3000:]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_interrupt_cancels_tasks_keeps_results_then_resume(cluster, tmp_path, reap, sig):
+    c, _ = cluster
+    args = tournament("--strategies", "BS,AD,AS", "--half-time", "5", "--ray", c.address, "--out", str(tmp_path))
+    proc = spawn(*args)
+    reap.append(proc)
+    matches = tmp_path / "matches"
+    wait_for(lambda: matches.is_dir() and any(matches.glob("*.json")), 120, "the first finished match")
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "--resume" in err and "Traceback" not in err, err
+    raylets = [raylet_pid(n) for n in (c.head_node, *c.worker_nodes)]
+    wait_for(
+        lambda: not any(" arena match " in cmdline(p) for r in raylets for p in descendants(r)),
+        30,
+        "the cancelled tasks' matches to stop",
+    )
+    kept = sorted(p.name for p in matches.glob("*.json"))
+    assert 1 <= len(kept) < 3 and not list(matches.glob("*.tmp")), (kept, err)
+    summary = arena_json(*args, "--resume")
+    assert summary["skipped"] == len(kept) and len(summary["matches"]) == 3
+    check_tables(summary, 2)
