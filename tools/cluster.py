@@ -28,7 +28,6 @@ import ctypes
 import hashlib
 import importlib.metadata
 import json
-import os
 import signal
 import socket
 import subprocess
@@ -143,8 +142,14 @@ def _die_with_parent() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
 
 
-def play_on_worker(argv: list[str], driver: dict, timeout: float) -> dict:
-    """Body of the Ray task: check the version, play one match, return what the driver needs."""
+def play_on_worker(job: dict, driver: dict) -> dict:
+    """Body of the Ray task: check the version, play one match, return what the driver needs.
+
+    `job` is {"argv": [...], "timeout": s} for the distributed engine (the
+    `arena match` command a local job runs, under this worker's interpreter)
+    or {"config": MatchConfig} for the in-process engine, which plays in this
+    worker process itself: Ray reuses its workers, so it imports once.
+    """
     import ray
 
     node = ray.get_runtime_context().get_node_id()[:12]
@@ -152,12 +157,21 @@ def play_on_worker(argv: list[str], driver: dict, timeout: float) -> dict:
     if mine != driver:
         return {
             "rc": -1,
+            "node": node,
             "reason": f"version mismatch on node {node}: the worker has {describe(mine)}, "
             f"the driver has {describe(driver)}; install the same soccer-arena on every node or use a runtime_env",
         }
     t0 = time.monotonic()
+    if "config" in job:
+        from arena.tools.inprocess import play_match
+
+        try:
+            m = play_match(job["config"])
+        except Exception as exc:  # a failed match is a result for the driver, never a crashed task
+            return {"rc": 1, "node": node, "reason": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+        return {"rc": 0, "match": m, "wall": time.monotonic() - t0, "node": node}
     proc = subprocess.Popen(
-        [sys.executable, *argv],
+        [sys.executable, *job["argv"]],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -166,11 +180,11 @@ def play_on_worker(argv: list[str], driver: dict, timeout: float) -> dict:
     )
     reason = ""
     try:
-        out, err = proc.communicate(timeout=timeout)
+        out, err = proc.communicate(timeout=job["timeout"])
     except subprocess.TimeoutExpired:
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate()
-        reason = f"timed out after {timeout:g} s"
+        reason = f"timed out after {job['timeout']:g} s"
     return {
         "rc": proc.returncode,
         "out": out,
@@ -178,7 +192,6 @@ def play_on_worker(argv: list[str], driver: dict, timeout: float) -> dict:
         "reason": reason,
         "wall": time.monotonic() - t0,
         "node": node,
-        "pid": os.getpid(),
     }
 
 
@@ -214,8 +227,11 @@ def _play(args, runner, todo: list, on_result) -> bool:
         inflight: dict = {}  # ref -> (fixture, attempt)
 
         def submit(fx, attempt: int) -> None:
-            argv = runner.command(fx)[1:]  # the worker's own interpreter runs it
-            inflight[remote.remote(argv, driver, timeout)] = (fx, attempt)
+            if runner.engine == "inprocess":
+                job = {"config": runner.match_config(fx)}
+            else:
+                job = {"argv": runner.command(fx)[1:], "timeout": timeout}  # the worker's own interpreter
+            inflight[remote.remote(job, driver)] = (fx, attempt)
 
         try:
             while queue and len(inflight) < cap:
@@ -252,11 +268,12 @@ def finish(runner, fx, attempt: int, got: dict):
 
     base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
     log = runner.logs_dir / f"{fx.id}.log"
-    write_atomic(log, (got.get("err") or "") + (f"[cluster] played on node {got['node']}\n" if "node" in got else ""))
     reason = got.get("reason", "")
+    where = f"[cluster] attempt {attempt} played on node {got['node']}\n" if "node" in got else ""
+    write_atomic(log, (got.get("err") or "") + (f"{reason}\n" if reason else "") + where)
     if got["rc"] == 0 and not reason:
         try:
-            m = json.loads(got["out"])
+            m = got["match"] if "match" in got else json.loads(got["out"])
         except json.JSONDecodeError:
             reason = "the match printed no JSON"
         else:
@@ -282,6 +299,6 @@ def finish(runner, fx, attempt: int, got: dict):
         reason = tail[-1] if tail else f"exit code {got['rc']}"
     if attempt < 2:
         return None
-    r = Result(id=fx.id, status="failed", reason=reason, attempts=attempt, **base)
+    r = Result(id=fx.id, status="failed", reason=reason, attempts=attempt, engine=runner.engine, **base)
     write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
     return r

@@ -54,15 +54,18 @@ def check_tables(summary: dict, matches_each: int) -> None:
 
 
 def test_two_nodes_same_digests_as_local_jobs(cluster, tmp_path):
-    """Fast: 2 matches, one per node, digests equal to the local run's."""
+    """Fast: 2 matches, one per node, with either engine; digests equal to the local run's."""
     c, _ = cluster
     args = tournament("--strategies", "BS,AD", "--legs", "2", "--half-time", "5")
     local = arena_json(*args, "--jobs", "2", "--out", str(tmp_path / "local"))
     remote = arena_json(*args, "--ray", c.address, "--out", str(tmp_path / "ray"))
-    assert digests(remote) == digests(local) and len(digests(local)) == 2
+    inproc = arena_json(*args, "--ray", c.address, "--engine", "inprocess", "--out", str(tmp_path / "inproc"))
+    assert digests(remote) == digests(local) == digests(inproc) and len(digests(local)) == 2
+    assert {m["engine"] for m in inproc["matches"]} == {"inprocess"}
     check_tables(remote, 2)
+    check_tables(inproc, 2)
     logs = [(tmp_path / "ray" / "logs" / f"{m['id']}.log").read_text() for m in remote["matches"]]
-    assert all("[cluster] played on node" in text for text in logs)
+    assert all("played on node" in text for text in logs)
     saved = json.loads((tmp_path / "ray" / "tournament.json").read_text())
     assert saved["table"] == remote["table"]
 
@@ -123,7 +126,7 @@ def test_worker_node_removed_mid_task(cluster, local_six, tmp_path, reap):
     (replayed,) = [m for m in summary["matches"] if (m["home"], m["away"], m["seed"]) == killed]
     assert replayed["attempts"] == 1, "a node's death is Ray's retry, not a second attempt of the match"
     log = (out / "logs" / f"{replayed['id']}.log").read_text()
-    assert "[cluster] played on node" in log and victim.node_id[:12] not in log, log
+    assert "played on node" in log and victim.node_id[:12] not in log, log
     assert "Traceback" not in stderr
 
 
@@ -159,7 +162,7 @@ task = ray.remote(cluster.play_on_worker).options(num_cpus=1)
 mine = cluster.fingerprint()
 other = dict(mine, version="0.0.9", git="0123456789ab")
 same = ray.get(ray.remote(cluster.fingerprint).options(num_cpus=1).remote())
-bad = ray.get(task.remote(["-c", "print(1)"], other, 30))
+bad = ray.get(task.remote({{"argv": ["-c", "print(1)"], "timeout": 30}}, other))
 print(json.dumps({{"mine": mine, "same": same, "bad": bad}}))
 ray.shutdown()
 """
