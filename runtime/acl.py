@@ -25,7 +25,19 @@ every process, since in a secure match every process is a client of it
 
 from __future__ import annotations
 
-from arena.schemas.keys import ACK, ALIVE, COLLECTOR, CONFIG, CONTROL, REFUSED, SUMMARY, TAP, VIEWER, routes
+from arena.schemas.keys import (
+    ACK,
+    ALIVE,
+    COLLECTOR,
+    CONFIG,
+    CONTROL,
+    KEY_BY_NAME,
+    REFUSED,
+    SUMMARY,
+    TAP,
+    VIEWER,
+    routes,
+)
 
 
 def user_of(principal: str) -> str:
@@ -43,7 +55,9 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
     if principal == "recorder":
         own_in += [f"{prefix}{TAP}/**", f"{prefix}{SUMMARY}/**"]
     writes = sends + own_out
-    reads = receives + own_in
+    # The referee's state is public (a RefBox broadcasts it to every team): any principal may
+    # read it; a process started by hand (`arena run`) prints the final score from it.
+    reads = list(dict.fromkeys([*receives, *own_in, prefix + KEY_BY_NAME["referee"].rel()]))
     barrier = [f"{prefix}{ALIVE}/**", f"{prefix}{COLLECTOR}"]
     config = [f"{prefix}{CONFIG}"]
     perms = {

@@ -54,6 +54,31 @@ def check_endpoint(flag: str, text: str) -> str:
     return text
 
 
+def listening(endpoint: str, timeout: float = 1.0) -> bool:
+    """Does anything accept a connection at `endpoint` (tcp, tls, ws or a unix socket)?
+
+    Tells "no router there" from "a router that refused us": zenoh reports both
+    as "Unable to connect". The probe opens a plain connection and closes it.
+    """
+    import socket
+
+    proto, _, address = endpoint.partition("/")
+    address = address.split("?", 1)[0].split("#", 1)[0]
+    try:
+        if proto == "unixsock-stream":
+            with socket.socket(socket.AF_UNIX) as s:
+                s.settimeout(timeout)
+                s.connect(address)
+            return True
+        if proto in ("tcp", "tls", "ws"):
+            host, _, port = address.rpartition(":")
+            with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+                return True
+    except (OSError, ValueError):
+        return False
+    return False
+
+
 def zenoh_reason(exc: Exception) -> str:
     """zenoh's error text without its Rust wrappers and source paths."""
     text = str(exc)

@@ -30,7 +30,7 @@ from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.credentials import load_fragment
 from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
-from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open_session
+from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Referee
@@ -80,8 +80,23 @@ def load_config(path: str) -> MatchConfig:
     return MatchConfig.from_json(text)
 
 
+def refused_by(connect: tuple[str, ...]) -> None:
+    """ConfigError if a router listens at one of `connect` and still would not have us (issue 15 item 6)."""
+    for ep in connect:
+        if listening(ep):
+            raise ConfigError(
+                f"refused by {ep}: authentication failed (a secure match needs this process's own --credentials file)"
+            )
+
+
 def fetch_config(
-    transport: ZenohTransport, keys: Keys, timeout: float, session=None, where: str = "", tell=None
+    transport: ZenohTransport,
+    keys: Keys,
+    timeout: float,
+    session=None,
+    where: str = "",
+    tell=None,
+    connect: tuple[str, ...] = (),
 ) -> MatchConfig:
     """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
     deadline = time.monotonic() + timeout
@@ -92,6 +107,8 @@ def fetch_config(
             return MatchConfig.from_json(payload.decode())
         if session is not None:
             connected = bool(list(session.info.routers_zid()) or list(session.info.peers_zid()))
+            if not connected:
+                refused_by(connect)
             now = f"a router at {where}, but no match {keys.match!r} there" if connected else f"no router at {where}"
             if now != state and tell is not None:
                 tell(f"waiting: {now} (retrying for up to {timeout:g} s)")
@@ -117,6 +134,7 @@ def open_until(net: NetConfig, timeout: float, where: str, tell):
         except EndpointError as exc:
             if net.mode != "client" or not net.connect:
                 raise
+            refused_by(net.connect)
             if time.monotonic() + 1.0 > deadline:
                 raise StartupError(f"gave up after {timeout:g} s: no router at {where}") from None
             if not told:
@@ -177,7 +195,7 @@ def run(
         ref_sub = None
         try:
             if cfg is None:
-                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell)
+                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell, net.connect)
             if seed is not None and seed != cfg.seed:
                 raise ConfigError(f"--seed {seed} differs from the match's seed {cfg.seed}")
             if realtime and not cfg.realtime:

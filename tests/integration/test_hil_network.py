@@ -57,6 +57,14 @@ def _in(ns: str, *argv: str, **kw) -> subprocess.Popen:
     )
 
 
+def _read_until(proc: subprocess.Popen, needle: str, timeout: float) -> list[str]:
+    """The lines of `proc`'s stderr up to and including the first that contains `needle`."""
+    lines = [wait_for(lambda: proc.stderr.readline(), timeout, needle)]
+    while needle not in lines[-1]:
+        lines.append(wait_for(lambda: proc.stderr.readline(), timeout, needle))
+    return lines
+
+
 def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap):
     laptop, robot_host = two_hosts
     py = [sys.executable, "-m", "arena"]
@@ -69,12 +77,14 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     reap.append(match)
     assert "external" in wait_for(lambda: match.stderr.readline(), 60, "the launcher's instructions")
     printed = match.stderr.readline().strip()
-    assert printed.startswith("arena run robot ") and f"--connect tcp/{NET}.1:7447" in printed, printed
-    assert "--mode client" in printed, printed
+    # A match on a non-loopback address is secure by default (issue 15): TLS, and the robot's own
+    # credentials file, which also says client mode; without --secure, tcp and --mode client.
+    assert printed.startswith("arena run robot ") and f"/{NET}.1:7447 " in printed, printed
+    assert "--mode client" in printed or "--credentials" in printed, printed
     # The robot's computer runs exactly what was printed (`arena` is this interpreter's module).
     robot = _in(robot_host, *py, *printed.split()[1:])
     reap.append(robot)
-    assert "external robot/a/1 joined" in wait_for(lambda: match.stderr.readline(), 60, "the robot joining")
+    _read_until(match, "external robot/a/1 joined", 60)
     # The same robot started a second time is refused, and the match says so.
     twin = subprocess.run(
         ["ip", "netns", "exec", robot_host, *py, *printed.split()[1:]], capture_output=True, text=True, timeout=60
@@ -86,7 +96,7 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     assert "refused a second robot/a/1" in err
     r_out, r_err = robot.communicate(timeout=30)
     assert robot.returncode == 0, r_err
-    assert f"connected to tcp/{NET}.1:7447 (zenoh client)" in r_err
+    assert f"connected to {printed.split('--connect ')[1].split()[0]} (zenoh client)" in r_err, r_err
     assert "match over at tick 1000 (END_GAME)" in r_err, r_err
     result = json.loads(out)
     a1 = next(p for p in result["processes"] if (p["kind"], p["team"], p["robot"]) == ("robot", "a", 1))

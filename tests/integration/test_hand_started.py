@@ -1,0 +1,73 @@
+"""Issue 15 item 6: a process started by hand says what it is waiting for, and why it gives up."""
+
+from __future__ import annotations
+
+import socket
+import subprocess
+import time
+
+from tests.integration.helpers import ARENA, spawn, wait_for
+
+ROBOT = ("run", "robot", "--match", "hand", "--team", "a", "--robot", "1")
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_no_router_is_said_at_once_and_the_robot_gives_up_with_exit_2():
+    port = free_port()
+    robot = subprocess.Popen(
+        [*ARENA, *ROBOT, "--connect", f"tcp/127.0.0.1:{port}", "--startup-timeout", "4"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    t0 = time.monotonic()
+    first = robot.stderr.readline()
+    said_after = time.monotonic() - t0
+    assert f"waiting: no router at tcp/127.0.0.1:{port}" in first, first
+    assert said_after < 2.0 + 1.0, f"said after {said_after:.1f} s (interpreter start included)"
+    rest = robot.communicate(timeout=60)[1]
+    assert robot.returncode == 2
+    assert rest.strip().splitlines()[-1] == f"arena run: error: gave up after 4 s: no router at tcp/127.0.0.1:{port}"
+
+
+def test_a_router_without_the_match_is_told_apart(tmp_path, reap):
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    router = spawn("run", "router", "--match", "other", "--listen", sock)
+    reap.append(router)
+    wait_for(lambda: (tmp_path / "r.sock").exists(), 30, "the router's socket")
+    r = subprocess.run([*ARENA, *ROBOT, "--connect", sock, "--startup-timeout", "3"], capture_output=True, text=True)
+    assert r.returncode == 2, r.stderr
+    assert f"waiting: a router at {sock}, but no match 'hand' there" in r.stderr
+    assert r.stderr.strip().splitlines()[-1].startswith("arena run: error: gave up after 3 s: a router at")
+
+
+def test_a_secure_match_refuses_a_wrong_or_missing_credential(tmp_path, reap):
+    port, creds = free_port(), tmp_path / "creds"
+    match = spawn(
+        *("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--external", "a/1", "--match", "hand"),
+        *("--listen", f"tcp/127.0.0.1:{port}", "--secure", "--credentials", str(creds), "--startup-timeout", "60"),
+    )
+    reap.append(match)
+    wait_for(lambda: (creds / "robot-a-1.json5").exists(), 60, "the credentials files")
+    text = (creds / "robot-a-1.json5").read_text()
+    wrong = tmp_path / "wrong.json5"
+    wrong.write_text(text.replace('"password": "', '"password": "x', 1))
+    endpoint = f"tls/127.0.0.1:{port}"
+    wait_for(lambda: "waiting for" in match.stderr.readline(), 60, "the match to listen")
+    for extra in (["--credentials", str(wrong)], ["--mode", "client"], []):
+        r = subprocess.run(
+            [*ARENA, *ROBOT, "--connect", endpoint, *extra, "--startup-timeout", "10"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert r.returncode == 2, (extra, r.stderr)
+        assert (
+            r.stderr.strip()
+            .splitlines()[-1]
+            .startswith(f"arena run: error: refused by {endpoint}: authentication failed")
+        ), (extra, r.stderr)
