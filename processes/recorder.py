@@ -12,8 +12,10 @@ collects the batches on `arena/<m>/tap/**` and writes:
   metadata, for information);
 * `/scene` and `/referee_log`, the Foxglove layer (recording/scene.py);
 * metadata `arena` (configuration, seed, strategies, git revision), `versions`,
-  `schemas`, one `summary/<process>` per process Summary, and `recording`
-  (complete or not).
+  `schemas`, one `summary/<process>` per process Summary, and `recording`:
+  `complete` only if every process's tap batches came without a gap and, per
+  key, as many frames as its Summary says it sent; otherwise `gaps` lists,
+  per process, the lost batch numbers and the keys whose counts differ.
 
 Log time = publish time = the frame's tick x dt, in ns of simulated time.
 Records are written in the order (tick, process in `cfg.processes()` order,
@@ -187,9 +189,12 @@ class RecorderNode(Node):
         self.sent = dict.fromkeys(self.peers, 0)  # per process: frames received so far (send order)
         self.batches = dict.fromkeys(self.peers, 0)  # per process: next expected batch number
         self.finals: set[str] = set()
+        self.lost_batches: dict[str, list[list[int]]] = {}  # per process: [first, last] batch numbers never received
+        self.recorded: dict[str, dict[str, int]] = {name: {} for name in self.peers}  # per process and key
         self.summaries: dict[str, Summary] = {}
         self.pending: list[tuple[int, int, int, str, bytes]] = []  # (tick, rank, seq, topic, payload)
         self.missing: list[str] = []
+        self.gap_list: dict[str, dict] = {}
         self.interrupted = ""
         self.sink: McapSink | None = None
         self.counts: dict[str, int] = {}  # messages written per topic
@@ -240,10 +245,35 @@ class RecorderNode(Node):
         )
         self.sink.flush()
 
+    def gaps(self) -> dict[str, dict]:
+        """What the file lacks, per process: tap batches never received, and per key the frames
+        its Summary says it sent against those recorded (only keys that differ)."""
+        out: dict[str, dict] = {}
+        for name in self.peers:
+            gap: dict = {}
+            if name in self.lost_batches:
+                gap["lost_batches"] = self.lost_batches[name]
+            s = self.summaries.get(name)
+            if s is None:
+                gap["summary"] = "none received: its counts cannot be checked"
+            else:
+                got = self.recorded[name]
+                keys = {
+                    k: {"sent": n, "recorded": got.get(k, 0)}
+                    for k, n in sorted(s.sent_by_key.items())
+                    if got.get(k, 0) != n
+                }
+                if keys:
+                    gap["keys"] = keys
+            if gap:
+                out[name] = gap
+        return out
+
     def _close(self) -> None:
         if self.sink is None:
             return
         self.missing = [n for n in self.peers if n not in self.finals]
+        self.gap_list = self.gaps()
         for name in self.peers:
             s = self.summaries.get(name)
             if s is not None:
@@ -251,8 +281,9 @@ class RecorderNode(Node):
         self.sink.metadata(
             "recording",
             {
-                "complete": str(not self.missing and not self.interrupted).lower(),
+                "complete": str(self.complete).lower(),
                 "missing": ",".join(self.missing),
+                "gaps": msgspec.json.encode(self.gap_list).decode(),
                 "interrupted": self.interrupted,
                 "last_tick": str(self.last_tick),
             },
@@ -276,10 +307,14 @@ class RecorderNode(Node):
             self.rejections.reject(
                 self.keys.tap(name), "out-of-sequence", f"batch {batch.seq}, expected {self.batches[name]}"
             )
+            if batch.seq > self.batches[name]:
+                self.lost_batches.setdefault(name, []).append([self.batches[name], batch.seq - 1])
         self.batches[name] = batch.seq + 1
         seq = self.sent[name]
+        counts = self.recorded[name]
         for f in batch.frames:
             self.pending.append((f.tick, rank, seq, f.key, f.payload))
+            counts[f.key] = counts.get(f.key, 0) + 1
             seq += 1
         self.sent[name] = seq
         if batch.final:
@@ -423,10 +458,16 @@ class RecorderNode(Node):
         finally:
             self._close()
 
+    @property
+    def complete(self) -> bool:
+        """Every process's last batch came, no batch was lost, and every count equals its sender's Summary."""
+        return not self.missing and not self.interrupted and not self.gap_list
+
     def summary_extra(self) -> dict[str, object]:
         return {
             "path": self.path,
             "messages": dict(sorted(self.counts.items())),
-            "complete": not self.missing and not self.interrupted,
+            "complete": self.complete,
             "missing": self.missing,
+            "gaps": self.gap_list,
         }

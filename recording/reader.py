@@ -52,6 +52,15 @@ class Recording:
         """The recorder says it got every process's last batch, and the file is whole."""
         return not self.truncated and self.meta.get("recording", {}).get("complete") == "true"
 
+    @property
+    def gaps(self) -> dict:
+        """What the recorder found missing, per process (lost tap batches, keys short of their count)."""
+        try:
+            gaps = msgspec.json.decode(self.meta.get("recording", {}).get("gaps", "{}"))
+        except msgspec.DecodeError:
+            return {"?": {"error": "unreadable gaps metadata"}}
+        return gaps if isinstance(gaps, dict) else {}
+
     def payloads(self, topic: str) -> list[bytes]:
         return [p for _, _, p in self.topics.get(topic, [])]
 

@@ -47,13 +47,18 @@ def print_review(r: dict, console: Console | None = None) -> None:
     if r["truncated"]:
         console.print(f"[yellow]truncated recording: {r['truncation']}; reviewed up to {r['sim_seconds']:.1f} s[/]")
     elif not r["complete"]:
-        console.print("[yellow]incomplete recording: the recorder missed some process's last batch[/]")
+        console.print("[yellow]incomplete recording: the recorder missed some process's frames (gaps below)[/]")
     if r["goals"]:
         console.print(
             "goals: " + ", ".join(f"{g['t']:.1f} s {g['team']} ({g['score'][0]}:{g['score'][1]})" for g in r["goals"])
         )
     else:
         console.print("goals: none")
+    for name, gap in r.get("gaps", {}).items():
+        lost = ", ".join(f"{a}-{b}" for a, b in gap.get("lost_batches", []))
+        keys = ", ".join(f"{k} {c['recorded']} of {c['sent']}" for k, c in gap.get("keys", {}).items())
+        what = "; ".join(x for x in (lost and f"tap batches {lost} lost", keys, gap.get("summary", "")) if x)
+        console.print(f"[yellow]gap: {name}: {what}[/]")
     for f in r.get("faults", []):
         console.print(f"[red]fault: {f['process']} at {f['t']:.1f} s (tick {f['tick']}): {f['reason']}[/]")
     console.print("restarts: " + (", ".join(f"{k} {v}" for k, v in r["restarts"].items()) or "none"))

@@ -183,6 +183,7 @@ def analyse(rec: Recording) -> dict:
         "planned_sim_seconds": round(cfg.total_ticks * dt, 3),
         "goals": goals,
         "faults": faults_of(rec),
+        "gaps": rec.gaps,
         "restarts": dict(sorted(restarts.items())),
         "commands": dict(sorted(commands.items())),
         "possession_percent": possession,

@@ -206,7 +206,9 @@ def test_a_strategy_that_returns_nan_every_100_ticks_plays_to_the_end(reap, tmp_
 def test_a_robot_stopped_for_10_s_alone_is_blamed(reap, tmp_path):
     """Issue 20: SIGSTOP robot a/1 for 10 s. It used to list engine and basestation/a as dead too."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "stop10", "--listen", endpoint)
+    mcap = tmp_path / "stop10.mcap"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "stop10", "--listen", endpoint,
+                 "--record", str(mcap))  # fmt: skip
     reap.append(proc)
     victim = child(proc.pid, "--team a --robot 1")
     wait_for_tick(endpoint, "stop10", 1000, proc)
@@ -222,6 +224,39 @@ def test_a_robot_stopped_for_10_s_alone_is_blamed(reap, tmp_path):
     assert [f["process"] for f in result["faults"]] == ["robot/a/1"], result["faults"]
     assert result["outcome"] == "completed_with_faults" and result["ticks"] == 6000
     assert result["events"]["END_GAME"] == 1
+    # The recording is complete with equal counts, or says what it lacks (it used to claim complete).
+    rec = load(str(mcap))
+    recorded = result["recording"]
+    if recorded["complete"]:
+        assert rec.complete and rec.gaps == {}
+        sent = {k: n for k, n in result["sent_by_key"].items()}
+        assert all(rec.counts.get(k, 0) == n for k, n in sent.items())
+    else:
+        assert not rec.complete and "robot/a/1" in rec.gaps, rec.gaps
+        assert recorded["gaps"] == rec.gaps
+        review = subprocess.run([*ARENA, "review", str(mcap)], capture_output=True, text=True, timeout=120)
+        assert "gap: robot/a/1:" in review.stdout, review.stdout
+
+
+def test_a_killed_recorder_is_a_fault_and_its_file_stays_readable(reap, tmp_path):
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    mcap = tmp_path / "cut.mcap"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "norec", "--listen", endpoint,
+                 "--record", str(mcap))  # fmt: skip
+    reap.append(proc)
+    victim = child(proc.pid, "arena run recorder")
+    wait_for_tick(endpoint, "norec", 2000, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc)
+    assert code == 0, err
+    assert result["outcome"] == "completed_with_faults" and result["ticks"] == 6000
+    assert [f["process"] for f in result["faults"]] == ["recorder"]
+    assert result["recording"]["complete"] is False and "recorder failed" in result["recording"]["error"]
+    rec = load(str(mcap))
+    assert rec.truncated and not rec.complete
+    assert len(rec.payloads("world")) > 500, "readable up to its last whole chunk"
+    review = subprocess.run([*ARENA, "review", str(mcap), "--json"], capture_output=True, text=True, timeout=120)
+    assert review.returncode == 0 and json.loads(review.stdout)["truncated"], review.stderr
 
 
 NO_SUMMARY = """
