@@ -563,7 +563,9 @@ def refbox_params(args: argparse.Namespace):
     changes: dict[str, object] = {}
     try:
         if args.refbox:
-            rp.parse_endpoint(args.refbox)
+            from arena.rules.refbox_server import check_listen
+
+            check_listen(args.refbox)
             changes["listen"] = args.refbox
         if args.refbox_teams:
             try:

@@ -40,6 +40,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from arena.runtime.config import ConfigError
 from arena.runtime.config import RefboxTeam as TeamEntry
 
 PORT = 28097  # the RefBox's base-station port
@@ -80,7 +81,7 @@ COLOURS = ("cyan", "magenta")
 DEFAULT_TARGETS = {"cyan": "224.16.32.201", "magenta": "224.16.32.202"}  # no MSL team uses these
 
 
-class ProtocolError(ValueError):
+class ProtocolError(ConfigError):
     """A value that cannot be used (an endpoint, a team table); the message is one line."""
 
 

@@ -48,6 +48,18 @@ class Client:
     out: bytearray = field(default_factory=bytearray)
 
 
+def check_listen(endpoint: str) -> None:
+    """Fail early, with one line, when the bridge could not listen on `endpoint` (a busy port)."""
+    host, port = rp.parse_endpoint(endpoint)
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    try:
+        with socket.socket(family) as s:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            s.bind((host, port))
+    except OSError as exc:
+        raise rp.ProtocolError(f"--refbox {endpoint}: cannot listen there: {exc.strerror}") from None
+
+
 class BridgeServer:
     def __init__(self, host: str, port: int, params: RefboxParams, log: logging.Logger):
         self.params = params

@@ -145,3 +145,38 @@ def test_endpoints():
     for bad in ("udp/1.2.3.4:5", "tcp/:5", "h:xx", "h:70000"):
         with pytest.raises(rp.ProtocolError):
             rp.parse_endpoint(bad)
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--refbox", "tcp/127.0.0.1:xx"], "is not a number"),
+        (["--refbox", "udp/1.2.3.4:5"], "only tcp/HOST:PORT"),
+        (["--refbox-teams", "/no/such/file.json"], "cannot read --refbox-teams"),
+        (["--refbox-protocol", "c=json"], "use a=json"),
+        (["--refbox-targets", "same,same"], "two different strings"),
+        (["--refbox-wait", "1"], "--refbox-wait needs --refbox"),
+        (["--refbox", "--via-refbox"], "--via-refbox needs --realtime"),
+        (["--via-refbox", "--realtime"], "--via-refbox needs the bridge"),
+        (["--refbox-follow", "host:port"], "is not a number"),
+    ],
+)
+def test_bad_refbox_flags_are_one_line_and_exit_2(flags, message, capsys):
+    from arena import cli
+
+    assert cli.main(["match", "--home", "BS", "--away", "BS", *flags]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_busy_port_is_refused_before_the_match(capsys):
+    import socket
+
+    from arena import cli
+
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        assert cli.main(["match", "--home", "BS", "--away", "BS", "--refbox", f"tcp/127.0.0.1:{port}"]) == 2
+    assert "cannot listen there" in capsys.readouterr().err
