@@ -4,7 +4,9 @@ No Docker engine runs on our machines, so this reads the very same file
 `docker compose up` would, expands its `${VAR:-default}` variables, and starts
 each service's `command` as a local process, the router first. It sets
 `ARENA_MATCH` to a fresh match id and `ARENA_LISTEN`/`ARENA_CONNECT` to a unix
-socket in a private temp dir, so that a local run is isolated like any match.
+socket in a private temp dir, so that a local run is isolated like any match;
+an `ARENA_MATCH` set in the environment is kept (a known key prefix for a
+viewer or a recorder started by hand).
 Then it supervises the services and prints the match result like `arena match`.
 """
 
@@ -23,7 +25,7 @@ import yaml
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys, process_names
+from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.tools import launcher
 
 MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
@@ -99,9 +101,13 @@ def _process_of(argv: list[str]) -> ProcessId | None:
 
 def up(path: str, timeout: float = 600.0) -> dict:
     t_start = time.monotonic()
+    match = os.environ.get("ARENA_MATCH") or launcher.new_match_id(0)
+    try:
+        check_match_id(match)
+    except ValueError as exc:
+        raise ComposeError(f"ARENA_MATCH: {exc}", bad_input=True) from None
     tmp = Path(tempfile.mkdtemp(prefix="arena-up-"))
     sock = tmp / "router.sock"
-    match = launcher.new_match_id(0)
     env = dict(os.environ)
     env.update(
         ARENA_MATCH=match,
@@ -130,7 +136,11 @@ def up(path: str, timeout: float = 600.0) -> dict:
             declared = {c.pid for c in children if c.name != "router"}
             missing = [str(p) for p in cfg.processes() if p not in declared]
             if missing:
-                raise ComposeError(f"{path} has no service for: {', '.join(missing)}", bad_input=True)
+                raise ComposeError(
+                    f"{path} has no service for: {', '.join(missing)} (arena up plays every process itself; for "
+                    "hardware in the loop use arena match --external, or docker compose)",
+                    bad_input=True,
+                )
             named = [c for c in children if c.pid.kind != "router"]
             for c in named:
                 c.name = str(c.pid)
