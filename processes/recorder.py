@@ -35,6 +35,7 @@ the lockstep leaves; its work per message is kept small (recording/writer.py).
 from __future__ import annotations
 
 import bisect
+import functools
 import importlib.metadata
 import os
 import platform
@@ -51,7 +52,7 @@ from arena.recording import scene
 from arena.recording.writer import McapWriter
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Node
-from arena.schemas.keys import KEYS
+from arena.schemas.keys import KEYS, routes, spec_of
 from arena.schemas.messages import EngineEvents, Referee, Summary, TapBatch, World
 
 FORMAT = "1"  # version of the layout described in docs/recording.md
@@ -177,8 +178,17 @@ class RecorderNode(Node):
         self.path = cfg.record
         self.peers = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "viewer")]
         self.rank = {name: i for i, name in enumerate(self.peers)}
-        self.tap_in = self.transport.subscribe(self.keys.tap_all())
-        self.summary_in = self.transport.subscribe(self.keys.summary_all())
+        # One subscription per process, so that each batch and summary is checked
+        # against its owner's MAC key (runtime/mac.py) and its owner's keys.
+        self.tap_in = {name: self._owned(self.keys.tap(name), name) for name in self.peers}
+        self.summary_in = {name: self._owned(self.keys.summary(name), name) for name in self.peers}
+        self.owns = {name: set() for name in self.peers}  # keys each process may send (the key table)
+        for rel, sender, _ in routes(cfg.robots):
+            if sender in self.owns:
+                self.owns[sender].add(rel)
+        # key -> decoder of its message type: a frame that does not decode is not written
+        decoders = {spec.name: msgspec.msgpack.Decoder(spec.message).decode for spec in KEYS}
+        self._decode_as = {rel: decoders[spec_of(rel).name] for owned in self.owns.values() for rel in owned}
         self._decode_batch = msgspec.msgpack.Decoder(TapBatch).decode
         self._decode_summary = msgspec.msgpack.Decoder(Summary).decode
         self._decode_world = msgspec.msgpack.Decoder(World).decode
@@ -292,16 +302,35 @@ class RecorderNode(Node):
         self.sink = None
 
     # ----------------------------------------------------------------- intake
-    def _on_batch(self, raw: bytes) -> None:
+    def _owned(self, key: str, owner: str):
+        verify = self.keyring.verifier(owner, key)
+        on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {owner}")
+        return self.transport.subscribe(key, verify=verify, on_forged=on_forged)
+
+    def _frames(self, owner: str, frames):
+        """The frames of `owner`'s batch that it may send and that decode as their key's type."""
+        owns, decoders = self.owns[owner], self._decode_as
+        for f in frames:
+            if f.key not in owns:
+                self.rejections.reject(self.keys.tap(owner), "forged", f"{owner} does not send {f.key!r}")
+                continue
+            try:
+                decoders[f.key](f.payload)
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self.rejections.reject(self.keys.tap(owner), "malformed", f"{f.key}: {str(exc)[:100]}")
+                continue
+            yield f
+
+    def _on_batch(self, raw: bytes, owner: str) -> None:
         try:
             batch = self._decode_batch(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-            self.rejections.reject(self.keys.tap_all(), "malformed", str(exc)[:120])
+            self.rejections.reject(self.keys.tap(owner), "malformed", str(exc)[:120])
             return
         name = batch.process
         rank = self.rank.get(name)
-        if rank is None:
-            self.rejections.reject(self.keys.tap(name), "unknown-process")
+        if name != owner or rank is None:
+            self.rejections.reject(self.keys.tap(owner), "forged", f"a batch of {name!r} on {owner}'s tap")
             return
         if batch.seq != self.batches[name]:
             self.rejections.reject(
@@ -312,7 +341,7 @@ class RecorderNode(Node):
         self.batches[name] = batch.seq + 1
         seq = self.sent[name]
         counts = self.recorded[name]
-        for f in batch.frames:
+        for f in self._frames(name, batch.frames):
             self.pending.append((f.tick, rank, seq, f.key, f.payload))
             counts[f.key] = counts.get(f.key, 0) + 1
             seq += 1
@@ -323,22 +352,24 @@ class RecorderNode(Node):
         else:
             self.water[name] = max(self.water[name], batch.tick)
 
-    def _on_summary(self, raw: bytes) -> None:
+    def _on_summary(self, raw: bytes, owner: str) -> None:
         try:
             s = self._decode_summary(raw)
         except (msgspec.DecodeError, msgspec.ValidationError):
             return  # not ours to judge: the collector reports it
-        if s.process in self.rank:
+        if s.process == owner:
             self.summaries.setdefault(s.process, s)
 
     def _drain(self) -> bool:
         got = False
-        while (raw := self.tap_in.try_recv()) is not None:
-            self._on_batch(raw)
-            got = True
-        while (raw := self.summary_in.try_recv()) is not None:
-            self._on_summary(raw)
-            got = True
+        for name, channel in self.tap_in.items():
+            while (raw := channel.try_recv()) is not None:
+                self._on_batch(raw, name)
+                got = True
+        for name, channel in self.summary_in.items():
+            while (raw := channel.try_recv()) is not None:
+                self._on_summary(raw, name)
+                got = True
         if got:
             self._write_ready(min(self.water.values()))
         return got

@@ -46,6 +46,7 @@ class Recording:
     summaries: dict[str, Summary] = field(default_factory=dict)
     truncated: bool = False
     problem: str = ""  # why it is truncated
+    undecodable: dict[str, int] = field(default_factory=dict)  # per topic: messages not of its type
 
     @property
     def complete(self) -> bool:
@@ -65,8 +66,16 @@ class Recording:
         return [p for _, _, p in self.topics.get(topic, [])]
 
     def decoded(self, topic: str, msg_type: type):
+        """The messages of `topic` that decode as `msg_type`; the others are skipped and counted
+        in `undecodable` (a hostile or damaged file never ends a review in a traceback)."""
         dec = msgspec.msgpack.Decoder(msg_type).decode
-        return [dec(p) for _, _, p in self.topics.get(topic, [])]
+        out = []
+        for _, _, p in self.topics.get(topic, []):
+            try:
+                out.append(dec(p))
+            except (msgspec.DecodeError, msgspec.ValidationError):
+                self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
+        return out
 
 
 def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:

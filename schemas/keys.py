@@ -261,3 +261,12 @@ class Keys:
 
     def everything(self) -> str:
         return f"{self.prefix}**"
+
+
+def spec_of(rel: str) -> KeySpec | None:
+    """The KeySpec of a concrete key relative to arena/<match>/ (`robot/a/1/cmd`), or None."""
+    for spec in KEYS:
+        pattern = re.escape(spec.pattern).replace(re.escape("<team>"), "[ab]").replace(re.escape("<n>"), "[0-9]+")
+        if re.fullmatch(pattern, rel):
+            return spec
+    return None

@@ -70,7 +70,12 @@ class ReplayResult:
 
 
 def _decode(payload: bytes | None) -> object:
-    return None if payload is None else msgspec.msgpack.decode(payload)
+    if payload is None:
+        return None
+    try:
+        return msgspec.msgpack.decode(payload)
+    except msgspec.DecodeError:
+        return payload  # not msgpack (a damaged or hostile file): compared as bytes
 
 
 def _difference(key: str, index: int, recorded: bytes | None, replayed: bytes | None) -> Difference:

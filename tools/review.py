@@ -48,6 +48,9 @@ def print_review(r: dict, console: Console | None = None) -> None:
         console.print(f"[yellow]truncated recording: {r['truncation']}; reviewed up to {r['sim_seconds']:.1f} s[/]")
     elif not r["complete"]:
         console.print("[yellow]incomplete recording: the recorder missed some process's frames (gaps below)[/]")
+    if r.get("undecodable"):
+        bad = ", ".join(f"{topic} {n}" for topic, n in r["undecodable"].items())
+        console.print(f"[yellow]skipped messages that do not decode as their topic's type: {bad}[/]")
     if r["goals"]:
         console.print(
             "goals: " + ", ".join(f"{g['t']:.1f} s {g['team']} ({g['score'][0]}:{g['score'][1]})" for g in r["goals"])

@@ -170,6 +170,7 @@ def analyse(rec: Recording) -> dict:
         "truncated": rec.truncated,
         "truncation": rec.problem,
         "complete": rec.complete,
+        "undecodable": dict(sorted(rec.undecodable.items())),
         "home": cfg.home,
         "away": cfg.away,
         "seed": cfg.seed,

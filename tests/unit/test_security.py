@@ -1,0 +1,91 @@
+"""The access control generated from the key table, the credentials files, and the MAC."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+from arena.runtime.acl import access_control, permissions
+from arena.runtime.credentials import Secrets, load_fragment
+from arena.runtime.mac import Keyring, tag
+from arena.schemas.keys import process_names
+
+P = "arena/m/"
+NAMES = process_names(3)
+
+
+def _rel(keys: list[str]) -> set[str]:
+    return {k[len(P) :] for k in keys}
+
+
+def test_robot_a1_puts_only_on_its_cmd_and_report():
+    perms = permissions("robot/a/1", P, 3)
+    assert _rel(perms["put/ingress"]) == {
+        "robot/a/1/cmd",
+        "team/a/report/1",
+        "summary/robot/a/1",
+        "tap/robot/a/1",
+        "refused/robot/a/1",
+    }
+    # the referee state is public (a RefBox broadcasts it to every team)
+    assert _rel(perms["declare_subscriber/ingress"]) == {
+        "robot/a/1/sense",
+        "team/a/order/1",
+        "field",
+        "referee",
+        "ack/robot/a/1",
+    }
+    assert _rel(perms["liveliness_token/ingress"]) == {"alive/robot/a/1"}
+
+
+def test_team_b_never_reads_team_a_nor_the_world():
+    for p in [n for n in NAMES if "/b" in n]:
+        reads = _rel(permissions(p, P, 3)["declare_subscriber/ingress"]) | _rel(permissions(p, P, 3)["put/egress"])
+        assert not any(k.startswith(("team/a/", "robot/a/")) for k in reads), p
+        assert "world" not in reads and "engine/events" not in reads, p
+        writes = _rel(permissions(p, P, 3)["put/ingress"])
+        assert not any("/a/" in k for k in writes) and "referee" not in writes, p
+
+
+def test_the_viewer_reads_world_referee_and_field_only():
+    reads = _rel(permissions("viewer", P, 3)["declare_subscriber/ingress"])
+    assert reads - {"ack/viewer"} == {"world", "referee", "field"}
+
+
+def test_default_deny_and_one_policy_per_principal():
+    acl = access_control(P, 3, NAMES)
+    assert acl["enabled"] and acl["default_permission"] == "deny"
+    assert {s["id"] for s in acl["subjects"]} == {n.replace("/", "-") for n in NAMES} | {"viewer"}
+    ids = [r["id"] for r in acl["rules"]]
+    assert len(ids) == len(set(ids))
+    assert all(r["key_exprs"] and all(k.startswith(P) for k in r["key_exprs"]) for r in acl["rules"])
+
+
+def test_fragments_hold_user_password_tls_root_and_keys(tmp_path):
+    s = Secrets.new("m1", 3, NAMES, secure=True, tls=True)
+    paths = s.write(tmp_path)
+    assert paths["robot/b/1"].name == "robot-b-1.json5" and paths["viewer"].name == "viewer.json5"
+    frag = load_fragment(str(paths["robot/b/1"]))
+    assert frag["mode"] == "client"
+    assert frag["transport"]["auth"]["usrpwd"]["user"] == "robot-b-1"
+    assert frag["transport"]["link"]["tls"]["root_ca_certificate_base64"]
+    keys = frag["metadata"]["arena"]["keys"]
+    assert set(keys) == {"robot/b/1"}, "a team process holds its own key only"
+    assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine"}
+    insecure = Secrets.new("m1", 3, NAMES, secure=False).fragment("robot/b/1")
+    assert set(insecure) == {"metadata"}, "without --secure: the MAC key only, the zenoh settings untouched"
+    json.dumps(frag)  # plain JSON, so valid JSON5
+
+
+def test_the_mac_is_keyed_blake2b_over_key_nul_payload():
+    key = bytes(range(32))
+    expected = hashlib.blake2b(b"arena/m/summary/engine\0\x81\xa1a\x01", key=key, digest_size=16).digest()
+    assert tag(key, "arena/m/summary/engine", b"\x81\xa1a\x01") == expected
+    # The test vector of schemas/README.md (Security):
+    assert expected.hex() == "d7c51f4829d4546d963595dcd996ee3f"
+    ring = Keyring("referee", {"engine": key})
+    ok = ring.verifier("engine", "arena/m/engine/events")
+    payload = b"\x82"
+    assert ok(payload, tag(key, "arena/m/engine/events", payload))
+    assert not ok(payload, None) and not ok(payload, tag(key, "arena/m/referee", payload))
+    assert ring.verifier("robot/a/1", "arena/m/summary/robot/a/1") is None  # no key: accepted as before
