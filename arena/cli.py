@@ -732,7 +732,7 @@ def cmd_up(args: argparse.Namespace) -> int:
     try:
         result = compose.up(args.file, timeout=args.timeout)
     except compose.ComposeError as exc:
-        print(f"arena up: error: {exc}", file=sys.stderr)
+        print(f"arena up: error: {one_line(str(exc))}", file=sys.stderr)
         return 2 if exc.bad_input else 1
     return emit_match(result, args.json, "arena up")
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import socket
 import subprocess
 import time
@@ -71,3 +72,35 @@ def test_a_secure_match_refuses_a_wrong_or_missing_credential(tmp_path, reap):
             .splitlines()[-1]
             .startswith(f"arena run: error: refused by {endpoint}: authentication failed")
         ), (extra, r.stderr)
+
+
+def test_a_hand_started_robot_says_whom_it_waits_for_and_the_final_score(tmp_path, reap):
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    match = spawn(
+        *("match", "--home", "BS", "--away", "AD", "--half-time", "2", "--seed", "1"),
+        *("--external", "a/1", "--external", "a/2", "--match", "two", "--listen", sock, "--json"),
+    )
+    reap.append(match)
+    assert "waiting for 2 external processes" in wait_for(lambda: match.stderr.readline(), 60, "the instructions")
+    commands = [match.stderr.readline().split() for _ in range(2)]
+    assert [c[:3] for c in commands] == [["arena", "run", "robot"]] * 2, commands
+    first = subprocess.Popen([*ARENA, *commands[0][1:]], stderr=subprocess.PIPE, text=True)
+    reap.append(first)
+    lines = [wait_for(lambda: first.stderr.readline(), 60, "robot a/1's first line")]
+    while "waiting for:" not in lines[-1]:
+        lines.append(wait_for(lambda: first.stderr.readline(), 60, "whom robot a/1 waits for"))
+    assert any("connected to " + sock in line for line in lines), lines
+    assert lines[-1].strip().startswith("arena run: robot/a/1: waiting for: robot/a/2"), lines
+    second = subprocess.Popen([*ARENA, *commands[1][1:]], stderr=subprocess.PIPE, text=True)
+    reap.append(second)
+    out, err = match.communicate(timeout=240)
+    assert match.returncode == 0, err
+    rest = first.communicate(timeout=30)[1]
+    assert first.returncode == 0, rest
+    assert "every process is here: playing" in rest
+    score = json.loads(out)["score"]
+    assert rest.strip().splitlines()[-1] == (
+        f"arena run: robot/a/1: match over at tick 200 (END_GAME): a (basic-static) {score[0]} : {score[1]} "
+        "b (advance-dynamic)"
+    )
+    second.communicate(timeout=30)
