@@ -332,7 +332,7 @@ def build_parser() -> Parser:
     r.add_argument(
         "--record",
         metavar="PATH",
-        help="recorder: write the MCAP file here; engine without --config: the match records",
+        help="recorder: write the MCAP file here; engine without --config: the match records (the path is the recorder's)",
     )
     r.add_argument("--host", default="127.0.0.1", metavar="HOST", help="viewer: the address to serve on (127.0.0.1)")
     r.add_argument(
@@ -446,7 +446,7 @@ def build_parser() -> Parser:
 
 
 def match_config(
-    args: argparse.Namespace, realtime: bool = False, external=(), record: str = "", refbox=None
+    args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None
 ) -> MatchConfig:
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
@@ -478,7 +478,7 @@ def match_config(
         link=link,
         link_overrides=overrides,
         realtime=realtime,
-        record=record,
+        tap=tap,
         **({"refbox": refbox} if refbox is not None else {}),
         external=tuple(
             ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e))
@@ -517,7 +517,9 @@ def cmd_match(args: argparse.Namespace) -> int:
     if missing and not args.config_file:
         raise ConfigError(f"the following arguments are required: {', '.join(missing)} (or give them in --config FILE)")
     record = record_path(args.record) if args.record else ""
-    cfg = match_config(args, realtime=args.realtime, external=args.external, record=record, refbox=refbox_params(args))
+    cfg = match_config(
+        args, realtime=args.realtime, external=args.external, tap=bool(record), refbox=refbox_params(args)
+    )
     cfg = live_config(cfg, args.live, args.pace, args.live_host)
     if args.match:
         from arena.schemas.keys import check_match_id
@@ -532,7 +534,7 @@ def cmd_match(args: argparse.Namespace) -> int:
         timeout = args.startup_timeout if args.startup_timeout is not None else 600.0
         cfg = cfg.replace(timing=dataclasses.replace(cfg.timing, startup_timeout=timeout))
     if args.engine == "inprocess":
-        return match_inprocess(args, cfg)
+        return match_inprocess(args, cfg, record)
     show = not args.json and sys.stderr.isatty()
     try:
         result = launcher.play_match(
@@ -546,6 +548,7 @@ def cmd_match(args: argparse.Namespace) -> int:
             live_host=args.live_host,
             secure=args.secure,
             credentials=args.credentials,
+            record=record,
         )
     except launcher.MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
@@ -609,7 +612,7 @@ def one_line(text: str) -> str:
     return f"{head} {tail[-1]}; {last}" if tail else f"{head.rstrip(':')}; {last}"
 
 
-def match_inprocess(args: argparse.Namespace, cfg: MatchConfig) -> int:
+def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = "") -> int:
     """`arena match --engine inprocess`: flags that need separate processes are refused."""
     from arena.tools import inprocess
 
@@ -626,7 +629,7 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig) -> int:
         if given:
             raise ConfigError(f"{flag} needs --engine processes (inprocess plays lockstep in one process)")
     try:
-        result = inprocess.play_match(cfg)
+        result = inprocess.play_match(cfg, record=record)
     except inprocess.InprocessError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 1
@@ -698,7 +701,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.config:
             cfg = runner.load_config(args.config)
         elif args.kind == "engine":
-            cfg = match_config(args, realtime=args.realtime, record=record_path(args.record) if args.record else "")
+            # The engine only needs to know that the match records; the path is the recorder's.
+            cfg = match_config(args, realtime=args.realtime, tap=bool(args.record))
         if args.record and args.kind not in ("engine", "recorder"):
             raise ConfigError(f"--record does not apply to {args.kind}")
         if args.port is not None and (args.kind != "viewer" or not 0 <= args.port <= 65535):

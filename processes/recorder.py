@@ -170,12 +170,16 @@ class McapSink:
 
 
 class RecorderNode(Node):
-    def __init__(self, *args, **kwargs):
+    """`path`: the MCAP file to write. Only the recorder gets it; the others see `cfg.tap`."""
+
+    def __init__(self, *args, path: str = "", **kwargs):
         super().__init__(*args, **kwargs)
         cfg = self.cfg
-        if not cfg.record:
+        if not cfg.tap:
             raise ConfigError("this match does not record: start it with --record FILE.mcap")
-        self.path = cfg.record
+        if not path:
+            raise ConfigError("the recorder needs --record FILE.mcap")
+        self.path = path
         self.peers = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "viewer")]
         self.rank = {name: i for i, name in enumerate(self.peers)}
         # One subscription per process, so that each batch and summary is checked

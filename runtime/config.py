@@ -203,7 +203,7 @@ class MatchConfig:
     link_overrides: dict[str, dict[str, float]] = field(default_factory=dict)
     realtime: bool = False
     external: tuple[str, ...] = ()  # processes started by hand, e.g. "robot/a/1"
-    record: str = ""  # MCAP path, "" for none
+    tap: bool = False  # the match records: every process taps what it sends (the MCAP path is the recorder's own)
     live: int = -1  # [-] TCP port of the live viewer's Foxglove server (processes/viewer.py); -1: no viewer, 0: any
     pace: float = 0.0  # [-] lockstep with a viewer: simulated seconds per wall second; 0: as fast as it goes
     field: FieldParams = FieldParams()
@@ -237,7 +237,7 @@ class MatchConfig:
                 out.append(ProcessId("robot", team, n))
         if self.refbox.listen:
             out.append(ProcessId("refbox"))
-        if self.record:
+        if self.tap:
             out.append(ProcessId("recorder"))
         if self.live >= 0:
             out.append(ProcessId("viewer"))

@@ -89,7 +89,7 @@ class Node:
         # (runtime/tap.py), which the recorder collects.
         self.tap: Tap | None = None
         self._tap_handoff: Handoff | None = None
-        if cfg.record and pid.kind not in ("recorder", "viewer"):  # they send no data
+        if cfg.tap and pid.kind not in ("recorder", "viewer"):  # they send no data
             put = transport.publisher(keys.tap(self.name), sign=self.keyring.signer(keys.tap(self.name)))
             self._tap_handoff = Handoff(put) if self.reactive else None
             self.tap = Tap(self.name, self._tap_handoff or put)

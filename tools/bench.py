@@ -85,9 +85,9 @@ def bench_record(args: argparse.Namespace) -> int:
             base = MatchConfig(seed=1000 + i, robots=args.robots, half_time=args.half_time, link=args.link)
             path = Path(tmp) / f"run{i}.mcap"
             # Alternate which goes first, so that drift in the machine's load favours neither.
-            order = [(False, base), (True, base.replace(record=str(path)))]
-            for rec, cfg in order if i % 2 == 0 else reversed(order):
-                r = launcher.play_match(cfg)
+            order = [(False, ""), (True, str(path))]
+            for rec, record in order if i % 2 == 0 else reversed(order):
+                r = launcher.play_match(base, record=record)
                 (recorded if rec else plain).append(r)
                 console.print(f"run {i + 1}/{args.runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
             sizes.append(path.stat().st_size)

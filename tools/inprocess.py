@@ -10,7 +10,7 @@ integration test compares against real processes over zenoh).
 What differs from the distributed run is only what the machine does: one
 interpreter, no zenoh, no start barrier or liveliness (every node is there by
 construction), and per-node `cpu_s` is the wall time the single thread spent
-in that node's loop. A recorded match (`cfg.record`) runs the recorder node
+in that node's loop. A recorded match (`record=PATH`) runs the recorder node
 too: it drains the taps between rounds of the run queue and writes the same
 MCAP message records as the distributed recorder.
 """
@@ -38,11 +38,18 @@ class InprocessError(RuntimeError):
     """The match could not be played to the end; the message says why (one line)."""
 
 
-def _play(cfg: MatchConfig, watch: tuple[str, ...]):
+def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
+    """`record`: the recorder's MCAP path ("" for none); the other nodes get only `cfg.tap`."""
+    cfg = cfg.replace(tap=bool(record))
     bus = CoopBus()
     keys = Keys("inprocess")
     taps = {name: bus.subscribe(None, keys.key(name)) for name in watch}
-    nodes = {str(p): node_class(p.kind)(p, cfg, CoopTransport(bus), keys) for p in cfg.processes()}
+    nodes = {
+        str(p): node_class(p.kind)(
+            p, cfg, CoopTransport(bus), keys, **({"path": record} if record and p.kind == "recorder" else {})
+        )
+        for p in cfg.processes()
+    }
     recorder = nodes.pop("recorder", None)
     settle_heap()
     t0 = time.perf_counter()
@@ -75,18 +82,25 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...]):
     return summaries, frames, play, deadlocks
 
 
-def play_in_process(cfg: MatchConfig, watch: tuple[str, ...] = ("world",), timeout: float = 120.0):  # noqa: ARG001
+def play_in_process(
+    cfg: MatchConfig,
+    watch: tuple[str, ...] = ("world",),
+    timeout: float = 120.0,
+    record: str = "",  # noqa: ARG001
+):
     """Play `cfg` in this thread. Returns (summaries by process, {key name: [payload, ...]}).
+
+    `record`: write the match to this MCAP file (the recorder node runs too).
 
     `timeout` is kept for callers of the threaded driver this replaced: a
     cooperative match cannot hang (a deadlock is detected, not waited out).
     """
-    summaries, frames, _, _ = _play(cfg, watch)
+    summaries, frames, _, _ = _play(cfg, watch, record)
     return summaries, frames
 
 
-def play_match(cfg: MatchConfig) -> dict:
-    """Play one match in-process and return the result dict of `arena match --json`."""
+def play_match(cfg: MatchConfig, record: str = "") -> dict:
+    """Play one match in-process and return the result dict of `arena match --json`; `record`: an MCAP path."""
     from arena.tools.launcher import Collected, assemble
 
     if cfg.realtime:
@@ -97,9 +111,9 @@ def play_match(cfg: MatchConfig) -> dict:
     if others:
         raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
     t_start = time.monotonic()
-    summaries, _, play, deadlocks = _play(cfg, watch=())
+    summaries, _, play, deadlocks = _play(cfg, watch=(), record=record)
     got = Collected(summaries=summaries, started=0.0, ended=play)
-    result = assemble(cfg, got, time.monotonic() - t_start, [])
+    result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, [], record=record)
     result["engine"] = ENGINE
     result["pid"] = os.getpid()
     result["deadlocks"] = deadlocks

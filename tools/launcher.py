@@ -521,7 +521,7 @@ def supervise(
     return got
 
 
-def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child]) -> dict:
+def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list[Child], record: str = "") -> dict:
     """The match result (what `arena match --json` prints)."""
     # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
     # what the teams sent (no process's input): the digest is the same with or without them.
@@ -584,9 +584,9 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
     play = max(1e-9, engine.wall_s if engine and engine.wall_s > 0 else got.ended - got.started)
     honest = match_outcome(cfg, sums, got.crashed, got.lost, got.missing, got.void)
     recording = recorder.extra if recorder else None
-    if cfg.record and recorder is None:
+    if cfg.tap and recorder is None:
         why = next((f["reason"] for f in honest["faults"] if f["process"] == "recorder"), "no summary")
-        recording = {"path": cfg.record, "complete": False, "error": f"the recorder failed: {why}"}
+        recording = {"path": record, "complete": False, "error": f"the recorder failed: {why}"}
     return {
         "outcome": honest["outcome"],
         "void": honest["void"],
@@ -629,7 +629,7 @@ def instructions(
     external: list[ProcessId],
     match: str,
     endpoint: str,
-    cfg: MatchConfig,
+    record: str = "",
     credentials: dict[str, Path] | None = None,
     secure: bool = False,
 ) -> str:
@@ -639,7 +639,7 @@ def instructions(
     lines = [f"waiting for {n} external process{'es' if n != 1 else ''}; start {'each' if n != 1 else 'it'} with:"]
     for p in external:
         cred = str(credentials[str(p)]) if credentials else None
-        argv = run_argv(p, match, endpoints[0], record=cfg.record, credentials=cred)[3:]
+        argv = run_argv(p, match, endpoints[0], record=record, credentials=cred)[3:]
         if client and not secure:  # a secure match's credentials file says client mode
             argv += ["--mode", "client"]
         lines.append("  arena " + " ".join(argv))
@@ -684,10 +684,13 @@ def play_match(
     live_host: str = "127.0.0.1",
     secure: bool | None = None,
     credentials: str | None = None,
+    record: str = "",
 ) -> dict:
     """Play one match as separate processes and return its result dict.
 
-    `announce(text)` is called with instructions for `--external` processes.
+    `record`: an MCAP path; it reaches the recorder's argv only, the other
+    processes see `cfg.tap`. `announce(text)` is called with instructions for
+    `--external` processes.
     `secure`: authenticated principals, access control and TLS (runtime/acl.py,
     runtime/credentials.py); None means on whenever `listen` is not loopback.
     `credentials`: the directory for every principal's credentials file
@@ -698,6 +701,7 @@ def play_match(
     """
     t_start = time.monotonic()
     compile_sources()
+    cfg = cfg.replace(tap=bool(record))
     match = match or new_match_id(cfg.seed)
     keys = Keys(match)
     tmp = Path(tempfile.mkdtemp(prefix="arena-"))
@@ -725,14 +729,14 @@ def play_match(
             for p in cfg.processes():
                 if p in external:
                     continue
-                argv = run_argv(p, match, connect, str(cfg_path), cfg.record, live_host, str(cred_paths[str(p)]))
+                argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
                 children.append(spawn(str(p), p, argv, logs))
             if cfg.live >= 0 and announce is not None:
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
             joins = Joins(session, keys, external, announce)
             if external and announce is not None:
-                announce(instructions(sorted(external), match, endpoint, cfg, cred_paths, secure))
+                announce(instructions(sorted(external), match, endpoint, record, cred_paths, secure))
             try:
                 joins.wait(cfg.timing.startup_timeout, children)
                 got = supervise(
@@ -756,7 +760,7 @@ def play_match(
                 c.popen.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 pass
-        result = assemble(cfg, got, time.monotonic() - t_start, children)
+        result = assemble(cfg, got, time.monotonic() - t_start, children, record)
         result["secure"] = secure
         if result["outcome"] != "completed" and log_dir is None:
             keep = True  # a fault's evidence

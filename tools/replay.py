@@ -102,7 +102,7 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
         raise ReplayError("refbox: the RefBox bridge replays nothing: its worldstates came from outside the match")
     if cfg.realtime:
         raise ReplayError("this match ran with --realtime, which is not deterministic: only lockstep matches replay")
-    cfg = cfg.replace(record="")  # the replayed node taps nothing
+    cfg = cfg.replace(tap=False)  # the replayed node taps nothing
     name = str(pid)
     bus = MemoryBus()
     keys = Keys("replay")

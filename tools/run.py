@@ -201,11 +201,13 @@ def run(
             if realtime and not cfg.realtime:
                 raise ConfigError("--realtime given, but the match runs in lockstep")
             if pid.kind == "recorder":
-                if not cfg.record:
+                if not cfg.tap:
                     raise ConfigError(f"match {match!r} does not record: start it with --record FILE.mcap")
-                if record:
-                    cfg = cfg.replace(record=record)
+                if not record:
+                    raise ConfigError("arena run recorder needs --record FILE.mcap")
             extra: dict[str, object] = {}
+            if pid.kind == "recorder":
+                extra = {"path": record}  # the path reaches the recorder only
             if pid.kind == "viewer":
                 # A viewer attached by hand to a match started without --live watches
                 # only (the engine has no pacer to pause) and nobody waits for it.

@@ -33,7 +33,7 @@ CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
 
 def record(tmp_path, name: str, cfg: MatchConfig = CFG):
     path = tmp_path / name
-    summaries, _ = play_in_process(cfg.replace(record=str(path)), watch=())
+    summaries, _ = play_in_process(cfg, watch=(), record=str(path))
     return path, summaries
 
 
@@ -73,7 +73,7 @@ def test_outbound_taps_only_when_the_match_records(recording):
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
 
-    cfg = MatchConfig(record="/nonexistent/x.mcap" if recording else "")
+    cfg = MatchConfig(tap=recording)
     node = RobotNode(ProcessId("robot", "a", 1), cfg, MemoryTransport(MemoryBus()), Keys("t"))
     assert {type(ob) for ob in node.outbound} == ({TappedOutbound} if recording else {Outbound})
     assert (node.tap is not None) == recording
@@ -128,7 +128,7 @@ def test_records_are_in_tick_then_process_order(recorded):
 def test_metadata_holds_configuration_seed_strategies_versions_and_revision(recorded):
     path, summaries = recorded
     rec = load(str(path))
-    assert rec.cfg == CFG.replace(record=str(path))
+    assert rec.cfg == CFG.replace(tap=True)
     arena = rec.meta["arena"]
     assert (arena["seed"], arena["home"], arena["away"]) == ("11", CFG.home, CFG.away)
     assert arena["git_revision"]
