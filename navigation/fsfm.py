@@ -33,9 +33,8 @@ both are 3x scheme #5, as the fixed-k schemes #2/#1 are (300/100), so #6 is
 taken as 600, 450, 300, 150, 75.
 
 The FIS runs on Python floats: for two inputs and 4 + 4 sets this is faster
-than numpy, whose per-call overhead dominates arrays this small (measured on
-the development machine: about 15 us per step with 5 obstacles, against about
-75 us for the same step vectorised with numpy).
+than numpy, whose per-call overhead dominates arrays this small
+(docs/performance.md, "Measurements behind design choices").
 """
 
 from __future__ import annotations

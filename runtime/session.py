@@ -9,18 +9,16 @@ Topology used by `arena match`: a router listens on a per-match endpoint (a
 unix socket in the match's temp dir, or a TCP port); every process opens a
 *peer* session that connects to it and listens on an ephemeral loopback port,
 so gossip scouting (over the router link only) lets the peers open direct links
-to one another. Measured on 2 cores (engine + 6 robots, lockstep ping-pong):
-clients through the router 0.95 ms per tick, peers meshed behind a router
-0.57 ms per tick. A hardware-in-the-loop process on another machine uses
+to one another, which is faster per tick than clients through the router
+(docs/performance.md, "Measurements behind design choices"). A hardware-in-the-loop process on another machine uses
 `--mode client` and talks through the router.
 
 Liveliness is how a match learns that a process is gone: a crashed process's
 token vanishes within milliseconds, a hung one's (SIGSTOP, power loss, cut
 cable) when its lease expires. The lease is 6 s instead of zenoh's 10 s; keep-
 alives only flow on links that carry nothing else, so the lockstep traffic
-pays nothing for it. It was 2 s: on a host loaded well past its cores (a
-match next to six busy loops on 2 cores), 2 of 3 matches lost a healthy peer
-to an expired 2 s lease, and none of 3 did with 6 s.
+pays nothing for it. A 2 s lease lost healthy peers on an overloaded host
+(docs/performance.md, "Measurements behind design choices").
 """
 
 from __future__ import annotations
@@ -119,19 +117,18 @@ class NetConfig:
 # Eleven processes share two cores. zenoh's default is a pool of threads per
 # runtime (rx, tx, app, acc, net), so every message wakes one thread to write it
 # and another to read it. Handing every runtime over to one thread per process
-# lets a message go out from the thread that is already awake: measured with
-# `arena bench match`, rtf 18.3 -> 20.6 and 8 % less CPU than one thread per pool
-# (and more against the default of one per core). A user's own ZENOH_RUNTIME wins.
+# lets a message go out from the thread that is already awake (faster, less CPU:
+# docs/performance.md, "Measurements behind design choices"). A user's own ZENOH_RUNTIME wins.
 ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),net:(handover:rx),app:(handover:rx))"
 
 
 # A client (a secure match, containers) sends everything over its one link to the
 # router, tap batches of ~100 kB included. With tx handed over to rx, a reactive
 # node's BLOCK put on zenoh's only thread waited for queue room that only that
-# thread could make: in secure recorded matches the engine stalled until its lease
-# expired (3 of 3 runs). A transmit thread of its own ends that (3 of 3 complete).
-# The router of a secure match, which carries every frame, gets one too (with one
-# thread: rtf 1.4 against 6-11 in a 2 x 5 s secure match on loopback TLS).
+# thread could make, and in secure recorded matches the engine stalled until its
+# lease expired. A transmit thread of its own ends that; the router of a secure
+# match, which carries every frame, gets one too (docs/performance.md, "Measurements
+# behind design choices").
 CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1),net:(handover:rx),app:(handover:rx))"
 
 

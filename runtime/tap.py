@@ -1,9 +1,8 @@
 """Taps: what a process sent, batched for the recorder (docs/recording.md).
 
 A recorder that subscribed to every key of a match would receive every frame
-a second time. On 2 cores each zenoh message received costs ~60-70 us of CPU
-and a match already sends ~15 per tick, so that would roughly halve the
-match's speed. Instead, when the match records, every process keeps a copy of
+a second time, which would roughly halve the match's speed on 2 cores
+(docs/performance.md, "Measurements behind design choices"). Instead, when the match records, every process keeps a copy of
 what it sends (a list append per frame) and publishes it as ONE `TapBatch`
 every `TAP_PERIOD` ticks on `arena/<m>/tap/<process>`, plus a final batch at
 the end of the match, before its `Summary`.

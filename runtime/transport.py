@@ -34,9 +34,8 @@ def keep_thread_state() -> None:
     faults on touching it, and a TLB shoot-down across the cores: `strace`
     showed one mmap/munmap/gettid triple per message in every process. One
     extra `PyGILState_Ensure`, never released, keeps the state alive; zenoh's
-    own Ensure/Release pairs then just take and drop the GIL. Measured with
-    `arena match` (2 x 60 s, BS v BS, seed 3, three interleaved pairs on a quiet
-    host): rtf 16.1-18.6 without, 20.3-21.2 with, same digest.
+    own Ensure/Release pairs then just take and drop the GIL (the measurement:
+    docs/performance.md, "Measurements behind design choices").
     """
     ident = _thread.get_ident()
     if ident not in _KEPT:
@@ -149,9 +148,8 @@ class _VerifiedChannel:
 class ZenohTransport:
     """Lockstep traffic is RELIABLE with congestion control BLOCK: nothing is dropped by zenoh.
 
-    Not `express`: measured on 2 cores, an express put costs ~40 us of CPU
-    (one write per message) against ~12 us batched, with no measurable
-    latency cost in the lockstep ping-pong (0.57 ms per tick either way).
+    Not `express`: it costs more CPU per put for no lockstep latency gain
+    (docs/performance.md, "Measurements behind design choices").
     """
 
     FIFO = 1 << 14  # frames buffered per subscription

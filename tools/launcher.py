@@ -182,8 +182,8 @@ def compile_sources() -> None:
 
     With PYTHONDONTWRITEBYTECODE set and an editable install (the README's),
     no interpreter writes a cache, so every process of every match compiled
-    arena's sources again: about 0.1 s of CPU per process, ~1 s per match
-    (measured with `arena match --half-time 1`: 3.6 against 2.6 CPU s). This
+    arena's sources again, about a second of CPU per match (docs/performance.md,
+    "Measurements behind design choices"). This
     writes the usual `__pycache__` files of arena's own packages only (skipping
     fresh ones, a few ms), never anything else. Without the variable the
     interpreters write them themselves, so this does nothing.

@@ -53,7 +53,7 @@ class IrisParams:
     regroup_clear: float = 0.6  # [m] ... first backing straight off the ball to this far (centre to ball centre)
     regroup_distance: float = 0.9  # [m] ... to this far from the ball (basic: aside, advance: goal-side)
     cover_depth: float = -2.5  # [m] along the attack direction: the defender's place while the team attacks
-    mark_zone: float = 6.5  # [m] advance defense: an opponent this close to our goal (about our half) is marked (was 5)
+    mark_zone: float = 6.5  # [m] advance defense: an opponent this close to our goal (about our half) is marked
     block_zone: float = (
         6.5  # [m] advance defense: a carrier this close to our goal is blocked, not left to the attacker
     )
