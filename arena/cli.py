@@ -416,6 +416,11 @@ def build_parser() -> Parser:
     v.add_argument("--plots", metavar="DIR", help="also write PNG charts and an animated GIF into DIR")
     v.add_argument("--goalkeepers", action="store_true", help="with --plots: keep the goalkeepers in the heatmaps")
     v.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
+    v.add_argument(
+        "--html",
+        metavar="FILE.html",
+        help="also write one self-contained web page that replays the match (no network needed)",
+    )
 
     y = add("replay", "re-run one process against its recorded inputs and compare its outputs")
     y.add_argument("file", help="an MCAP file written by arena match --record (lockstep)")
@@ -803,7 +808,11 @@ def cmd_review(args: argparse.Namespace) -> int:
 
     if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
         raise ConfigError(f"--plots {args.plots} exists and is not a directory")
-    return review.main(args.file, plots=args.plots, as_json=args.json, goalkeepers=args.goalkeepers)
+    if args.html:
+        page = Path(args.html).expanduser()
+        if page.is_dir() or not page.parent.is_dir():
+            raise ConfigError(f"--html {args.html}: not a file in an existing directory")
+    return review.main(args.file, plots=args.plots, as_json=args.json, goalkeepers=args.goalkeepers, html=args.html)
 
 
 def cmd_facts(args: argparse.Namespace) -> int:

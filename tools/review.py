@@ -323,7 +323,9 @@ def _animate(worlds: list[World], cfg, path: Path, refs: list[Referee] | None = 
     return str(path)
 
 
-def main(path: str, plots: str | None = None, as_json: bool = False, goalkeepers: bool = False) -> int:
+def main(
+    path: str, plots: str | None = None, as_json: bool = False, goalkeepers: bool = False, html: str | None = None
+) -> int:
     try:
         rec = load(path, keep=NEEDED)
     except RecordingError as exc:
@@ -332,10 +334,20 @@ def main(path: str, plots: str | None = None, as_json: bool = False, goalkeepers
     review = analyse(rec)
     if plots:
         review["plots"] = write_plots(rec, review, plots, goalkeepers)
+    if html:
+        from arena.tools.replay_page import write_page
+
+        try:
+            review["html"] = write_page(rec, html)
+        except OSError as exc:
+            print(f"arena review: error: cannot write --html {html}: {exc.strerror}", file=sys.stderr)
+            return 2
     if as_json:
         print(json.dumps(review, indent=2))
     else:
         print_review(review)
         for p in review.get("plots", []):
             print(f"wrote {p}")
+        if "html" in review:
+            print(f"wrote {review['html']['path']} ({review['html']['bytes'] / 1e6:.2f} MB, open it in any browser)")
     return 0
