@@ -85,7 +85,10 @@ class ViewerNode(Node):
         self.world_in = tr.subscribe(keys.key("world"), latest=1)
         self.referee_in = tr.subscribe(keys.key("referee"), latest=RING)
         self.events_in = tr.subscribe(keys.key("events"), latest=RING)
-        self.report_in = {t: tr.subscribe(keys.key("report", t, None).replace("<n>", "*"), latest=64) for t in TEAMS}
+        # one subscription per key: the access control of a secure match allows no wildcard
+        self.report_in = {
+            (t, n): tr.subscribe(keys.key("report", t, n), latest=8) for t in TEAMS for n in range(cfg.robots)
+        }
         self.order_in = {t: tr.subscribe(keys.key("order", t, 0), latest=8) for t in TEAMS}
         self.control_put = tr.publisher(keys.control())
         # The engine asks for the viewer's state once before tick 0 (a pause set before
@@ -198,8 +201,8 @@ class ViewerNode(Node):
                 continue
             for b in self.builder.events_log(ev, self._ns(ev.tick)):
                 self.log_ch.base.log(b, self._ns(ev.tick))
-        for team in TEAMS:
-            while (raw := self.report_in[team].try_recv()) is not None:
+        for (team, _), channel in self.report_in.items():
+            while (raw := channel.try_recv()) is not None:
                 try:
                     r = self._dec_report(raw)
                 except (msgspec.DecodeError, msgspec.ValidationError):
@@ -209,6 +212,7 @@ class ViewerNode(Node):
                     self.seen[(team, r.robot)] = (r.ball.x, r.ball.y)
                 else:
                     self.seen.pop((team, r.robot), None)
+        for team in TEAMS:
             while (raw := self.order_in[team].try_recv()) is not None:
                 try:
                     o = self._dec_order(raw)

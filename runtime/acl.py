@@ -15,8 +15,10 @@ read-only `viewer`) gets a zenoh `access_control` policy, matched on its
 * its own liveliness token `alive/<p>`, and reading `alive/**` and the
   collector's token (the start barrier and dead-peer detection);
 * querying the engine's `config` queryable (the engine: serving it);
-* the viewer: reading `world`, `referee` and `field` only, and the live
-  viewer's `control` (pause, step, pace) to the engine.
+* the viewer: reading `world`, `referee`, `field`, `engine/events` and the
+  teams' `report`s and `order`s (the live viewer draws what each robot and
+  base station believes), and the live viewer's `control` (pause, step,
+  pace) to the engine.
 
 The router (hosted by `arena match` / `arena run router`) enforces it for
 every process, since in a secure match every process is a client of it

@@ -100,12 +100,19 @@ KEYS: tuple[KeySpec, ...] = (
         m.Report,
         "R_n_B",
         "robot/<team>/<n>",
-        "base station",
+        "base station, viewers",
         Timing("comm", 0),
         "wifi",
     ),
     KeySpec(
-        "order", "team/<team>/order/<n>", m.Order, "B_R_n", "basestation/<team>", "robot n", Timing("comm", 1), "wifi"
+        "order",
+        "team/<team>/order/<n>",
+        m.Order,
+        "B_R_n",
+        "basestation/<team>",
+        "robot n, viewers",
+        Timing("comm", 1),
+        "wifi",
     ),
     KeySpec(
         "referee",
@@ -117,7 +124,9 @@ KEYS: tuple[KeySpec, ...] = (
         Timing("referee", 0),
         "wired",
     ),
-    KeySpec("events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee", Timing("referee", -1), "wired"),
+    KeySpec(
+        "events", "engine/events", m.EngineEvents, "G_Re", "engine", "referee, viewers", Timing("referee", -1), "wired"
+    ),
     KeySpec(
         "world",
         "world",
@@ -145,7 +154,9 @@ KEYS: tuple[KeySpec, ...] = (
 KEY_BY_NAME = {k.name: k for k in KEYS}
 
 TEAM_NAMES = ("a", "b")
-VIEWER = "viewer"  # a read-only principal (world, referee, field), not a process of the match
+# A read-only principal: world, referee, field, and what the teams believe (reports, orders)
+# and the engine's ball events, which the live viewer draws (processes/viewer.py).
+VIEWER = "viewer"
 
 
 def process_names(robots: int, record: bool = True) -> list[str]:

@@ -32,7 +32,13 @@ def start_live(match: str, *flags: str):
     argv = [*ARENA, "match", "--home", "BS", "--away", "BS", "--live", str(port), "--external", "a/1"]
     argv += ["--match", match, "--listen", endpoint, "--json", *flags]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    robot_argv = [*ARENA, "run", "robot", "--match", match, "--connect", endpoint, "--team", "a", "--robot", "1"]
+    # The robot is started with the command the match prints (with its credentials in a secure match).
+    said = []
+    while not any("arena run robot" in line for line in said):
+        line = proc.stderr.readline()
+        assert line, "".join(said) + proc.stderr.read()
+        said.append(line)
+    robot_argv = [*ARENA, *next(x for x in said if "arena run robot" in x).split()[1:]]
     return proc, f"ws://127.0.0.1:{port}", lambda: subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL)
 
 
@@ -45,7 +51,8 @@ def finish(proc: subprocess.Popen, robot: subprocess.Popen | None) -> dict:
 
 
 def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command():
-    proc, url, start_robot = start_live("viewer-rt", "--realtime", "--half-time", "5")
+    # --secure: the viewer is the read-only `viewer` principal of the match's access control
+    proc, url, start_robot = start_live("viewer-rt", "--realtime", "--half-time", "5", "--secure")
     robot = None
     try:
         client = FoxgloveClient(url, timeout=60)
@@ -53,12 +60,13 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command()
         assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
         client.subscribe("/scene", "/referee_log", "/match")
         robot = start_robot()
-        full, referee_logs, last_match = 0, [], None
+        full, beliefs, referee_logs, last_match = 0, set(), [], None
         for topic, _, payload in client.messages(60):
             if topic == "/scene":
                 ids = set(scene_entities(payload))
                 if {"field", "ball", "score"} | ROBOTS <= ids:
                     full += 1
+                beliefs |= {i.split("/")[0] for i in ids if i.startswith(("seen/", "p_ball/"))}
             elif topic == "/referee_log":
                 entry = log_entry(payload)
                 if entry["name"] == "referee":
@@ -73,6 +81,7 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command()
                 p.kill()
     assert result["realtime"] and result["ticks"] == 500
     assert full >= 40, f"only {full} complete scene updates"
+    assert beliefs == {"seen", "p_ball"}, "the robots' perceived ball and the base stations' P_ball are drawn"
     commands = sum(result["events"].values())
     assert len(referee_logs) == commands, (referee_logs, result["events"])
     assert [m.split()[0] for m in referee_logs].count("KICKOFF") == result["events"]["KICKOFF"]
