@@ -33,10 +33,10 @@ import hmac
 import os
 from collections.abc import Callable
 
-TAG_BYTES = 16
-KEY_BYTES = 32
-# Keys whose frames are MAC'd by their sender (relative to arena/<match>/, see schemas/keys.py).
-SIGNED_DATA = ("engine/events", "referee", "world")
+from arena.schemas.keys import MAC_BYTES, MAC_KEY_BYTES
+
+TAG_BYTES = MAC_BYTES
+KEY_BYTES = MAC_KEY_BYTES
 
 
 def new_key() -> bytes:

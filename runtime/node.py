@@ -27,12 +27,12 @@ from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
 from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
-from arena.runtime.mac import SIGNED_DATA, Keyring
+from arena.runtime.mac import Keyring
 from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
-from arena.schemas.keys import KEY_BY_NAME, Keys
+from arena.schemas.keys import KEY_BY_NAME, SIGNED_DATA, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 

@@ -23,6 +23,9 @@ from arena.schemas.keys import (
     CONTROL,
     DEFAULT_PERIODS,
     KEYS,
+    MAC_BYTES,
+    MAC_KEY_BYTES,
+    SIGNED_DATA,
     SUMMARY,
     TAP,
     TAP_PERIOD,
@@ -186,6 +189,76 @@ def schedules(periods: dict[str, int] | None = None) -> str:
     return "\n".join(rows)
 
 
+SECURITY = f"""
+## Security
+
+Two walls (docs/architecture.md, "Security and faults"): message
+authentication, always on, and, in a secure match, zenoh's own user/password
+authentication, access control and TLS.
+
+**Credentials file.** `arena match` writes one file per principal,
+`<process with / as ->.json5` (`robot-b-1.json5`, `basestation-a.json5`,
+`referee.json5`, `engine.json5`, `viewer.json5`, ...), into `--credentials
+DIR` or the match's private temp dir, mode 0600. It is a zenoh configuration
+fragment in plain JSON (so valid JSON5): load it as your session's
+configuration (zenoh-c `zc_config_from_file`, zenoh-cpp `Config::from_file`,
+Rust `Config::from_file`) and add only the router's endpoint
+(`connect/endpoints`). `arena run ... --credentials FILE` does the same.
+
+```json5
+{{
+  "mode": "client",                      // secure match only: everything through the router
+  "transport": {{
+    "auth": {{"usrpwd": {{"user": "robot-b-1", "password": "..."}}}},      // secure match only
+    "link": {{"tls": {{"root_ca_certificate_base64": "...",             // secure match on TCP only
+                     "verify_name_on_connect": false}}}}
+  }},
+  "metadata": {{"arena": {{"match": "<match>", "process": "robot/b/1",
+                         "keys": {{"robot/b/1": "<{MAC_KEY_BYTES} bytes, hex>"}}}}}}
+}}
+```
+
+Without `--secure` the file holds `metadata` only: your zenoh settings are
+yours, the MAC key is what the file is for. `metadata` is free-form in zenoh's
+configuration and is never sent on the wire.
+
+**Secure match** (`arena match --secure`, the default when `--listen` is not
+a loopback address): the router refuses a session without a valid user and
+password at connect time; TCP endpoints become TLS (`tls/host:port`), with a
+CA made for this match alone (trust only `root_ca_certificate_base64`; it
+signs the router's certificate and nothing else, so host names are not
+checked). The router's access control is generated from the key table above,
+default deny: a principal may put only on the keys it sends, declare
+subscribers only on the keys it receives (the referee state is readable by
+all), plus its own `{ALIVE}/<process>` token, `{SUMMARY}/<process>`,
+`{TAP}/<process>`, `{ACK}/<process>` and reading `{ALIVE}/**`, `{COLLECTOR}` and
+`{CONFIG}`. A put or a subscription outside that is dropped silently by the
+router. `viewer` reads `world`, `referee` and `field`.
+
+**Message authentication** (every match, with or without `--secure`). The
+sender of `{SUMMARY}/<process>`, `{TAP}/<process>` and of
+{", ".join(f"`{k}`" for k in SIGNED_DATA)} puts, as the sample's zenoh
+**attachment**, a {MAC_BYTES}-byte MAC:
+
+    BLAKE2b(key = own key from metadata.arena.keys, digest_size = {MAC_BYTES},
+            data = <full key expression, UTF-8> 0x00 <payload>)
+
+e.g. key `00 01 02 ... 1f`, key expression `arena/m/summary/engine`, payload
+`81 a1 61 01`: MAC `d7c51f4829d4546d963595dcd996ee3f`. The payload, and so every
+digest and every recorded byte, is unchanged. A receiver that holds the
+sender's key (the collector and the recorder: every process's; the referee:
+the engine's; the engine: the referee's) drops a frame without a valid MAC
+and counts it as `forged`. The collector also accepts one Summary per process,
+only on that process's own key, and only if it is plausible (tick within the
+match, `sent` = sum of `sent_by_key`, `rejected` = sum of `rejected_reasons`);
+the match JSON lists what it refused under `forged_summaries`. The recorder
+writes a tap frame only if its key is one the batch's owner sends and its
+payload decodes as that key's type. A client of a match that announced a
+credentials file for it must MAC its Summary (and its tap batches, in a
+recorded match), or its Summary never counts.
+"""
+
+
 def render() -> str:
     lines = [HEADER.rstrip("\n").replace("{SCHEDULES}", schedules())]
     for k in KEYS:
@@ -215,6 +288,7 @@ def render() -> str:
             cons = _constraints(t)
             text = description + (f" ({cons})" if cons else "")
             lines.append(f"| `{f.name}` | {_type_name(t)} | {text} | {_default(f)} |")
+    lines.append(SECURITY.rstrip("\n"))
     lines.append("")
     return "\n".join(lines)
 

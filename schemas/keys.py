@@ -153,6 +153,12 @@ KEYS: tuple[KeySpec, ...] = (
 
 KEY_BY_NAME = {k.name: k for k in KEYS}
 
+# Data keys whose frames carry their sender's MAC in the zenoh attachment (runtime/mac.py),
+# besides every `summary/<p>` and `tap/<p>`; relative to arena/<match>/.
+SIGNED_DATA = ("engine/events", "referee", "world")
+MAC_BYTES = 16  # BLAKE2b digest size of a MAC
+MAC_KEY_BYTES = 32  # a process's MAC key
+
 TEAM_NAMES = ("a", "b")
 # A read-only principal: world, referee, field, and what the teams believe (reports, orders)
 # and the engine's ball events, which the live viewer draws (processes/viewer.py).
