@@ -38,7 +38,7 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Node
-from arena.schemas.messages import Control, EngineEvents, Order, Referee, Report, World
+from arena.schemas.messages import Control, EngineEvents, FieldSpec, Order, Referee, Report, World
 
 POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
 SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
@@ -83,6 +83,7 @@ class ViewerNode(Node):
         super().__init__(*args, **kwargs)
         cfg, keys, tr = self.cfg, self.keys, self.transport
         self.world_in = tr.subscribe(keys.key("world"), latest=1)
+        self.field_in = tr.subscribe(keys.key("field"), latest=1)  # drawn from the configuration; checked against it
         self.referee_in = tr.subscribe(keys.key("referee"), latest=RING)
         self.events_in = tr.subscribe(keys.key("events"), latest=RING)
         # one subscription per key: the access control of a secure match allows no wildcard
@@ -95,6 +96,7 @@ class ViewerNode(Node):
         # the start holds tick 0); every change after that is put on the same key.
         tr.serve(keys.control(), self._control_state)
         self._dec_world = msgspec.msgpack.Decoder(World).decode
+        self._dec_field = msgspec.msgpack.Decoder(FieldSpec).decode
         self._dec_ref = msgspec.msgpack.Decoder(Referee).decode
         self._dec_events = msgspec.msgpack.Decoder(EngineEvents).decode
         self._dec_report = msgspec.msgpack.Decoder(Report).decode
@@ -184,6 +186,16 @@ class ViewerNode(Node):
         if last is not None:
             self.world = self._dec_world(last)
             moved = True
+        if (raw := self.field_in.try_recv()) is not None:
+            try:
+                spec = self._dec_field(raw)
+                f = self.cfg.field
+                if (spec.length, spec.width, spec.goal_width) != (f.length, f.width, f.goal_width):
+                    self.rejections.reject(
+                        self.keys.key("field"), "invalid", "the field frame differs from the configuration"
+                    )
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self.rejections.reject(self.keys.key("field"), "malformed", str(exc)[:120])
         while (raw := self.referee_in.try_recv()) is not None:
             try:
                 ref = self._dec_ref(raw)
