@@ -373,6 +373,11 @@ def build_parser() -> Parser:
         help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
         "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
     )
+    t.add_argument(
+        "--ray-runtime-env",
+        metavar="JSON",
+        help='with --ray: a Ray runtime_env for the workers, e.g. \'{"pip": ["soccer-arena==0.1.0"]}\'',
+    )
     t.add_argument("--json", action="store_true", help="print one JSON object")
     t.add_argument("--engine", **ENGINE_FLAG)
 
@@ -768,10 +773,13 @@ def cmd_tournament(args: argparse.Namespace) -> int:
         cls, param, value = parse_override(text)
         overrides.setdefault(cls, {})[param] = value
     resolve(args.link, overrides)
-    if args.ray:
-        from arena.tools.cluster import parse_address
+    if args.ray is not None:
+        from arena.tools.cluster import parse_address, parse_runtime_env
 
         parse_address(args.ray)
+        parse_runtime_env(args.ray_runtime_env)
+    elif args.ray_runtime_env is not None:
+        raise ConfigError("--ray-runtime-env needs --ray")
     summary, interrupted = tournament.run(args)
     if args.json:
         print(json.dumps(summary, indent=2))

@@ -49,13 +49,28 @@ INSTALL_HINT = "--ray needs Ray: pip install 'soccer-arena[cluster]'"
 
 # ------------------------------------------------------------------ address
 def parse_address(text: str | None) -> str | None:
-    """None: start a local instance; "auto": the cluster on this node; "HOST:PORT": that head node."""
-    if text is None or text == "auto":
+    """None or "" (--ray alone): start a local instance; "auto": the cluster on this node; "HOST:PORT": that head."""
+    if not text:
+        return None
+    if text == "auto":
         return text
     host, sep, port = text.rpartition(":")
     if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise ConfigError(f"--ray {text!r}: give auto or HOST:PORT of a Ray head node (e.g. 10.0.0.5:6379)")
     return text
+
+
+def parse_runtime_env(text: str | None) -> dict | None:
+    """--ray-runtime-env: a JSON object, handed to ray.init as the job's runtime_env."""
+    if text is None:
+        return None
+    try:
+        env = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"--ray-runtime-env: not JSON ({exc.msg} at character {exc.pos})") from None
+    if not isinstance(env, dict):
+        raise ConfigError('--ray-runtime-env: give a JSON object, e.g. {"pip": ["soccer-arena==0.1.0"]}')
+    return env
 
 
 def probe(address: str, timeout: float = 5.0) -> None:
@@ -71,7 +86,7 @@ def probe(address: str, timeout: float = 5.0) -> None:
         ) from None
 
 
-def connect(address: str | None, local_cpus: float):
+def connect(address: str | None, local_cpus: float, runtime_env: dict | None = None):
     """ray.init for the driver; a one-line ConfigError on any failure."""
     try:
         import ray
@@ -80,6 +95,8 @@ def connect(address: str | None, local_cpus: float):
     if address not in (None, "auto"):
         probe(address)
     kw = {"logging_level": "ERROR", "log_to_driver": False, "include_dashboard": False}
+    if runtime_env is not None:
+        kw["runtime_env"] = runtime_env
     try:
         if address is None:
             ray.init(address="local", num_cpus=local_cpus, **kw)
@@ -213,8 +230,8 @@ def _play(args, runner, todo: list, on_result) -> bool:
 
     cpus = task_cpus(args)
     jobs = args.jobs or T.default_jobs()
-    address = parse_address(args.ray) if args.ray != "" else None
-    ray = connect(address, local_cpus=jobs * cpus)
+    address = parse_address(args.ray)
+    ray = connect(address, jobs * cpus, parse_runtime_env(getattr(args, "ray_runtime_env", None)))
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, T._interrupt)  # ray.init put in its own, which exits at once
     try:

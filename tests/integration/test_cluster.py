@@ -130,6 +130,14 @@ def test_worker_node_removed_mid_task(cluster, local_six, tmp_path, reap):
     assert "Traceback" not in stderr
 
 
+def test_ray_alone_starts_a_local_instance_and_stops_it(tmp_path):
+    args = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--engine", "inprocess")
+    summary = arena_json(*args, "--jobs", "1", "--ray", "--out", str(tmp_path / "ray"))
+    local = arena_json(*args, "--jobs", "1", "--out", str(tmp_path / "local"))
+    assert digests(summary) == digests(local) and len(digests(local)) == 1
+    assert "played on node" in (tmp_path / "ray" / "logs" / f"{summary['matches'][0]['id']}.log").read_text()
+
+
 def test_no_cluster_at_address_is_one_line_and_exit_2(tmp_path):
     import socket
 
@@ -147,8 +155,14 @@ def test_no_cluster_at_address_is_one_line_and_exit_2(tmp_path):
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and f"127.0.0.1:{port}" in lines[0] and "no Ray cluster" in lines[0], r.stderr
-    bad = subprocess.run([*ARENA, "tournament", "--ray", "nowhere"], capture_output=True, text=True, timeout=60)
-    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "HOST:PORT" in bad.stderr
+    for argv, says in (
+        (["--ray", "nowhere"], "HOST:PORT"),
+        (["--ray", "--ray-runtime-env", "{pip"], "not JSON"),
+        (["--ray", "--ray-runtime-env", "[1]"], "JSON object"),
+        (["--ray-runtime-env", "{}"], "needs --ray"),
+    ):
+        bad = subprocess.run([*ARENA, "tournament", *argv], capture_output=True, text=True, timeout=60)
+        assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and says in bad.stderr, bad.stderr
 
 
 def test_worker_with_another_version_refuses(cluster):
