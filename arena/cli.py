@@ -76,8 +76,7 @@ EXAMPLES = {
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
-  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench/navbench.toml)
-  arena bench mcap match.mcap --writer ours --runs 5      # us per message rewriting a recording (or --writer foxglove)""",
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench/navbench.toml)""",
     "review": """examples:
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
@@ -384,12 +383,10 @@ def build_parser() -> Parser:
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "mcap"],
+        choices=["match", "record", "robot", "nav"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
-        "nav: the navigators in their papers' scenarios; mcap: our MCAP writer or foxglove-sdk's on a recording",
+        "nav: the navigators in their papers' scenarios",
     )
-    b.add_argument("file", nargs="?", metavar="FILE.mcap", help="mcap: the recording whose messages are written")
-    b.add_argument("--writer", choices=["ours", "foxglove"], default="ours", help="mcap: which writer (ours)")
     b.add_argument("--strategy", default="advance-dynamic", metavar="NAME", help="robot: strategy to time (AD)")
     b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
     b.add_argument("--half-time", type=half_time, default=60.0, metavar="SECONDS", help="half length [s] (60)")
@@ -798,12 +795,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return bench.bench_record(args)
     if args.what == "robot":
         return bench.bench_robot(args)
-    if args.what == "mcap":
-        from arena.tools import mcapbench
-
-        if not args.file:
-            raise ConfigError("arena bench mcap needs FILE.mcap (a recording, e.g. from arena match --record)")
-        return mcapbench.main(args.file, writer=args.writer, repeat=args.runs, as_json=args.json)
     if args.what == "nav":
         from arena.tools import navbench
 

@@ -1,4 +1,5 @@
-"""MCAP recordings: the writer the recorder process uses (writer.py), the
-reader behind `arena review` and `arena replay` (reader.py), and the Foxglove
-scene built from the world stream (scene.py). May import `arena.runtime` and
-`arena.schemas`; imported by processes and tools."""
+"""MCAP recordings: the reader behind `arena review` and `arena replay`
+(reader.py), the Foxglove scene built from the world stream (scene.py), and
+the one analysis of the World/Referee streams (analysis/). The recorder
+process writes its file with foxglove-sdk's MCAP writer. May import
+`arena.runtime` and `arena.schemas`; imported by processes and tools."""

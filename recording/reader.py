@@ -21,12 +21,12 @@ from mcap.exceptions import InvalidMagic, McapError
 from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
-from arena.recording.writer import MAGIC  # the 8 bytes an MCAP file starts and ends with
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.schemas.messages import Summary
 
 # What a cut-off file can raise inside a record: short reads, a chunk that does
 # not decompress, a CRC that does not match.
+MAGIC = b"\x89MCAP0\r\n"  # the 8 bytes an MCAP file starts and ends with
 _CUT = (McapError, struct.error, ValueError, EOFError, zstandard.ZstdError)
 
 
