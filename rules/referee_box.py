@@ -40,10 +40,10 @@ from dataclasses import dataclass
 from arena.rules import setpieces as sp
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee
-from arena.schemas.vocabulary import REF_COMMANDS, STAGES, other_team
+from arena.schemas.vocabulary import REF_COMMANDS, SET_PIECES, STAGES, other_team
 
 MSL_COMMANDS = REF_COMMANDS  # arena.schemas.vocabulary.RefCommandName: the wire types check them on decode
-TEAM_COMMANDS = frozenset({"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "GOAL"})  # need a team
+TEAM_COMMANDS = (SET_PIECES - {"DROP_BALL"}) | {"GOAL"}  # need a team
 PLAYING_STAGES = frozenset({"FIRST_HALF", "SECOND_HALF"})
 _STAGE_COMMANDS = frozenset({"FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"})
 _KEEP_IN_FORCE = frozenset({"GOAL", "FIRST_HALF", "SECOND_HALF"})  # announced; the command in force stays

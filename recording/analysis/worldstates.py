@@ -26,6 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from arena.runtime.stats import percentile
 from arena.schemas.messages import World, Worldstate
 
 MATCH_RADIUS = 0.5  # [m] an obstacle within this of an opponent is a hit
@@ -34,12 +35,11 @@ MATCH_RADIUS = 0.5  # [m] an obstacle within this of an opponent is a hit
 def _stats(values: list[float]) -> dict[str, float]:
     if not values:
         return {"n": 0, "mean": 0.0, "p95": 0.0, "max": 0.0}
-    a = np.asarray(values, dtype=float)
     return {
         "n": len(values),
-        "mean": round(float(a.mean()), 4),
-        "p95": round(float(np.percentile(a, 95)), 4),
-        "max": round(float(a.max()), 4),
+        "mean": round(sum(values) / len(values), 4),
+        "p95": round(percentile(values, 95), 4),
+        "max": round(float(max(values)), 4),
     }
 
 
