@@ -51,6 +51,7 @@ EXAMPLES = {
       --credentials robot-a-1.json5
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
+  arena run router --match demo --listen tls/0.0.0.0:7447 --credentials creds/   # secure: writes creds/*.json5
   # a recorder on another machine (the match was started with --record ... --external recorder)
   arena run recorder --match demo --connect tcp/192.168.1.10:7447 --record out.mcap
   # watch a running match in Foxglove (ws://127.0.0.1:8765); pause/step need arena match --live
@@ -323,7 +324,8 @@ def build_parser() -> Parser:
         "--credentials",
         metavar="FILE",
         help="this process's credentials file from arena match (a zenoh config fragment: user, password, "
-        "TLS root, MAC key); a secure match needs it",
+        "TLS root, MAC key); a secure match needs it. router: make the match secure and write every "
+        "process's credentials file into this directory",
     )
     r.add_argument(
         "--startup-timeout", type=seconds, default=60.0, metavar="S", help="wait this long [s] for the match (60)"
@@ -698,14 +700,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         listen=(args.listen,) if args.listen else (),
     )
     if args.kind == "router":
-        return runner.main_guarded(runner.run_router, args.match, net)
+        return runner.main_guarded(runner.run_router, args.match, net, args.credentials)
     keyring = None
     try:
         pid = runner.process_id(args.kind, args.team, args.robot)
         if args.credentials:
             import dataclasses
 
-            base, mode, keyring = runner.load_credentials(args.credentials, pid, args.match)
+            base, mode, keyring = runner.load_credentials(args.credentials, pid, args.match, wait=10.0)
             net = dataclasses.replace(net, base=base, mode=mode or net.mode)
         cfg = None
         if args.config:

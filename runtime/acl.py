@@ -41,6 +41,9 @@ from arena.schemas.keys import (
     routes,
 )
 
+# The summary collector of a standalone router's match (`arena up`): not a process of the match.
+COLLECTOR_PRINCIPAL = "collector"
+
 
 def user_of(principal: str) -> str:
     """The zenoh user name (and credentials file stem) of a principal: `robot/b/1` -> `robot-b-1`."""
@@ -84,6 +87,10 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         perms["put/egress"] = [*reads, *control]
         perms["query/ingress"] = [*config, *control]
         perms["reply/egress"] = [*config, *control]
+    if principal == COLLECTOR_PRINCIPAL:
+        perms["declare_subscriber/ingress"] = perms["put/egress"] = [f"{prefix}{SUMMARY}/**", *reads]
+        perms["put/ingress"] = [f"{prefix}{ACK}/**"]
+        perms["liveliness_token/ingress"] = [f"{prefix}{COLLECTOR}"]
     if principal == VIEWER:
         perms["put/ingress"] = [*writes, *control]
         perms.update({"declare_queryable/ingress": control, "reply/ingress": control, "query/egress": control})

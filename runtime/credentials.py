@@ -40,7 +40,9 @@ import secrets
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from arena.runtime.acl import access_control, principals, user_of
+from arena.runtime.acl import COLLECTOR_PRINCIPAL, access_control, principals, user_of
+
+__all__ = ["COLLECTOR_PRINCIPAL", "Secrets", "load_fragment", "loopback_only", "make_tls", "secure_endpoint"]
 from arena.runtime.mac import Keyring, new_key
 
 OFFICIAL_VERIFIES = {"engine": ["referee"], "referee": ["engine"], "viewer": ["engine", "referee"]}
@@ -69,7 +71,7 @@ class Secrets:
         return s
 
     def keyring(self, principal: str) -> Keyring:
-        if principal in ("recorder", "launcher"):
+        if principal in ("recorder", "launcher", COLLECTOR_PRINCIPAL):
             verifies = list(self.mac_keys)
         else:
             verifies = [principal, *OFFICIAL_VERIFIES.get(principal, [])]
@@ -117,10 +119,35 @@ class Secrets:
         return items
 
 
+def loopback_only(endpoint: str | None) -> bool:
+    """True for a unix socket or a TCP/TLS/UDP/QUIC endpoint on a loopback address."""
+    if endpoint is None or endpoint.startswith("unixsock-stream/"):
+        return True
+    address = endpoint.split("/", 1)[-1].split("#", 1)[0]
+    host = address.rsplit(":", 1)[0].strip("[]")
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False  # a host name: assume it is reachable from elsewhere
+
+
+def secure_endpoint(endpoint: str) -> tuple[str, bool]:
+    """The endpoint a secure match listens on (tcp becomes tls) and whether it uses TLS."""
+    proto, _, rest = endpoint.partition("/")
+    if proto == "tcp":
+        return "tls/" + rest, True
+    return endpoint, proto in ("tls", "quic")
+
+
 def _write_private(path: Path, text: str) -> None:
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    """Mode 0600, and whole or not at all (a process may be waiting to read it)."""
+    part = path.with_name(path.name + ".part")
+    fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "w") as fh:
         fh.write(text)
+    os.replace(part, path)
 
 
 def load_fragment(path: str) -> dict:

@@ -233,7 +233,7 @@ subscribers only on the keys it receives (the referee state is readable by
 all), plus its own `{ALIVE}/<process>` token, `{SUMMARY}/<process>`,
 `{TAP}/<process>`, `{ACK}/<process>` and reading `{ALIVE}/**`, `{COLLECTOR}` and
 `{CONFIG}`. A put or a subscription outside that is dropped silently by the
-router. `viewer` reads `world`, `referee` and `field`.
+router. `viewer` is read-only: it may put nothing but the live `control`.
 
 **Message authentication** (every match, with or without `--secure`). The
 sender of `{SUMMARY}/<process>`, `{TAP}/<process>` and of

@@ -12,6 +12,7 @@ Then it supervises the services and prints the match result like `arena match`.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import re
 import shutil
@@ -23,10 +24,12 @@ from pathlib import Path
 import yaml
 
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
+from arena.runtime.credentials import COLLECTOR_PRINCIPAL
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.tools import launcher
+from arena.tools.run import load_credentials
 
 MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
 
@@ -113,6 +116,7 @@ def up(path: str, timeout: float = 600.0) -> dict:
         ARENA_MATCH=match,
         ARENA_LISTEN=f"unixsock-stream/{sock}",
         ARENA_CONNECT=f"unixsock-stream/{sock}",
+        ARENA_CREDENTIALS=str(tmp / "credentials"),
     )
     services = load_services(path, env)
     routers = [n for n, argv in services.items() if _process_of(argv) is None]
@@ -124,8 +128,9 @@ def up(path: str, timeout: float = 600.0) -> dict:
         router = routers[0]
         children.append(launcher.spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
         _wait_for_socket(sock, children[0])
-        with open_session(NetConfig(mode="client", connect=(env["ARENA_CONNECT"],))) as session:
-            transport = ZenohTransport(session)
+        net, keyring = _collector_net(env, router_argv=services[router], match=match)
+        with open_session(net) as session:
+            transport = ZenohTransport(session, keyring)
             keys = Keys(match)
             # The configuration (how many robots) comes from the engine later: listen for any.
             collector = launcher.open_collector(transport, keys, process_names(MAX_ROBOTS))
@@ -161,6 +166,7 @@ def up(path: str, timeout: float = 600.0) -> dict:
                 transport.close()
         result = launcher.assemble(cfg, got, time.monotonic() - t_start, children)
         result["services"] = list(services)
+        result["secure"] = "--credentials" in services[router]
         return result
     except ComposeError as exc:
         if exc.bad_input:
@@ -171,6 +177,20 @@ def up(path: str, timeout: float = 600.0) -> dict:
         launcher.stop_all(children)
         if not keep:
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _collector_net(env: dict[str, str], router_argv: list[str], match: str):
+    """How `arena up` joins as the summary collector: with the `collector` credentials when the
+    router service makes the match secure (`--credentials DIR`), else as a plain client."""
+    net = NetConfig(mode="client", connect=(env["ARENA_CONNECT"],))
+    if "--credentials" not in router_argv:
+        return net, None
+    path = str(Path(router_argv[router_argv.index("--credentials") + 1]) / f"{COLLECTOR_PRINCIPAL}.json5")
+    try:
+        base, _, keyring = load_credentials(path, COLLECTOR_PRINCIPAL, match, wait=30.0)
+    except ConfigError as exc:
+        raise ComposeError(f"the router service's credentials: {exc}") from None
+    return dataclasses.replace(net, base=base), keyring
 
 
 def _argv(argv: list[str]) -> list[str]:

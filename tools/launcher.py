@@ -15,7 +15,6 @@ import ctypes
 import functools
 import hashlib
 import importlib.util
-import ipaddress
 import os
 import shutil
 import signal
@@ -31,7 +30,7 @@ import msgspec
 import zenoh
 
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.credentials import Secrets
+from arena.runtime.credentials import Secrets, loopback_only, secure_endpoint
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
@@ -648,28 +647,6 @@ def instructions(
     if len(endpoints) > 1:
         lines.append(f"  (this machine is also reachable as: {', '.join(e.split('/', 1)[1] for e in endpoints[1:])})")
     return "\n".join(lines)
-
-
-def loopback_only(endpoint: str | None) -> bool:
-    """True for a unix socket or a TCP/TLS/UDP/QUIC endpoint on a loopback address."""
-    if endpoint is None or endpoint.startswith("unixsock-stream/"):
-        return True
-    address = endpoint.split("/", 1)[-1].split("#", 1)[0]
-    host = address.rsplit(":", 1)[0].strip("[]")
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False  # a host name: assume it is reachable from elsewhere
-
-
-def secure_endpoint(endpoint: str) -> tuple[str, bool]:
-    """The endpoint a secure match listens on (tcp becomes tls) and whether it uses TLS."""
-    proto, _, rest = endpoint.partition("/")
-    if proto == "tcp":
-        return "tls/" + rest, True
-    return endpoint, proto in ("tls", "quic")
 
 
 def play_match(

@@ -19,6 +19,7 @@ import os
 import signal
 import socket
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -27,12 +28,12 @@ import zenoh
 
 from arena.processes import node_class
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.credentials import load_fragment
+from arena.runtime.credentials import COLLECTOR_PRINCIPAL, Secrets, load_fragment, secure_endpoint
 from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys
+from arena.schemas.keys import Keys, process_names
 from arena.schemas.messages import Referee
 
 
@@ -56,8 +57,13 @@ def process_id(kind: str, team: str | None, robot: int | None) -> ProcessId:
     return ProcessId(kind)
 
 
-def load_credentials(path: str, pid: ProcessId, match: str) -> tuple[str, str | None, Keyring]:
-    """(fragment JSON, zenoh mode it asks for, keyring) from `--credentials FILE`, checked against who we are."""
+def load_credentials(path: str, pid: ProcessId | str, match: str, wait: float = 0.0) -> tuple[str, str | None, Keyring]:
+    """(fragment JSON, zenoh mode it asks for, keyring) from `--credentials FILE`, checked against who we are.
+
+    `wait`: the file may not be there yet (a router service writes it as it starts): wait this long."""
+    deadline = time.monotonic() + wait
+    while not Path(path).exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
     try:
         frag = load_fragment(path)
         arena = frag["metadata"]["arena"]
@@ -252,10 +258,33 @@ def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
     return f"match over at tick {ref.tick} ({ref.stage}): a ({cfg.home}) {ref.score_a} : {ref.score_b} b ({cfg.away})"
 
 
-def run_router(match: str, net: NetConfig) -> int:
+ROUTER_ROBOTS = 6  # a standalone router's credentials cover every robot a configuration may ask for
+
+
+def secure_router(match: str, net: NetConfig, directory: str) -> NetConfig:
+    """A secure match's router (`arena run router --credentials DIR`): every principal's credentials
+    file written into DIR, the router's passwords, access control and TLS certificate in its config."""
+    if len(net.listen) != 1:
+        raise ConfigError("arena run router --credentials needs one --listen endpoint")
+    endpoint, tls = secure_endpoint(net.listen[0])
+    names = [*process_names(ROUTER_ROBOTS), "refbox", COLLECTOR_PRINCIPAL]
+    secrets = Secrets.new(match, ROUTER_ROBOTS, names, secure=True, tls=tls)
+    try:
+        secrets.write(Path(directory))
+    except OSError as exc:
+        raise ConfigError(f"cannot write --credentials {directory}: {exc.strerror}") from None
+    private = Path(tempfile.mkdtemp(prefix="arena-router-"))  # the password dictionary stays ours
+    return NetConfig(
+        mode="router", listen=(endpoint,), connect=net.connect, extra=(*net.extra, *secrets.router_settings(private))
+    )
+
+
+def run_router(match: str, net: NetConfig, credentials: str | None = None) -> int:
     """A zenoh router for one match; exits when every process of the match has left."""
     signal.signal(signal.SIGTERM, _sigterm)
     keys = Keys(match)
+    if credentials:
+        net = secure_router(match, net, credentials)
     alive: set[str] = set()
     seen = [False]
 

@@ -194,3 +194,6 @@ def test_arena_up_runs_the_compose_file_as_local_processes():
     assert len({p["pid"] for p in r["processes"]}) == 10
     assert r["seed"] == 2 and r["half_time"] == 3.0 and r["link"] == "wifi"
     assert r["events"]["END_GAME"] == 1
+    # The router service writes the credentials (`--credentials`): every service is a zenoh user of a
+    # secure match, and `arena up` collects the summaries as the `collector` principal, MACs checked.
+    assert r["secure"] and r["rejected_reasons"] == {} and r["forged_summaries"] == {}

@@ -47,9 +47,11 @@ def test_team_b_never_reads_team_a_nor_the_world():
         assert not any("/a/" in k for k in writes) and "referee" not in writes, p
 
 
-def test_the_viewer_reads_world_referee_and_field_only():
-    reads = _rel(permissions("viewer", P, 3)["declare_subscriber/ingress"])
-    assert reads - {"ack/viewer"} == {"world", "referee", "field"}
+def test_the_viewer_reads_world_referee_and_field_and_writes_no_match_data():
+    perms = permissions("viewer", P, 3)
+    assert {"world", "referee", "field"} <= _rel(perms["declare_subscriber/ingress"])
+    # read-only: nothing of the match's data, only its own infrastructure keys and the live control
+    assert _rel(perms["put/ingress"]) == {"summary/viewer", "tap/viewer", "refused/viewer", "control"}
 
 
 def test_default_deny_and_one_policy_per_principal():
