@@ -2,6 +2,9 @@
 
 `KEYS` is the single table the wire contract (schemas/README.md), the
 recorder and the process wiring are derived from.
+
+Over 150 lines for one reason: every key expression of the wire is built
+here and nowhere else (the table, the infrastructure keys, the builders).
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from arena.schemas import messages as m
+from arena.schemas.vocabulary import TEAMS
 
 ROOT = "arena"
 _MATCH_ID = re.compile(r"^[A-Za-z0-9_.-]{1,64}$")
@@ -159,7 +163,6 @@ SIGNED_DATA = ("engine/events", "referee", "world")
 MAC_BYTES = 16  # BLAKE2b digest size of a MAC
 MAC_KEY_BYTES = 32  # a process's MAC key
 
-TEAM_NAMES = ("a", "b")
 # A read-only principal: world, referee, field, and what the teams believe (reports, orders)
 # and the engine's ball events, which the live viewer draws (processes/viewer.py).
 VIEWER = "viewer"
@@ -167,8 +170,8 @@ VIEWER = "viewer"
 
 def process_names(robots: int, record: bool = True) -> list[str]:
     """Every process of a match with `robots` per team, in `MatchConfig.processes()` order."""
-    names = ["engine", "referee"] + [f"basestation/{t}" for t in TEAM_NAMES]
-    names += [f"robot/{t}/{n}" for t in TEAM_NAMES for n in range(robots)]
+    names = ["engine", "referee"] + [f"basestation/{t}" for t in TEAMS]
+    names += [f"robot/{t}/{n}" for t in TEAMS for n in range(robots)]
     return names + (["recorder"] if record else [])
 
 
@@ -182,7 +185,7 @@ def _who(role: str, team: str, n: int) -> list[str]:
     if role == "base station":
         return [f"basestation/{team}"]
     if role == "base stations":
-        return [f"basestation/{t}" for t in TEAM_NAMES]
+        return [f"basestation/{t}" for t in TEAMS]
     if role == "viewers":
         return [VIEWER]
     if role in ("engine", "referee", "recorder", "refbox"):
@@ -200,7 +203,7 @@ def routes(robots: int) -> list[tuple[str, str, tuple[str, ...]]]:
     everyone = process_names(robots) + [VIEWER]
     out = []
     for spec in KEYS:
-        teams = TEAM_NAMES if "<team>" in spec.pattern else ("",)
+        teams = TEAMS if "<team>" in spec.pattern else ("",)
         numbers = range(robots) if "<n>" in spec.pattern else (0,)
         for team in teams:
             for n in numbers:

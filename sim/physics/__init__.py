@@ -15,8 +15,8 @@ One `Physics` per match, assembled from one module per concern:
 * `possession.py`: the dribbler's capture, hold, challenges and losses;
 * `events.py`: touches, line crossings, goals, no progress and fouls, and
   play on or off;
-* `state.py`: robot placement, kick-off positions and the reads (poses,
-  `World`);
+* `placement.py`: robot placement, parking and kick-off positions;
+* `state.py`: the reads (poses, `World`);
 * `bodies.py`: the constants and the per-robot record.
 
 Nothing here is random or reads a clock: equal inputs give equal outputs.

@@ -33,12 +33,13 @@ from arena.sim.physics.bodies import (
     RobotBody,
 )
 from arena.sim.physics.events import Events
+from arena.sim.physics.placement import Placement
 from arena.sim.physics.possession import Possession
 from arena.sim.physics.state import State
 from arena.sim.physics.world import WorldBuilding
 
 
-class Physics(WorldBuilding, BallFlight, Possession, Events, State):
+class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
     """The pymunk world of one match; see the package docstring for the model.
 
     Attributes set by the engine: `attack_dir_a` (+1: team a attacks the +x
