@@ -51,3 +51,16 @@ def test_imports_never_point_up():
                 if RANK[dep] >= rank:
                     bad.append(f"{path.relative_to(ROOT)} imports arena.{dep} (rank {RANK[dep]} >= {rank})")
     assert not bad, "\n".join(bad)
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists every package of the tree, so a non-editable install has them all."""
+    import tomllib
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = set()
+    for pkg in RANK:
+        for init in (ROOT / pkg).rglob("__init__.py"):
+            rel = init.parent.relative_to(ROOT / pkg).parts
+            found.add(".".join(("arena",) if pkg == "arena" else ("arena", pkg, *rel)))
+    assert found <= listed, f"not in pyproject.toml packages: {sorted(found - listed)}"
