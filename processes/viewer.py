@@ -26,6 +26,7 @@ runs at a lower CPU priority. So the same loop (`watch`) serves lockstep and
 
 from __future__ import annotations
 
+import functools
 import os
 import threading
 import time
@@ -79,13 +80,19 @@ class _Listener(ServerListener):
 
 
 class ViewerNode(Node):
+    def _owned(self, name: str, sender: str) -> dict:
+        """Only the owner's frames (their MAC, runtime/mac.py), when this viewer holds the owner's key."""
+        key = self.keys.key(name)
+        verify = self.keyring.verifier(sender, key)
+        return {"verify": verify, "on_forged": functools.partial(self.rejections.reject, key, "forged", sender)}
+
     def __init__(self, *args, host: str = "127.0.0.1", attached: bool = False, **kwargs):
         super().__init__(*args, **kwargs)
         cfg, keys, tr = self.cfg, self.keys, self.transport
-        self.world_in = tr.subscribe(keys.key("world"), latest=1)
+        self.world_in = tr.subscribe(keys.key("world"), latest=1, **self._owned("world", "engine"))
         self.field_in = tr.subscribe(keys.key("field"), latest=1)  # drawn from the configuration; checked against it
-        self.referee_in = tr.subscribe(keys.key("referee"), latest=RING)
-        self.events_in = tr.subscribe(keys.key("events"), latest=RING)
+        self.referee_in = tr.subscribe(keys.key("referee"), latest=RING, **self._owned("referee", "referee"))
+        self.events_in = tr.subscribe(keys.key("events"), latest=RING, **self._owned("events", "engine"))
         # one subscription per key: the access control of a secure match allows no wildcard
         self.report_in = {
             (t, n): tr.subscribe(keys.key("report", t, n), latest=8) for t in TEAMS for n in range(cfg.robots)
