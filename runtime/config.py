@@ -308,6 +308,8 @@ class MatchConfig:
                 "--via-refbox needs --realtime: the RefBox protocol carries no tick, so a command read from "
                 "TCP cannot be given the lockstep tick it belongs to (docs/refbox.md)"
             )
+        if rb.via and rb.listen.rsplit(":", 1)[-1] == "0":
+            raise ConfigError("--via-refbox needs a fixed --refbox port (our base stations connect to it), not 0")
         if not -1 <= self.live <= 65535:
             raise ConfigError(f"--live port must be in 0..65535, got {self.live}")
         if not (math.isfinite(self.pace) and 0.0 <= self.pace <= 1000.0):

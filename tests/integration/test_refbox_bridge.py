@@ -230,7 +230,7 @@ def test_via_refbox_our_base_stations_through_the_bridge(tmp_path):
 
 def test_via_refbox_is_refused_in_lockstep():
     r = subprocess.run(
-        [*ARENA, "match", "--home", "BS", "--away", "BS", "--refbox", "--via-refbox"],
+        [*ARENA, "match", "--home", "BS", "--away", "BS", "--refbox", "tcp/127.0.0.1:0", "--via-refbox"],
         capture_output=True,
         text=True,
         timeout=60,

@@ -156,9 +156,10 @@ def test_endpoints():
         (["--refbox-protocol", "c=json"], "use a=json"),
         (["--refbox-targets", "same,same"], "two different strings"),
         (["--refbox-wait", "1"], "--refbox-wait needs --refbox"),
-        (["--refbox", "--via-refbox"], "--via-refbox needs --realtime"),
+        (["--refbox", "tcp/127.0.0.1:0", "--via-refbox"], "--via-refbox needs --realtime"),  # 28097 may be busy
         (["--via-refbox", "--realtime"], "--via-refbox needs the bridge"),
         (["--refbox-follow", "host:port"], "is not a number"),
+        (["--refbox", "tcp/127.0.0.1:0", "--via-refbox", "--realtime"], "needs a fixed --refbox port"),
     ],
 )
 def test_bad_refbox_flags_are_one_line_and_exit_2(flags, message, capsys):
