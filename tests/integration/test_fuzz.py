@@ -1,0 +1,226 @@
+"""Property-based fuzzing of every data key of a real match (issue 15, item 5).
+
+Hypothesis draws (key, payload) pairs for every key pattern: random bytes,
+truncated msgpack, wrong types, NaN and inf, huge arrays, 1 MB payloads, wrong
+ticks and wrong team names. Every payload that decodes carries a tick no
+receiver can ever expect (past the match's last tick, or negative), so nothing
+well-formed is injected: the match must play exactly as the unfuzzed one (the
+golden digests, tests/golden/digests.json), no process may crash or hang, and
+every payload must be counted by every process subscribed to its key.
+
+How the count is made exact: robot a/0 is left `--external`, so every other
+process has subscribed and wait at the start barrier while the
+payloads go in (a subscribed process counts what it gets, barrier or not);
+then a/0 is started and the match plays. The keys only a/0 receives are not
+fuzzed (nobody would count them). Hypothesis builds the payloads by hand, not
+with `st.from_type` on the message types (../shared/notes-foxglove-refbox-ray.md).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import subprocess
+import time
+from pathlib import Path
+
+import msgspec
+import pytest
+import zenoh
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+
+from arena.runtime.session import NetConfig, open_session
+from arena.schemas import messages as m
+from tests.integration.helpers import ARENA, spawn, wait_for
+
+GOLDEN = json.loads((Path(__file__).resolve().parents[1] / "golden" / "digests.json").read_text())[0]
+CFG = GOLDEN["config"]  # seed 100, basic-static v basic-dynamic, 2 robots, ideal, 2 x 4 s
+TOTAL = int(2 * CFG["half_time"] / 0.02)
+TEAMS = ("a", "b")
+ROBOTS = range(CFG["robots"])
+
+# The key patterns, their message type, and how many of the waiting processes receive each key.
+TARGETS: list[tuple[str, type, int]] = (
+    [(f"robot/{t}/{n}/sense", m.Sense, 1) for t in TEAMS for n in ROBOTS if (t, n) != ("a", 0)]
+    + [(f"robot/{t}/{n}/cmd", m.Cmd, 1) for t in TEAMS for n in ROBOTS]
+    + [(f"team/{t}/report/{n}", m.Report, 1) for t in TEAMS for n in ROBOTS]
+    + [(f"team/{t}/order/{n}", m.Order, 1) for t in TEAMS for n in ROBOTS if (t, n) != ("a", 0)]
+    + [
+        ("referee", m.Referee, 3),
+        ("engine/events", m.EngineEvents, 1),
+        ("world", m.World, 0),
+        ("field", m.FieldSpec, 0),
+    ]
+)
+
+POSE = {"x": 0.5, "y": -0.5, "theta": 0.1}
+SHAPES = {  # a valid map of each type but for its tick
+    m.Sense: {"pose": POSE, "robots": [{"team": "b", "x": 1.0, "y": 1.0}], "ball": {"visible": True, "x": 0.0}},
+    m.Cmd: {"vx": 1.0, "vy": 0.0, "omega": 0.5, "wheels": [], "kick_speed": 0.0},
+    m.Report: {"robot": 1, "pose": POSE, "robots": [{"team": "a", "x": 1.0, "y": 2.0}]},
+    m.Order: {"robot": 1, "own": [{"robot": 1, "x": 0.0, "y": 0.0}], "ball_x": 0.0, "command": "START"},
+    m.Referee: {"stage": "FIRST_HALF", "command": "START", "commands": [{"name": "START", "team": ""}]},
+    m.EngineEvents: {"events": [{"kind": "TOUCH", "tick": 3, "team": "a", "robot": 1, "x": 0.0, "y": 0.0}]},
+    m.World: {"t": 0.0, "ball_x": 0.0, "ball_y": 0.0, "robots": [{"team": "a", "robot": 0, "x": 0.0, "y": 0.0, "theta": 0.0}]},
+    m.FieldSpec: {"length": 12.0, "width": 8.0, "runoff": 1.0, "goal_width": 2.0, "goal_height": 1.0,
+                  "goal_depth": 0.5, "center_circle_radius": 1.0, "penalty_area_depth": 1.0,
+                  "penalty_area_width": 4.0, "goal_area_depth": 0.5, "goal_area_width": 3.0,
+                  "penalty_mark_distance": 2.0, "robots_per_team": 2, "dt": 0.02, "total_ticks": TOTAL},
+}  # fmt: skip
+for _type, _shape in SHAPES.items():  # decode our own encodings (the notes' advice): each shape is valid
+    msgspec.msgpack.decode(msgspec.msgpack.encode({"tick": 1, **_shape}), type=_type)
+
+bad_tick = st.one_of(st.integers(TOTAL + 1, 2**64 - 1), st.integers(-(2**63), -1))
+wrong_value = st.one_of(
+    st.text(max_size=6),
+    st.none(),
+    st.booleans(),
+    st.lists(st.integers(-(2**63), 2**64 - 1), max_size=3),
+    st.binary(max_size=4),
+)
+non_finite = st.sampled_from([math.nan, math.inf, -math.inf])
+
+
+def _set_deep(value, path: list, new):
+    """`value` (a map) with the float/str at `path` replaced."""
+    value = json.loads(json.dumps(value))
+    at = value
+    for p in path[:-1]:
+        at = at[p]
+    at[path[-1]] = new
+    return value
+
+
+def _leaves(value, kind, path=()):
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from _leaves(v, kind, (*path, k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from _leaves(v, kind, (*path, i))
+    elif isinstance(value, kind) and not isinstance(value, bool):
+        yield list(path)
+
+
+def payloads(msg_type: type, huge: bool) -> st.SearchStrategy[bytes]:
+    shape = SHAPES[msg_type]
+    enc = msgspec.msgpack.encode
+    floats = list(_leaves(shape, float))
+    teams = [p for p in _leaves(shape, str) if p[-1] == "team"]
+    valid = bad_tick.map(lambda t: {"tick": t, **shape})
+    small = st.one_of(
+        st.binary(max_size=300),  # random bytes
+        st.tuples(bad_tick, st.integers(0, 10_000)).map(  # truncated msgpack
+            lambda ti: (b := enc({"tick": ti[0], **shape}))[: ti[1] % max(1, len(b))]
+        ),
+        st.tuples(valid, st.sampled_from(["tick", *shape]), wrong_value).map(  # a field of the wrong type
+            lambda v: enc({**v[0], v[1]: v[2]})
+        ),
+        st.tuples(valid, st.sampled_from(floats or [["tick"]]), non_finite).map(  # NaN and inf
+            lambda v: enc(_set_deep(v[0], v[1], v[2]))
+        ),
+        st.tuples(valid, st.sampled_from(teams or [["tick"]]), st.sampled_from(["c", "", "A", "ab", "é"])).map(
+            lambda v: enc(_set_deep(v[0], v[1], v[2]))  # wrong team names
+        ),
+        valid.map(enc),  # a whole, valid frame at a tick nobody expects
+        st.tuples(valid, st.dictionaries(st.text(max_size=5), wrong_value, max_size=4)).map(  # unknown fields
+            lambda v: enc({**v[1], **v[0]})
+        ),
+    )
+    big = st.one_of(
+        st.integers(0, 2**32).map(lambda seed: random.Random(seed).randbytes(1 << 20)),  # 1 MB of noise
+        valid.map(lambda v: enc({**v, "pad": "x" * (1 << 20)})),  # 1 MB that decodes
+        st.tuples(valid, st.integers(10_000, 60_000)).map(  # huge arrays
+            lambda v: enc({**v[0], "robots": [{"team": "a", "x": 0.0, "y": 0.0}] * v[1], "events": [{}] * v[1]})
+        ),
+    )
+    return big if huge else small
+
+
+def frames(huge: bool) -> st.SearchStrategy[tuple[str, int, bytes]]:
+    return st.sampled_from(TARGETS).flatmap(lambda t: payloads(t[1], huge).map(lambda p: (t[0], t[2], p)))
+
+
+def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
+    match_id = f"fuzz{n}"
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn("match", "--home", CFG["home"], "--away", CFG["away"], "--robots", str(CFG["robots"]),
+                 "--half-time", str(CFG["half_time"]), "--seed", str(CFG["seed"]), "--link", CFG["link"],
+                 "--external", "a/0", "--match", match_id, "--listen", endpoint, "--json")  # fmt: skip
+    reap.append(proc)
+    # The launcher prints the command that starts a/0 (with its credentials): start it exactly so, later.
+    line = ""
+    while not line.strip().startswith("arena run robot"):
+        line = wait_for(lambda: proc.stderr.readline(), 60, "the launcher's instructions")
+    command = line.split()
+    expected = {"count": 0, "frames": 0, "bytes": 0}  # the small payloads
+    huge = {"count": 0, "frames": 0, "bytes": 0}  # then 1 MB payloads and huge arrays
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        alive: set[str] = set()
+        sub = session.liveliness().declare_subscriber(
+            f"arena/{match_id}/alive/**", lambda s: alive.add(str(s.key_expr).split("/alive/")[1]), history=True
+        )
+        others = 2 * CFG["robots"] + 3  # engine, referee, two base stations, the robots but a/0
+        wait_for(lambda: len(alive) >= others, 120, "every other process at its start barrier")
+        sub.undeclare()
+        pubs = {
+            key: session.declare_publisher(
+                f"arena/{match_id}/{key}",
+                congestion_control=zenoh.CongestionControl.BLOCK,
+                reliability=zenoh.Reliability.RELIABLE,
+            )
+            for key, _, _ in TARGETS
+        }
+
+        def inject(n: int, huge: bool, into: dict) -> None:
+            @settings(max_examples=n, deadline=None, database=None, derandomize=True, phases=[Phase.generate],
+                      suppress_health_check=list(HealthCheck))  # fmt: skip
+            @given(frames(huge))
+            def put(frame):
+                key, receivers, payload = frame
+                pubs[key].put(payload)
+                into["count"] += receivers
+                into["frames"] += 1
+                into["bytes"] += len(payload) * receivers
+
+            put()
+            # Every payload must reach its subscribers before the match starts: a 1 MB frame goes through
+            # the router to up to three processes, each decoding it on its one network thread.
+            time.sleep(1.0 + into["bytes"] / 10e6)
+
+        inject(n, False, expected)
+        if n_huge:
+            inject(n_huge, True, huge)
+        robot = subprocess.Popen([*ARENA, *command[1:]], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        reap.append(robot)
+        out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err
+    result = json.loads(out)
+    assert expected["frames"] >= n * 0.9, expected  # hypothesis may stop a little short of max_examples
+    assert result["outcome"] == "completed", (result["faults"], result["outcome_reasons"])
+    assert result["dead"] == [] and result["ticks"] == TOTAL
+    # Every small payload is counted. Of the megabyte ones, a few (0-3 % in our runs, varying from run
+    # to run) never reached a subscriber while the router forwarded ~100 MB: lost in transit, not by a
+    # process (unexplained yet; docs/architecture.md, "Faults").
+    rejected = result["rejected"]
+    assert expected["count"] + 0.9 * huge["count"] <= rejected <= expected["count"] + huge["count"], (
+        result["rejected_reasons"],
+        expected,
+        huge,
+    )
+    assert "conflict" not in result["rejected_reasons"] and "invalid" not in result["rejected_reasons"]
+    assert result["process_digests"] == GOLDEN["digests"], "nothing well-formed went in: the match is unchanged"
+
+
+def test_fuzzing_every_key_with_1000_payloads_changes_nothing_and_counts_everything(tmp_path, reap):
+    """The default suite's share: 1,000 payloads of every kind but the megabyte ones (those are -m slow)."""
+    fuzz_a_match(tmp_path, reap, 1000, 0)
+
+
+@pytest.mark.slow
+def test_fuzzing_every_key_with_10000_payloads_changes_nothing_and_counts_everything(tmp_path, reap):
+    """10,000 payloads, then 100 of 1 MB (noise, or decodable with padding) and huge arrays."""
+    fuzz_a_match(tmp_path, reap, 10_000, 100)
