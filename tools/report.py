@@ -46,6 +46,15 @@ def print_match(result: dict, console: Console | None = None) -> None:
         console.print(f"[yellow]rejected inputs: {result['rejected']} {result['rejected_reasons']}[/]")
     if result["dead"]:
         console.print(f"[red]treated as dead: {', '.join(result['dead'])}[/]")
+    rb = result.get("refbox")
+    if rb:
+        c = rb["counts"]
+        errors = {t: sum(e.values()) for t, e in rb["worldstate_errors"].items()}
+        console.print(
+            f"refbox (tcp port {rb['port']}): {c.get('connections', 0)} base station(s), {c.get('refused', 0)} refused, "
+            f"{rb['commands_forwarded']} commands forwarded; worldstates a {c.get('worldstates_a', 0)} "
+            f"({errors.get('a', 0)} bad), b {c.get('worldstates_b', 0)} ({errors.get('b', 0)} bad)"
+        )
     rec = result.get("recording")
     if rec:
         state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"
