@@ -27,6 +27,7 @@ runs at a lower CPU priority. So the same loop (`watch`) serves lockstep and
 from __future__ import annotations
 
 import functools
+import json
 import os
 import threading
 import time
@@ -39,8 +40,10 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Node
+from arena.schemas.keys import Keys
 from arena.schemas.messages import Control, EngineEvents, FieldSpec, Order, Referee, Report, World
 
+MAX_ROBOTS = 6  # [-] per team, MatchConfig's bound: the session is configured before the match's count is known
 POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
 SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
 REPEAT_S = 0.5  # [s] wall: a match standing still (paused, starting) has its last scene sent again this often
@@ -64,6 +67,27 @@ MATCH_SCHEMA = {
         )
     },
 }
+
+
+BELIEF_HZ = 20.0  # [Hz] wall: report and order frames let in per key (zenoh ingress downsampling)
+
+
+def downsampling(keys: Keys) -> str:
+    """zenoh `downsampling` config (JSON) for the viewer's own session.
+
+    An unpaced match sends 10 Hz x its speed reports and orders per robot (a
+    few thousand a second); the viewer draws the beliefs at most `SCENE_HZ`
+    times a second. zenoh drops the surplus as it comes in, one rate per
+    concrete key, before any Python runs. Never `world` (downsampling drops
+    the newest frame too, and a paused or stepped match must show the tick it
+    holds: the ring of one keeps the newest instead), nor the referee's or the
+    engine's events: every command is logged.
+    """
+    rules = []
+    for team in TEAMS:
+        rules.append({"key_expr": keys.key("order", team, 0), "freq": BELIEF_HZ})
+        rules += [{"key_expr": keys.key("report", team, n), "freq": BELIEF_HZ} for n in range(MAX_ROBOTS)]
+    return json.dumps([{"flows": ["ingress"], "messages": ["put"], "rules": rules}])
 
 
 class _Listener(ServerListener):
