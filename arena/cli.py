@@ -75,6 +75,7 @@ EXAMPLES = {
   arena bench match --runs 5 --half-time 120 --link wifi
   arena bench record               # median rtf with and without --record, and the ratio
   arena bench robot                # median us per robot control step and per F-SFM step
+  arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench/navbench.toml)""",
@@ -385,11 +386,14 @@ def build_parser() -> Parser:
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav"],
+        choices=["match", "record", "robot", "nav", "throughput"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
-        "nav: the navigators in their papers' scenarios",
+        "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
+        "side by side",
     )
-    b.add_argument("--strategy", default="advance-dynamic", metavar="NAME", help="robot: strategy to time (AD)")
+    b.add_argument(
+        "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
+    )
     b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
     b.add_argument("--half-time", type=half_time, default=60.0, metavar="SECONDS", help="half length [s] (60)")
     b.add_argument("--robots", type=int, default=3, metavar="N")
@@ -797,6 +801,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return bench.bench_record(args)
     if args.what == "robot":
         return bench.bench_robot(args)
+    if args.what == "throughput":
+        from arena.tools import throughput
+
+        return throughput.bench_throughput(args)
     if args.what == "nav":
         from arena.tools import navbench
 

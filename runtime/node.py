@@ -81,6 +81,7 @@ class Node:
         self._work_s: list[float] = []  # wall seconds of own work per tick (perf statistics only)
         self.last_tick = 0
         self._wall_s = 0.0
+        self.play_started = 0.0  # [s] Unix time of the start of the loop (start-up measurement only)
         self._collector = False
         # Called with the peers still missing, once a wait at the start barrier
         # passes 1 s and whenever that list changes (`arena run` by hand prints it).
@@ -257,6 +258,7 @@ class Node:
         try:
             self.barrier()
             settle_heap()
+            self.play_started = time.time()
             t0 = time.perf_counter()
             self.loop()
             self._wall_s = time.perf_counter() - t0
@@ -331,7 +333,7 @@ class Node:
             tick_us=tick_us,
             wall_s=self._wall_s,
             cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
-            extra=self.summary_extra(),
+            extra={**self.summary_extra(), "play_started": self.play_started},
             sent_by_key={o.rel.decode(): o.sent for o in self.outbound},
             conflicts={self.keys.rel(k): n for k, n in sorted(self.rejections.conflicts.items())},
             dead_at=dict(sorted(self.dead_at.items())),

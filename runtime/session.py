@@ -131,9 +131,14 @@ ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),
 # behind design choices").
 CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1),net:(handover:rx),app:(handover:rx))"
 
+# Whether this process has opened a zenoh session: zenoh's runtime threads then
+# exist, and a fork of this process would not have them (tools/forkstart.py).
+OPENED = [False]
+
 
 def open_session(net: NetConfig) -> zenoh.Session:
     """Open a zenoh session; use as `with open_session(net) as session:`."""
+    OPENED[0] = True
     if os.environ.get("ZENOH_RUNTIME") in (None, ONE_THREAD_RUNTIME, CLIENT_RUNTIME):
         # Ours, not the user's (children inherit the launcher's environment): choose per mode.
         relays = net.mode == "client" or any(path == "access_control" for path, _ in net.extra)

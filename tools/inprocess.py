@@ -52,6 +52,7 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     }
     recorder = nodes.pop("recorder", None)
     settle_heap()
+    started = time.time()
     t0 = time.perf_counter()
     tasks = [Task(name, node.lockstep()) for name, node in nodes.items()]
     try:
@@ -67,6 +68,7 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     for task in tasks:
         node = nodes[task.name]
         node._wall_s = play
+        node.play_started = started
         s = node.conclude()
         summaries[task.name] = msgspec.structs.replace(s, cpu_s=[round(task.busy_s, 3), 0.0])
     if recorder is not None:
@@ -111,10 +113,14 @@ def play_match(cfg: MatchConfig, record: str = "") -> dict:
     if others:
         raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
     t_start = time.monotonic()
+    launched = time.time()
     summaries, _, play, deadlocks = _play(cfg, watch=(), record=record)
     got = Collected(summaries=summaries, started=0.0, ended=play)
     result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, [], record=record)
     result["engine"] = ENGINE
+    result["startup_seconds"] = round(summaries["engine"].extra["play_started"] - launched, 3)
+    result["launch"] = ENGINE
+    result["play_started_unix"] = summaries["engine"].extra["play_started"]
     result["pid"] = os.getpid()
     result["deadlocks"] = deadlocks
     return result

@@ -36,6 +36,7 @@ from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Referee, Summary
+from arena.tools import forkstart
 from arena.tools.faults import VOIDING, exit_reason
 from arena.tools.faults import outcome as match_outcome
 
@@ -649,6 +650,13 @@ def instructions(
     return "\n".join(lines)
 
 
+def startup_seconds(summaries: dict[str, Summary], launched: float) -> float | None:
+    """Launch (`play_match` called) to the engine's first tick, from the engine's Summary."""
+    engine = summaries.get("engine")
+    started = engine.extra.get("play_started", 0.0) if engine is not None else 0.0
+    return round(started - launched, 3) if started else None
+
+
 def play_match(
     cfg: MatchConfig,
     *,
@@ -677,6 +685,7 @@ def play_match(
     match that cannot start.
     """
     t_start = time.monotonic()
+    launched = time.time()
     compile_sources()
     cfg = cfg.replace(tap=bool(record))
     match = match or new_match_id(cfg.seed)
@@ -698,12 +707,25 @@ def play_match(
     router_extra = tuple(secrets.router_settings(tmp)) if secure else ()
     children: list[Child] = []
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
+    external = {ProcessId.parse(e) for e in cfg.external}
+    starter = None
     try:
+        # Fork the processes before any zenoh session exists here (tools/forkstart.py);
+        # they open theirs once the router is up.
+        if forkstart.enabled():
+            local = [p for p in cfg.processes() if p not in external]
+            forkstart.preload({p.kind for p in local}, {cfg.home, cfg.away})
+            starter = forkstart.Starter()
+            for p in local:
+                argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
+                log_path = logs / (str(p).replace("/", "_") + ".log")
+                children.append(Child(str(p), p, starter.fork(argv[3:], log_path), log_path))  # type: ignore[arg-type]
         with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
-            external = {ProcessId.parse(e) for e in cfg.external}
-            for p in cfg.processes():
+            if starter is not None:
+                starter.release()
+            for p in cfg.processes() if starter is None else ():
                 if p in external:
                     continue
                 argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
@@ -739,6 +761,10 @@ def play_match(
                 pass
         result = assemble(cfg, got, time.monotonic() - t_start, children, record)
         result["secure"] = secure
+        result["startup_seconds"] = startup_seconds(got.summaries, launched)
+        result["launch"] = "exec" if starter is None else "fork"
+        engine = got.summaries.get("engine")
+        result["play_started_unix"] = engine.extra.get("play_started") if engine is not None else None
         if result["outcome"] != "completed" and log_dir is None:
             keep = True  # a fault's evidence
             result["logs"] = str(tmp)
@@ -749,6 +775,8 @@ def play_match(
             raise type(exc)(f"{exc}\nevery process's log is kept in {tmp}") from None
         raise
     finally:
+        if starter is not None:
+            starter.close()  # children still waiting on the router read end-of-file and exit
         stop_all(children)
         if not keep:
             shutil.rmtree(tmp, ignore_errors=True)

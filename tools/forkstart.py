@@ -1,0 +1,211 @@
+"""Start a match's processes by forking one parent that has imported everything.
+
+`arena match` used to start every process as `python -m arena run <kind>`:
+eleven interpreters, each importing zenoh, numpy, pymunk and the strategies,
+which took about 1.4 s of a match's wall time on a quiet host and ~2.5 s of
+its CPU. Here the launcher imports every process kind once (`preload`) and
+`os.fork`s one child per process. A child is the same `arena run <kind> ...`
+command (arena/cli.py `main` with the same arguments), so `arena run` stays
+the entry of every process, and the per-process one for hardware in the loop.
+
+Rules kept:
+* No zenoh session exists in the launcher when it forks (a forked session's
+  runtime threads would not exist in the child). The launcher forks first,
+  then opens the match's router; each child waits on a pipe until the router
+  is up (`release`) before it opens its own session. If the launcher dies
+  first, the pipe reads end-of-file and the child exits.
+* Each child gets its own session (`setsid`, Ctrl-C reaches the launcher
+  only), `PR_SET_PDEATHSIG` (it dies with the launcher) and its own log file
+  on stdout and stderr, as an exec'd child did.
+* The launcher is the real parent: `ForkedProcess` waits for its children
+  like `subprocess.Popen` does (`poll`, `wait`, `send_signal`, `kill`).
+
+`ARENA_LAUNCH=exec` keeps the former exec start (for comparison runs and as a
+fallback). It is also used off the main thread, and in a process that has
+already opened a zenoh session (a second match played by the same process,
+as `arena bench match` does): zenoh's runtime threads outlive the session,
+and a fork would inherit its state without them (measured: the children of
+such a fork did not play).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import traceback
+from pathlib import Path
+
+_PR_SET_PDEATHSIG = 1
+
+
+def enabled() -> bool:
+    """Fork, unless asked not to, off the main thread, or once this process has opened zenoh."""
+    from arena.runtime.session import OPENED
+
+    return (
+        os.environ.get("ARENA_LAUNCH", "fork") != "exec"
+        and threading.current_thread() is threading.main_thread()
+        and not OPENED[0]
+    )
+
+
+def preload(kinds: set[str], strategies: set[str]) -> None:
+    """Import what the match's processes import (their kinds, its strategies), once, before forking."""
+    from arena import cli  # noqa: F401
+    from arena.processes import node_class
+    from arena.strategies import registry
+    from arena.tools import run  # noqa: F401
+
+    for kind in kinds:
+        node_class(kind)
+    for name in strategies:
+        registry.get(name)
+
+
+class ForkedProcess:
+    """The `subprocess.Popen` subset the launcher uses, for a forked child."""
+
+    def __init__(self, pid: int):
+        self.pid = pid
+        self.returncode: int | None = None
+
+    def _reaped(self, status: int) -> int:
+        self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def poll(self) -> int | None:
+        if self.returncode is None:
+            try:
+                pid, status = os.waitpid(self.pid, os.WNOHANG)
+            except ChildProcessError:
+                self.returncode = self.returncode if self.returncode is not None else 0
+                return self.returncode
+            if pid != 0:
+                return self._reaped(status)
+        return self.returncode
+
+    def wait(self, timeout: float | None = None) -> int:
+        deadline = None if timeout is None else time.monotonic() + timeout
+        delay = 0.001
+        while self.poll() is None:
+            if deadline is not None and time.monotonic() >= deadline:
+                raise subprocess.TimeoutExpired(f"pid {self.pid}", timeout)
+            time.sleep(delay)
+            delay = min(delay * 2, 0.05)
+        return self.returncode  # type: ignore[return-value]
+
+    def send_signal(self, sig: int) -> None:
+        if self.poll() is None:
+            try:
+                os.kill(self.pid, sig)
+            except ProcessLookupError:
+                pass
+
+    def kill(self) -> None:
+        self.send_signal(signal.SIGKILL)
+
+
+class Starter:
+    """Forks the children of one match; `release` lets them open their sessions."""
+
+    def __init__(self) -> None:
+        self._go_r, self._go_w = os.pipe()
+        self._count = 0
+
+    def fork(self, argv: list[str], log_path: Path) -> ForkedProcess:
+        """Fork `arena <argv>` (argv as after `python -m arena`), logging to `log_path`."""
+        sys.stdout.flush()
+        sys.stderr.flush()
+        parent = os.getpid()
+        pid = os.fork()
+        if pid == 0:  # the child: never returns
+            _child(argv, log_path, self._go_r, self._go_w, parent)
+        self._count += 1
+        return ForkedProcess(pid)
+
+    def release(self) -> None:
+        """The router is up: every forked child may start."""
+        if self._go_w >= 0:
+            os.write(self._go_w, b"g" * self._count)
+            self.close()
+
+    def close(self) -> None:
+        for fd in (self._go_r, self._go_w):
+            if fd >= 0:
+                os.close(fd)
+        self._go_r = self._go_w = -1
+
+
+def retitle(argv: list[str]) -> None:
+    """Show `python -m arena <argv>` as this process's command line (ps, /proc/<pid>/cmdline).
+
+    A forked child would show the launcher's command. The kernel reads the
+    command line from the memory of the original argv, so it is overwritten
+    in place (truncated to its length, the rest NUL); the name (`comm`) is set
+    too. Best effort: nothing depends on it but people and tests reading ps.
+    """
+    # Who it is first (`run robot --team a --robot 2`), the rest after, as far as it fits.
+    head, rest = list(argv[:2]), list(argv[2:])
+    for flag in ("--team", "--robot"):
+        if flag in rest:
+            i = rest.index(flag)
+            head += rest[i : i + 2]
+            del rest[i : i + 2]
+    title = "\0".join(["python", "-m", "arena", *head, *rest]).encode()
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(15, ctypes.c_char_p(("arena-" + argv[1])[:15].encode()), 0, 0, 0)  # PR_SET_NAME
+        stat = Path("/proc/self/stat").read_text()
+        fields = stat[stat.rindex(")") + 2 :].split()
+        start, end = int(fields[45]), int(fields[46])  # proc(5): arg_start (48), arg_end (49)
+        size = end - start
+        if size > 1:
+            ctypes.memmove(start, title[: size - 1].ljust(size, b"\0"), size)
+    except (OSError, ValueError, IndexError):
+        pass
+
+
+def _child(argv: list[str], log_path: Path, go_r: int, go_w: int, parent: int) -> None:
+    code = 1
+    try:
+        os.close(go_w)
+        os.setsid()
+        try:
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+        except OSError:
+            pass
+        if os.getppid() != parent:  # the launcher died before the prctl
+            os._exit(1)
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGCHLD):
+            signal.signal(sig, signal.SIG_DFL)
+        log = os.open(log_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        null = os.open(os.devnull, os.O_RDONLY)
+        os.dup2(null, 0)
+        os.dup2(log, 1)
+        os.dup2(log, 2)
+        os.close(log)
+        os.close(null)
+        if os.read(go_r, 1) != b"g":  # the launcher is gone: nothing to join
+            os._exit(1)
+        os.close(go_r)
+        # Named `arena run ...` only now: whoever sees one (ps, a test) can count on the router being up.
+        retitle(argv)
+        from arena.cli import main
+
+        code = main(argv)
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    except BaseException:
+        traceback.print_exc()
+        code = 1
+    finally:
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        finally:
+            os._exit(code)

@@ -1,0 +1,148 @@
+"""`arena bench throughput`: the two engines side by side on the same host.
+
+Each run plays the same match (same seed) once with `--engine processes` and
+once with `--engine inprocess`, each as its own `arena match --json` command,
+the order alternating from run to run (interleaved A/B), and every figure is
+the median over the runs. Whole-process figures: the command's wall time and
+its CPU (itself and every child it waited for, `RUSAGE_CHILDREN`).
+
+Printed per engine: play rtf (simulated s / wall s from the first to the last
+tick), start-up (the command's launch to the engine's first tick), the
+command's CPU per simulated second, and the tournament throughput in matches
+per hour of 2 x 300 s at the default `--jobs` (one per core). That last
+figure is derived, not measured, as the smaller of two bounds:
+* wall: `jobs` matches at a time, each taking 600 s / rtf + its start-up and
+  teardown (command wall - play wall);
+* CPU: the cores' CPU seconds per hour over a match's CPU, scaled from the
+  measured match to 600 simulated seconds.
+The in-process engine's match is one thread (its CPU ~ its wall), so its two
+bounds agree; the distributed engine's eleven processes share the cores, so
+the CPU bound is the one that holds for it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+from rich.console import Console
+
+from arena.tools.tournament import default_jobs
+
+ENGINES = ("processes", "inprocess")
+TOURNAMENT_MATCH_S = 600.0  # [s] simulated: the paper's 2 x 300 s
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def play(engine: str, args: argparse.Namespace, seed: int) -> dict:
+    argv = [sys.executable, "-m", "arena", "match", "--home", args.strategy, "--away", args.strategy]
+    argv += ["--robots", str(args.robots), "--half-time", str(args.half_time), "--link", args.link]
+    argv += ["--seed", str(seed), "--engine", engine, "--json"]
+    cpu0, t0 = _children_cpu(), time.time()
+    proc = subprocess.run(argv, capture_output=True, text=True, timeout=600 + 10 * args.half_time)
+    wall, cpu = time.time() - t0, _children_cpu() - cpu0
+    if proc.returncode != 0:
+        tail = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
+        raise RuntimeError(f"arena match --engine {engine} failed: {tail}")
+    r = json.loads(proc.stdout)
+    started = r.get("play_started_unix") or t0
+    return {
+        "engine": engine,
+        "seed": seed,
+        "digest": r["digest"],
+        "rtf": r["rtf"],
+        "sim_seconds": r["sim_seconds"],
+        "command_wall_s": round(wall, 3),
+        "command_cpu_s": round(cpu, 3),
+        "launch_to_first_tick_s": round(started - t0, 3),
+        "overhead_s": round(wall - r["play_wall_seconds"], 3),  # start-up and teardown of one match
+    }
+
+
+def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
+    med = {k: statistics.median(r[k] for r in runs) for k in ("rtf", "command_wall_s", "launch_to_first_tick_s")}
+    overhead = statistics.median(r["overhead_s"] for r in runs)
+    cpu_per_sim = statistics.median(r["command_cpu_s"] / r["sim_seconds"] for r in runs)
+    per_match_wall = TOURNAMENT_MATCH_S / med["rtf"] + overhead
+    wall_bound = jobs * 3600.0 / per_match_wall
+    cpu_bound = cores * 3600.0 / (cpu_per_sim * TOURNAMENT_MATCH_S)
+    return {
+        "rtf": round(med["rtf"], 2),
+        "rtf_all": [r["rtf"] for r in runs],
+        "launch_to_first_tick_s": round(med["launch_to_first_tick_s"], 3),
+        "command_wall_s": round(med["command_wall_s"], 3),
+        "cpu_s_per_sim_s": round(cpu_per_sim, 4),
+        "matches_per_hour": round(min(wall_bound, cpu_bound), 1),
+        "matches_per_hour_wall_bound": round(wall_bound, 1),
+        "matches_per_hour_cpu_bound": round(cpu_bound, 1),
+    }
+
+
+def bench_throughput(args: argparse.Namespace) -> int:
+    console = Console(stderr=True)
+    cores = os.cpu_count() or 1
+    jobs = default_jobs()
+    runs: dict[str, list[dict]] = {e: [] for e in ENGINES}
+    for i in range(args.runs):
+        seed = 1 + i
+        for engine in ENGINES if i % 2 == 0 else ENGINES[::-1]:
+            console.print(f"run {i + 1}/{args.runs}: --engine {engine}, 2 x {args.half_time:g} s, seed {seed} ...")
+            r = play(engine, args, seed)
+            runs[engine].append(r)
+            console.print(f"  rtf {r['rtf']:.1f}, first tick after {r['launch_to_first_tick_s']:.2f} s")
+    per = {e: summarise(runs[e], jobs, cores) for e in ENGINES}
+    same = all(a["digest"] == b["digest"] for a, b in zip(runs["processes"], runs["inprocess"]))
+    ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(runs["processes"], runs["inprocess"]))
+    out = {
+        "runs": args.runs,
+        "match": f"{args.strategy} v {args.strategy}, {args.robots}v{args.robots}, 2 x {args.half_time:g} s, "
+        f"link {args.link}",
+        "cores": cores,
+        "jobs": jobs,
+        "engines": per,
+        "rtf_ratio_inprocess_over_processes": round(ratio, 2),
+        "digests_equal": same,
+        "throughput_how": "matches/hour of 2 x 300 s = min(jobs x 3600 / (600 / rtf + start-up and teardown), "
+        "cores x 3600 / (CPU s per simulated s x 600)), from the medians above",
+        "all_runs": runs,
+    }
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0 if same else 1
+    from rich.table import Table
+
+    t = Table(title=f"arena bench throughput: medians of {args.runs} interleaved runs, {out['match']}")
+    t.add_column("metric")
+    for e in ENGINES:
+        t.add_column(e, justify="right")
+    t.add_column("inprocess / processes", justify="right")
+    p, q = per["processes"], per["inprocess"]
+    t.add_row("play rtf", f"{p['rtf']:.1f}", f"{q['rtf']:.1f}", f"{ratio:.2f}x")
+    t.add_row(
+        "launch to first tick [s]",
+        f"{p['launch_to_first_tick_s']:.2f}",
+        f"{q['launch_to_first_tick_s']:.2f}",
+        f"{q['launch_to_first_tick_s'] / max(1e-9, p['launch_to_first_tick_s']):.2f}x",
+    )
+    t.add_row("whole command [s]", f"{p['command_wall_s']:.2f}", f"{q['command_wall_s']:.2f}", "")
+    t.add_row("CPU s per simulated s", f"{p['cpu_s_per_sim_s']:.4f}", f"{q['cpu_s_per_sim_s']:.4f}", "")
+    t.add_row(
+        f"tournament matches/hour (2 x 300 s, --jobs {jobs})",
+        f"{p['matches_per_hour']:.0f}",
+        f"{q['matches_per_hour']:.0f}",
+        f"{q['matches_per_hour'] / max(1e-9, p['matches_per_hour']):.2f}x",
+    )
+    Console().print(t)
+    console.print(f"digests equal in every pair: {'yes' if same else 'NO'}")
+    console.print("throughput derived: " + out["throughput_how"])
+    return 0 if same else 1
