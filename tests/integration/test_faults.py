@@ -16,6 +16,7 @@ import sys
 import textwrap
 
 import msgspec
+import pytest
 import zenoh
 
 from arena.recording.reader import load
@@ -104,6 +105,7 @@ def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
     assert "fault: robot/b/1 at" in text
 
 
+@pytest.mark.slow
 def test_strict_stops_the_match_at_the_first_crash(reap, tmp_path):
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "strict", "--listen", endpoint, "--strict")
@@ -133,6 +135,7 @@ def test_a_dead_referee_voids_the_match_at_once(reap, tmp_path):
     wait_for(lambda: not [p for p in kids if alive(p)], 10, "every process of the void match to stop")
 
 
+@pytest.mark.slow
 def test_a_dead_engine_voids_the_match(reap, tmp_path):
     """Issue 20: kill -9 of the engine used to leave the others playing to the end and exit 0."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
@@ -238,6 +241,7 @@ def test_a_robot_stopped_for_10_s_alone_is_blamed(reap, tmp_path):
         assert "gap: robot/a/1:" in review.stdout, review.stdout
 
 
+@pytest.mark.slow
 def test_a_killed_recorder_is_a_fault_and_its_file_stays_readable(reap, tmp_path):
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     mcap = tmp_path / "cut.mcap"
@@ -318,3 +322,45 @@ def test_two_senders_on_one_key_are_flagged_as_possible_spoofing(reap, tmp_path)
     assert conflicts > 0, result["rejected_reasons"]
     assert result["rejected_reasons"]["conflict"] == sum(result["conflicts"].values())
     assert "two senders on robot/b/1/cmd: possible spoofing" in err
+
+
+CAMPAIGN = [  # (the process to kill, its command-line marker, whether the match then counts)
+    ("robot/a/2", "--team a --robot 2", True),
+    ("basestation/b", "arena run basestation", True),
+    ("referee", "arena run referee", False),
+    ("engine", "arena run engine", False),
+    ("recorder", "arena run recorder", True),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("process", "needle", "counts"), CAMPAIGN, ids=[c[0] for c in CAMPAIGN])
+def test_fault_campaign_kill_9_at_a_seeded_random_tick(reap, tmp_path, process, needle, counts):
+    """Issue 15, item 5: kill -9 of each kind of process at a seeded random tick of a recorded 2 x 60 s match."""
+    import random
+
+    tick = random.Random(f"campaign/{process}").randint(200, 5000)
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    proc = spawn(*MATCH, "--half-time", "60", "--seed", "7", "--match", "campaign", "--listen", endpoint,
+                 "--record", str(tmp_path / "c.mcap"))  # fmt: skip
+    reap.append(proc)
+    if process == "basestation/b":
+        victim = wait_for(
+            lambda: next((p for p in descendants(proc.pid) if needle in cmdline(p) and "--team b" in cmdline(p)), None),
+            60,
+            "basestation/b",
+        )
+    else:
+        victim = child(proc.pid, needle)
+    wait_for_tick(endpoint, "campaign", tick, proc)
+    os.kill(victim, signal.SIGKILL)
+    code, result, err = finish(proc)
+    assert "Traceback" not in err
+    assert process in [f["process"] for f in result["faults"]], result["faults"]
+    if process in ("referee", "engine"):
+        assert code == 1 and result["outcome"] == "void", err
+    else:
+        assert code == 0, err
+        assert result["outcome"] == "completed_with_faults" and result["ticks"] == 6000
+        assert result["events"]["END_GAME"] == 1
+    assert counts == (result["outcome"] != "void")
