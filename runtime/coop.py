@@ -135,8 +135,13 @@ def _advance(task: Task) -> None:
             return
 
 
-def drive(bus: CoopBus, tasks: list[Task], on_idle: Callable[[], None] | None = None) -> list[str]:
+def drive(
+    bus: CoopBus, tasks: list[Task], on_idle: Callable[[], None] | None = None, quit_early: set[str] | None = None
+) -> list[str]:
     """Run every task to its end; returns the deadlocks met (one line each), usually none.
+
+    `quit_early` collects the nodes whose loop ended while others still waited
+    for them (what a launcher would see as a vanished liveliness token).
 
     `on_idle` is called whenever the run queue has gone round once (the
     recorder drains its taps there). A task that raises ends the match:
@@ -163,16 +168,21 @@ def drive(bus: CoopBus, tasks: list[Task], on_idle: Callable[[], None] | None = 
             on_idle()
         if runnable:
             continue
-        parked = [t for t in tasks if not t.done]
+        parked = [t for t in tasks if not t.done and t.waiting is not None]
         if not parked:
             return deadlocks
-        # Every unfinished node waits for another: what the watchdog would end
-        # after `wait_timeout` in a distributed match, ended at once here.
-        waits = ", ".join(f"{t.name} on {t.waiting[0].key} (tick {t.waiting[1]})" for t in parked if t.waiting)
+        waits = ", ".join(f"{t.name} on {t.waiting[0].key} (tick {t.waiting[1]})" for t in parked)  # type: ignore[index]
         deadlocks.append(f"deadlock: every unfinished node waits: {waits}")
-        for t in parked:
-            if t.waiting is not None:
-                ib, k = t.waiting
-                ib._channel.waiter = None  # type: ignore[union-attr]
-                ib._give_up(f"deadlock: nobody can send tick {k} (cooperative driver)")
+        # Waits on a node whose loop has ended are given up first: in a distributed
+        # match its liveliness token would be gone. Only a cycle of live nodes is
+        # ended as the watchdog would end it after `wait_timeout`: every wait at once.
+        live = {t.name for t in tasks if not t.done}
+        stuck = [t for t in parked if t.waiting[0].sender not in live] or parked  # type: ignore[index]
+        for t in stuck:
+            ib, k = t.waiting  # type: ignore[misc]
+            ib._channel.waiter = None  # type: ignore[union-attr]
+            why = "its loop ended" if ib.sender not in live else f"nobody can send tick {k}"
+            if ib.sender not in live and quit_early is not None:
+                quit_early.add(ib.sender)
+            ib._give_up(f"deadlock: {why} (cooperative driver)")
             runnable.append(t)

@@ -55,8 +55,9 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     started = time.time()
     t0 = time.perf_counter()
     tasks = [Task(name, node.lockstep()) for name, node in nodes.items()]
+    quit_early: set[str] = set()
     try:
-        deadlocks = drive(bus, tasks, on_idle=recorder.pump if recorder is not None else None)
+        deadlocks = drive(bus, tasks, on_idle=recorder.pump if recorder is not None else None, quit_early=quit_early)
     except NodeFailed as exc:
         if recorder is not None:
             recorder.finish()
@@ -81,7 +82,7 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
         while (raw := ch.try_recv()) is not None:
             got.append(raw)
         frames[name] = got
-    return summaries, frames, play, deadlocks
+    return summaries, frames, play, deadlocks, quit_early
 
 
 def play_in_process(
@@ -97,7 +98,7 @@ def play_in_process(
     `timeout` is kept for callers of the threaded driver this replaced: a
     cooperative match cannot hang (a deadlock is detected, not waited out).
     """
-    summaries, frames, _, _ = _play(cfg, watch, record)
+    summaries, frames, _, _, _ = _play(cfg, watch, record)
     return summaries, frames
 
 
@@ -114,8 +115,9 @@ def play_match(cfg: MatchConfig, record: str = "") -> dict:
         raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
     t_start = time.monotonic()
     launched = time.time()
-    summaries, _, play, deadlocks = _play(cfg, watch=(), record=record)
-    got = Collected(summaries=summaries, started=0.0, ended=play)
+    summaries, _, play, deadlocks, quit_early = _play(cfg, watch=(), record=record)
+    lost = {name: "its loop ended while others still waited for it" for name in quit_early}
+    got = Collected(summaries=summaries, started=0.0, ended=play, lost=lost)
     result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, [], record=record)
     result["engine"] = ENGINE
     result["startup_seconds"] = round(summaries["engine"].extra["play_started"] - launched, 3)

@@ -1,0 +1,50 @@
+"""The cooperative driver (runtime/coop.py): one thread, and a node that stops is detected, never waited on."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from arena.processes import node_class
+from arena.processes.robot import RobotNode
+from arena.runtime.config import MatchConfig
+from arena.tools import inprocess
+
+
+class QuitsAtTick20(RobotNode):
+    """A robot whose loop ends early: its peers would wait for its frames for ever."""
+
+    def lockstep(self):
+        for step in super().lockstep():
+            if self.last_tick >= 20 and self.pid.team == "b" and self.pid.robot == 1:
+                return
+            yield step
+
+
+def test_a_node_that_stops_sending_is_a_detected_deadlock_and_the_match_goes_on(monkeypatch):
+    monkeypatch.setattr(inprocess, "node_class", lambda kind: QuitsAtTick20 if kind == "robot" else node_class(kind))
+    threads = threading.active_count()
+    result = inprocess.play_match(MatchConfig(seed=4, half_time=2.0))
+    assert threading.active_count() == threads, "no thread was started"
+    assert result["ticks"] == 200, "the match was played to its end"
+    assert result["deadlocks"] and "robot/b/1" in result["deadlocks"][0]
+    assert "robot/b/1" in result["dead"]
+
+
+def test_a_clean_match_has_no_deadlock_and_one_pid():
+    r = inprocess.play_match(MatchConfig(seed=4, half_time=1.0))
+    assert r["deadlocks"] == [] and r["dead"] == [] and r["engine"] == "inprocess"
+    assert len({p["pid"] for p in r["processes"]}) == 1
+
+
+def test_a_node_that_raises_ends_the_match_with_its_name(monkeypatch):
+    class Broken(RobotNode):
+        def act(self, k: int) -> None:
+            if k == 7:
+                raise ZeroDivisionError("a strategy divided by zero")
+            super().act(k)
+
+    monkeypatch.setattr(inprocess, "node_class", lambda kind: Broken if kind == "robot" else node_class(kind))
+    with pytest.raises(inprocess.InprocessError, match="robot/a/0 failed: ZeroDivisionError"):
+        inprocess.play_match(MatchConfig(seed=4, half_time=1.0))
