@@ -281,11 +281,12 @@ def test_an_external_robot_that_never_sends_its_summary_is_named_within_the_boun
     proc = spawn(*MATCH, "--half-time", "10", "--seed", "4", "--match", "mute", "--listen", endpoint,
                  "--external", "a/1")  # fmt: skip
     reap.append(proc)
-    robot = subprocess.Popen(
-        [sys.executable, "-c", NO_SUMMARY, "run", "robot", "--match", "mute", "--connect", endpoint,
-         "--team", "a", "--robot", "1"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
+    # Start it with the command the launcher prints (its credentials included), through the patched main.
+    line = ""
+    while not line.strip().startswith("arena run robot"):
+        line = wait_for(lambda: proc.stderr.readline(), 60, "the launcher's instructions")
+    robot = subprocess.Popen([sys.executable, "-c", NO_SUMMARY, *line.split()[1:]],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)  # fmt: skip
     reap.append(robot)
     code, result, err = finish(proc, 120)
     assert code == 0, err
