@@ -136,6 +136,17 @@ CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1)
 OPENED = [False]
 
 
+def check_runtime_variable(text: str) -> None:
+    """A user's ZENOH_RUNTIME must at least look like zenoh's RON tuple: a bad one panics inside zenoh."""
+    depth = 0
+    for ch in text:
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if depth < 0:
+            break
+    if not (text.strip().startswith("(") and text.strip().endswith(")") and depth == 0):
+        raise ConfigError(f"ZENOH_RUNTIME={text!r} is not a zenoh runtime setting (e.g. {ONE_THREAD_RUNTIME})")
+
+
 def open_session(net: NetConfig) -> zenoh.Session:
     """Open a zenoh session; use as `with open_session(net) as session:`."""
     OPENED[0] = True
@@ -143,6 +154,7 @@ def open_session(net: NetConfig) -> zenoh.Session:
         # Ours, not the user's (children inherit the launcher's environment): choose per mode.
         relays = net.mode == "client" or any(path == "access_control" for path, _ in net.extra)
         os.environ["ZENOH_RUNTIME"] = CLIENT_RUNTIME if relays else ONE_THREAD_RUNTIME
+    check_runtime_variable(os.environ["ZENOH_RUNTIME"])
     for ep in net.listen:
         check_endpoint("--listen", ep)
     for ep in net.connect:
@@ -152,3 +164,12 @@ def open_session(net: NetConfig) -> zenoh.Session:
     except zenoh.ZError as exc:
         where = " and ".join([*(f"listen on {e}" for e in net.listen), *(f"connect to {e}" for e in net.connect)])
         raise EndpointError(f"cannot {where or 'open a zenoh session'}: {zenoh_reason(exc)}") from None
+    except (
+        BaseException
+    ) as exc:  # zenoh's Rust side panics (pyo3 PanicException, a BaseException) on a bad ZENOH_* variable
+        if type(exc).__name__ != "PanicException":
+            raise
+        bad = [f"{k}={v}" for k, v in os.environ.items() if k.startswith("ZENOH_")]
+        raise ConfigError(
+            f"zenoh could not start ({zenoh_reason(exc)[:160]}); check the environment: {', '.join(bad) or 'no ZENOH_* set'}"
+        ) from None

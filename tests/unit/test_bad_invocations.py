@@ -160,3 +160,26 @@ def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, c
 def test_version():
     r = subprocess.run([sys.executable, "-m", "arena", "--version"], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and r.stdout.startswith("arena ") and r.stdout.split()[1][0].isdigit()
+
+
+@pytest.mark.parametrize(
+    ("env", "args", "needle"),
+    [
+        ({"ZENOH_RUNTIME": "garbage"}, M, "ZENOH_RUNTIME='garbage' is not a zenoh runtime setting"),
+        ({"ARENA_MATCH": "bad/id"}, ["up", "compose.yaml"], "ARENA_MATCH: bad match id 'bad/id'"),
+    ],
+)
+def test_a_bad_environment_variable_is_one_line_and_exit_2(env, args, needle):
+    import os
+
+    r = subprocess.run(
+        [sys.executable, "-m", "arena", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, **env},
+        cwd=Path(__file__).resolve().parents[2],
+    )
+    assert "Traceback" not in r.stderr and "panicked" not in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and needle in r.stderr, r.stderr
+    assert r.returncode == 2
