@@ -87,13 +87,18 @@ def load_config(path: str) -> MatchConfig:
     return MatchConfig.from_json(text)
 
 
-def refused_by(connect: tuple[str, ...]) -> None:
-    """ConfigError if a router listens at one of `connect` and still would not have us (issue 15 item 6)."""
-    for ep in connect:
-        if listening(ep):
-            raise ConfigError(
-                f"refused by {ep}: authentication failed (a secure match needs this process's own --credentials file)"
-            )
+REFUSED_AFTER = 6.0  # [s] listening but not connected this long is a refusal: zenoh retries a connect every <= 4 s
+
+
+def refused_by(connect: tuple[str, ...]) -> str | None:
+    """The endpoint of `connect` at which something listens (a router that did not have us), if any."""
+    return next((ep for ep in connect if listening(ep)), None)
+
+
+def refusal(ep: str) -> ConfigError:
+    return ConfigError(
+        f"refused by {ep}: authentication failed (a secure match needs this process's own --credentials file)"
+    )
 
 
 def fetch_config(
@@ -108,14 +113,20 @@ def fetch_config(
     """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
     deadline = time.monotonic() + timeout
     state = ""
+    refused_since: float | None = None  # a router listens, and we are still not connected to it
     while time.monotonic() < deadline:
         payload = transport.query(keys.config(), timeout=1.0)
         if payload is not None:
             return MatchConfig.from_json(payload.decode())
         if session is not None:
             connected = bool(list(session.info.routers_zid()) or list(session.info.peers_zid()))
-            if not connected:
-                refused_by(connect)
+            ep = None if connected else refused_by(connect)
+            if ep is None:
+                refused_since = None
+            elif refused_since is None:
+                refused_since = time.monotonic()
+            elif time.monotonic() - refused_since > REFUSED_AFTER:
+                raise refusal(ep)
             now = f"a router at {where}, but no match {keys.match!r} there" if connected else f"no router at {where}"
             if now != state and tell is not None:
                 tell(f"waiting: {now} (retrying for up to {timeout:g} s)")
@@ -135,13 +146,20 @@ def open_until(net: NetConfig, timeout: float, where: str, tell):
         check_endpoint("--connect", ep)
     deadline = time.monotonic() + timeout
     told = False
+    refused_once = False
     while True:
         try:
             return open_session(net)
         except EndpointError as exc:
             if net.mode != "client" or not net.connect:
                 raise
-            refused_by(net.connect)
+            ep = refused_by(net.connect)
+            if ep is not None:
+                if refused_once:  # twice in a row, 1 s apart: not a router still starting
+                    raise refusal(ep) from None
+                refused_once = True
+            else:
+                refused_once = False
             if time.monotonic() + 1.0 > deadline:
                 raise StartupError(f"gave up after {timeout:g} s: no router at {where}") from None
             if not told:
