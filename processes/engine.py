@@ -44,6 +44,7 @@ from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.runtime.pace import Pacer
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
+from arena.schemas.vocabulary import SEND_OFF
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics
 from arena.sim.sensors import NormalStream, sense
@@ -83,6 +84,7 @@ class Restarts:
         self.physics = physics
         self.pending: RefCommand | None = None  # the set piece waiting for its START
         self.placed: list[tuple[int, str, int, float, float]] = []
+        self.sent_off: list[tuple[int, str, int, str]] = []  # (tick, team, robot, command)
 
     def apply_frame(self, frame: Referee) -> None:
         self.physics.attack_dir_a = frame.attack_dir_a
@@ -96,14 +98,32 @@ class Restarts:
             if c.name == "KICKOFF":
                 ph.kickoff_positions(c.team)
             ph.pin_ball(c.x, c.y)
+            if c.name == "PENALTY":
+                self.penalty_positions(c)
             self.pending = c
         elif c.name == "START":
             if self.pending is not None:
                 self.enforce_distance(self.pending)
+                if self.pending.name == "PENALTY":
+                    self.penalty_positions(self.pending)
             self.pending = None
             ph.start_play()
-        elif c.name in ("STOP", "HALF_TIME", "END_GAME", "PARK"):
+        elif c.name in ("STOP", "HALF_TIME", "END_GAME", "PARK", "GAMEOVER"):
             ph.stop_play()
+        elif c.name in SEND_OFF and c.team in TEAMS and 0 <= c.robot < self.cfg.robots:
+            if (c.team, c.robot) not in ph.parked():
+                ph.park_robot(c.team, c.robot)  # sent off: beyond the fence, no collisions; its process plays on
+                self.sent_off.append((ph.tick, c.team, c.robot, c.name))
+
+    def penalty_positions(self, c: RefCommand) -> None:
+        """The penalty procedure: keeper on its line, taker behind the mark, the rest out of the area."""
+        ph = self.physics
+        parked = set(ph.parked())
+        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states() if (t, n) not in parked}
+        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
+        for t, n, x, y, th in setpieces.penalty_positions(robots, c.team, (c.x, c.y), ph.attack_dir_a, self.cfg):
+            ph.place_robot(t, n, x, y, poses[(t, n)][2] if math.isnan(th) else th)
+            self.placed.append((ph.tick, t, n, x, y))
 
     def enforce_distance(self, c: RefCommand) -> None:
         """Move every robot too close to the ball spot of `c` to the nearest legal place."""
@@ -319,4 +339,5 @@ class EngineNode(Node):
             "ticks": self.last_tick,
             "placed": len(self.restarts.placed),
             "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
+            "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
         }

@@ -61,7 +61,7 @@ class RefboxNode(Node):
         t0 = time.perf_counter()
         for frame in self.ref_in.take(k):
             for c in frame.commands:
-                self.server.broadcast(c.name, c.team)
+                self.server.broadcast(rp.OUR_TO_WIRE.get(c.name, c.name), c.team, c.robot)
                 self.forwarded += 1
         self._worldstates(k)
         if self.tap is not None:

@@ -36,6 +36,7 @@ from arena.rules import setpieces as sp
 from arena.rules.refbox_client import RefboxClient
 from arena.rules.referee_box import MSL_COMMANDS, TEAM_COMMANDS, RefereeState, Result, Rules, issue
 from arena.runtime.config import RefboxParams, RefboxTeam
+from arena.schemas.vocabulary import ROBOT_COMMANDS
 
 
 def team_of_command(cmd: rp.Command, params: RefboxParams) -> str:
@@ -71,7 +72,7 @@ def follow(
     st: RefereeState, tick: int, cmd: rp.Command, ball: tuple[float, float], rules: Rules, params: RefboxParams
 ) -> tuple[RefereeState, list, str]:
     """(new state, our commands, why ignored or "") for one command of the real RefBox."""
-    name = cmd.name
+    name = rp.WIRE_TO_OURS.get(cmd.name, cmd.name)
     team = team_of_command(cmd, params)
     if name == "SUBGOAL":
         if team not in ("a", "b"):
@@ -82,6 +83,11 @@ def follow(
         return st, [], f"{name} is not a command of our referee"
     if name in TEAM_COMMANDS and not team:
         return st, [], f"{name} for unknown targetTeam {cmd.target!r}"
+    if name in ROBOT_COMMANDS:  # the RefBox's cards carry no robotID: we cannot tell whom to send off
+        if not 0 <= cmd.robot_id < rules.cfg.robots:
+            return st, [], f"{name} without a robotID of ours"
+        st, c = issue(st, tick, name, team, (0.0, 0.0), cmd.robot_id)
+        return st, [c], ""
     if name == "START":
         st, c = issue(st, tick, "START", st.command_team, st.spot)
         return st, [c], ""

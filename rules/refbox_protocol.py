@@ -60,7 +60,12 @@ TEAM_COMMANDS = frozenset(
     {"KICKOFF", "FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY", "GOAL", "SUBGOAL"}
     | {"YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR", "SUBSTITUTION", "IS_ALIVE"}
 )
-ROBOT_COMMANDS = frozenset({"IS_ALIVE", "SUBSTITUTION"})  # carry robotID
+# Carry robotID: the RefBox's IS_ALIVE and SUBSTITUTION, and our referee's cards and REPAIR,
+# which name the robot they are about (a client that does not know the key ignores it).
+ROBOT_COMMANDS = frozenset({"IS_ALIVE", "SUBSTITUTION", "YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR"})
+# Our command names (schemas/vocabulary.py) that the 2020 protocol spells differently, both ways.
+OUR_TO_WIRE = {"REPAIR_OUT": "REPAIR"}
+WIRE_TO_OURS = {w: o for o, w in OUR_TO_WIRE.items()}
 
 # Legacy characters: team commands as the cyan (upper case) letter, the others as is.
 LEGACY_TEAM = {

@@ -21,7 +21,14 @@ tabled in docs/rules.md:
   THROWIN for the other team than the last toucher's; GOAL_LINE -> CORNER
   if the defending team touched it last, else GOALKICK; NO_PROGRESS ->
   DROP_BALL; FOUL_PUSHING and FOUL_DRIBBLING -> FREEKICK for the other team
-  than the offender's. A TOUCH after START marks the set piece as taken.
+  than the offender's, or PENALTY at the penalty mark if a defender fouled in
+  its own penalty area. A TOUCH after START marks the set piece as taken.
+* discipline: every foul counts against the robot that committed it; its
+  `yellow_fouls`-th foul adds YELLOW_CARD, its 2 x `yellow_fouls`-th
+  DOUBLE_YELLOW, its `red_fouls`-th (if set) RED_CARD, between the STOP and
+  the restart. ROBOT_DEAD (at any time) gives REPAIR_OUT. DOUBLE_YELLOW,
+  RED_CARD and REPAIR_OUT send the robot off (`off`); the engine parks it.
+* END_GAME is followed on the same tick by PARK and GAMEOVER.
 
 Every restart is the MSL set-piece procedure: STOP, then the command with
 its team and ball spot (`setpieces.py`), then after the positioning time
@@ -40,13 +47,15 @@ from dataclasses import dataclass
 from arena.rules import setpieces as sp
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee
-from arena.schemas.vocabulary import REF_COMMANDS, SET_PIECES, STAGES, other_team
+from arena.schemas.vocabulary import REF_COMMANDS, ROBOT_COMMANDS, SEND_OFF, SET_PIECES, STAGES, other_team
 
 MSL_COMMANDS = REF_COMMANDS  # arena.schemas.vocabulary.RefCommandName: the wire types check them on decode
-TEAM_COMMANDS = (SET_PIECES - {"DROP_BALL"}) | {"GOAL"}  # need a team
+TEAM_COMMANDS = (SET_PIECES - {"DROP_BALL"}) | {"GOAL"} | ROBOT_COMMANDS  # need a team
 PLAYING_STAGES = frozenset({"FIRST_HALF", "SECOND_HALF"})
 _STAGE_COMMANDS = frozenset({"FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"})
-_KEEP_IN_FORCE = frozenset({"GOAL", "FIRST_HALF", "SECOND_HALF"})  # announced; the command in force stays
+# announced; the command in force stays
+_KEEP_IN_FORCE = frozenset({"GOAL", "FIRST_HALF", "SECOND_HALF", "PARK", "GAMEOVER"}) | ROBOT_COMMANDS
+FOULS = frozenset({"FOUL_PUSHING", "FOUL_DRIBBLING"})
 
 
 def check_referee(frame: Referee) -> str | None:
@@ -74,6 +83,8 @@ def check_referee(frame: Referee) -> str | None:
             return f"{c.name} without a target team"
         if not (math.isfinite(c.x) and math.isfinite(c.y)):
             return f"{c.name} spot is not finite"
+        if (c.name in ROBOT_COMMANDS) != (c.robot >= 0):
+            return f"{c.name} with robot {c.robot}" if c.robot >= 0 else f"{c.name} without a robot"
     return None
 
 
@@ -89,6 +100,8 @@ class RefereeState:
     issued_at: int = 0  # tick the command in force was issued; older events are stale
     start_at: int = -1  # tick at which START is due, -1 for none
     take_by: int = -1  # tick by which the set piece must be taken, -1 for none
+    fouls: tuple[tuple[str, int, int], ...] = ()  # (team, robot, fouls so far), sorted
+    off: tuple[tuple[str, int], ...] = ()  # robots sent off (cards, REPAIR_OUT), in order
 
     @property
     def in_play(self) -> bool:
@@ -151,9 +164,11 @@ Result = tuple[RefereeState, list[RefCommand]]
 
 
 # ------------------------------------------------------------------ commands
-def issue(st: RefereeState, tick: int, name: str, team: str = "", spot=(0.0, 0.0)) -> tuple[RefereeState, RefCommand]:
+def issue(
+    st: RefereeState, tick: int, name: str, team: str = "", spot=(0.0, 0.0), robot: int = -1
+) -> tuple[RefereeState, RefCommand]:
     """The state after announcing `name`, and the command itself."""
-    cmd = RefCommand(name=name, team=team, x=spot[0], y=spot[1], tick=tick)
+    cmd = RefCommand(name=name, team=team, x=spot[0], y=spot[1], tick=tick, robot=robot)
     if name in _STAGE_COMMANDS:
         st = dataclasses.replace(st, stage=name)
     if name not in _KEEP_IN_FORCE:
@@ -161,8 +176,8 @@ def issue(st: RefereeState, tick: int, name: str, team: str = "", spot=(0.0, 0.0
     return st, cmd
 
 
-def restart(st: RefereeState, tick: int, r: Restart, rules: Rules) -> Result:
-    """STOP, the set-piece command, and START due after the positioning time."""
+def restart(st: RefereeState, tick: int, r: Restart, rules: Rules, cards: tuple[RefCommand, ...] = ()) -> Result:
+    """STOP, any cards, the set-piece command, and START due after the positioning time."""
     out = []
     if r.goal:
         a, b = st.score
@@ -171,6 +186,7 @@ def restart(st: RefereeState, tick: int, r: Restart, rules: Rules) -> Result:
         out.append(c)
     st, c = issue(st, tick, "STOP")
     out.append(c)
+    out.extend(cards)
     st, c = issue(st, tick, r.command, r.team, r.spot)
     out.append(c)
     wait = rules.kickoff_ticks if r.command == "KICKOFF" else rules.setpiece_ticks
@@ -206,10 +222,53 @@ def no_progress_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart |
 
 
 def foul_rule(st: RefereeState, ev: BallEvent, rules: Rules) -> Restart | None:
-    """FOUL_PUSHING, FOUL_DRIBBLING: free kick for the other team where the foul happened."""
+    """FOUL_PUSHING, FOUL_DRIBBLING: free kick for the other team where the foul happened;
+    a penalty if the offender was defending its own penalty area."""
     if ev.team not in TEAMS:
         return None
+    if sp.in_own_penalty_area(ev.team, ev.x, ev.y, st.attack_dir_a, rules.cfg):
+        return Restart("PENALTY", other_team(ev.team), sp.penalty_spot(ev.team, st.attack_dir_a, rules.cfg))
     return Restart("FREEKICK", other_team(ev.team), sp.free_kick_spot(ev.x, ev.y, rules.cfg))
+
+
+def card_rule(fouls: int, rules: Rules) -> str | None:
+    """The card a robot's `fouls`-th foul earns (RulesParams.yellow_fouls, red_fouls), if any."""
+    p = rules.cfg.rules
+    if p.red_fouls > 0 and fouls == p.red_fouls:
+        return "RED_CARD"
+    if p.yellow_fouls > 0 and fouls == 2 * p.yellow_fouls:
+        return "DOUBLE_YELLOW"
+    if p.yellow_fouls > 0 and fouls == p.yellow_fouls:
+        return "YELLOW_CARD"
+    return None
+
+
+def book(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> tuple[RefereeState, tuple[RefCommand, ...]]:
+    """Count a foul against its robot; the card it earns, if any (a red or a double yellow sends it off)."""
+    if ev.team not in TEAMS or ev.robot < 0:
+        return st, ()
+    counts = {(t, n): k for t, n, k in st.fouls}
+    k = counts.get((ev.team, ev.robot), 0) + 1
+    counts[(ev.team, ev.robot)] = k
+    st = dataclasses.replace(st, fouls=tuple(sorted((t, n, c) for (t, n), c in counts.items())))
+    card = card_rule(k, rules)
+    if card is None:
+        return st, ()
+    return send_off(*issue(st, tick, card, ev.team, (ev.x, ev.y), ev.robot))
+
+
+def send_off(st: RefereeState, c: RefCommand) -> tuple[RefereeState, tuple[RefCommand, ...]]:
+    if c.name in SEND_OFF and (c.team, c.robot) not in st.off:
+        st = dataclasses.replace(st, off=(*st.off, (c.team, c.robot)))
+    return st, (c,)
+
+
+def repair_out_rule(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result:
+    """ROBOT_DEAD: REPAIR_OUT for it, once, whether the ball is in play or not; play goes on."""
+    if ev.team not in TEAMS or ev.robot < 0 or (ev.team, ev.robot) in st.off:
+        return st, []
+    st, cards = send_off(*issue(st, tick, "REPAIR_OUT", ev.team, (0.0, 0.0), ev.robot))
+    return st, list(cards)
 
 
 EventRule = Callable[[RefereeState, BallEvent, Rules], Restart | None]
@@ -224,6 +283,8 @@ EVENT_RULES: dict[str, EventRule] = {
 
 
 def on_event(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result:
+    if ev.kind == "ROBOT_DEAD":
+        return repair_out_rule(st, tick, ev, rules) if st.stage != "END_GAME" else (st, [])
     if not st.in_play or ev.tick <= st.issued_at:
         return st, []  # stopped, or it happened before START: stale
     if ev.kind == "TOUCH":
@@ -232,7 +293,8 @@ def on_event(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result
     decision = rule(st, ev, rules) if rule else None
     if decision is None:
         return st, []
-    return restart(st, tick, decision, rules)
+    st, cards = book(st, tick, ev, rules) if ev.kind in FOULS else (st, ())
+    return restart(st, tick, decision, rules, cards)
 
 
 # --------------------------------------------------------------- clock rules
@@ -240,7 +302,9 @@ def end_game(st: RefereeState, tick: int, rules: Rules) -> Result | None:
     if tick < rules.total_ticks:
         return None
     st, c = issue(st, tick, "END_GAME")
-    return dataclasses.replace(st, start_at=-1, take_by=-1), [c]
+    st, p = issue(st, tick, "PARK")
+    st, g = issue(st, tick, "GAMEOVER")
+    return dataclasses.replace(st, start_at=-1, take_by=-1), [c, p, g]
 
 
 def first_half(st: RefereeState, tick: int, rules: Rules) -> Result | None:
@@ -367,6 +431,7 @@ class RefereeBox:
             "events": dict(self.counts),
             "log": [
                 {"tick": e.tick, "command": c.name, "team": c.team, "cause": e.cause}
+                | ({"robot": c.robot} if c.robot >= 0 else {})
                 for e in self.log
                 for c in e.commands
             ],

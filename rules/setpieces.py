@@ -16,8 +16,11 @@ Ball spots (field frame, SI units; L, W the field's length and width):
   ball went out, inside the corner arc.
 * GOALKICK: the corner of the goal area on the side the ball went out.
 * FREEKICK: where the foul happened, kept `spot_inset` inside the lines and
-  moved out of a penalty area onto its front line (penalty kicks are not
-  awarded, see docs/rules.md).
+  moved out of a penalty area onto its front line (a foul by a defender in
+  its own penalty area is a PENALTY instead, see docs/rules.md).
+* PENALTY: the penalty mark of the defending team's goal
+  (`FieldParams.penalty_mark_distance` from its goal line, on the centre
+  line of the field's length axis).
 * DROP_BALL: where the ball was, kept `drop_ball_inset` inside the lines.
 * KICKOFF: the centre spot.
 
@@ -88,6 +91,12 @@ def free_kick_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
     if abs(x) > front and abs(y) < f.penalty_area_width / 2:
         x = math.copysign(front, x)
     return x, y
+
+
+def penalty_spot(defender: str, attack_dir_a: int, cfg: MatchConfig) -> tuple[float, float]:
+    """The penalty mark in front of `defender`'s goal."""
+    f = cfg.field
+    return -attack_dir(defender, attack_dir_a) * (f.length / 2 - f.penalty_mark_distance), 0.0
 
 
 def drop_ball_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
@@ -182,3 +191,56 @@ def legal_spot(
             if all(math.hypot(cx - ox, cy - oy) >= gap for ox, oy in others):
                 return cx, cy
     return x, y
+
+
+# ------------------------------------------------------------------ penalty
+PENALTY_BEHIND = 0.5  # [m] the taker's centre behind the penalty mark
+
+
+def penalty_positions(
+    robots: list[tuple[str, int, float, float]],
+    taker_team: str,
+    spot: tuple[float, float],
+    attack_dir_a: int,
+    cfg: MatchConfig,
+) -> list[tuple[str, int, float, float, float]]:
+    """(team, n, x, y, theta) of every robot that must move for a penalty.
+
+    The defending keeper (robot 0) stands on its goal line, in the middle of
+    the goal, facing the field. The taker, the taking team's field robot
+    nearest to the mark (its keeper if it has no other), stands
+    `PENALTY_BEHIND` behind the mark facing the goal. Every other robot
+    leaves the penalty area and keeps `setpiece_distance` from the mark
+    (`legal_spot`, with rings further out until the place is outside the
+    area). Robots already where they may be are not in the list.
+    """
+    f, reach = cfg.field, cfg.robot.size * math.sqrt(0.5)
+    defender = other_team(taker_team)
+    side = -attack_dir(defender, attack_dir_a)  # x sign of the defended goal
+    front = f.length / 2 - f.penalty_area_depth
+
+    def in_area(x: float, y: float) -> bool:
+        return side * x > front - reach and abs(y) < f.penalty_area_width / 2 + reach
+
+    pos = {(t, n): (x, y) for t, n, x, y in robots}
+    takers = sorted((math.hypot(x - spot[0], y - spot[1]), n) for t, n, x, y in robots if t == taker_team and n != 0)
+    taker = (taker_team, takers[0][1] if takers else 0)
+    keeper = (defender, 0)
+    fixed = {taker: (spot[0] - side * PENALTY_BEHIND, spot[1], 0.0 if side > 0 else math.pi)}
+    if keeper in pos:
+        fixed[keeper] = (side * (f.length / 2 - cfg.robot.size / 2), 0.0, math.pi if side > 0 else 0.0)
+    moves = [(t, n, x, y, th) for (t, n), (x, y, th) in fixed.items() if (t, n) in pos]
+    for r, (x, y, _) in fixed.items():
+        pos[r] = (x, y)
+    d0 = cfg.rules.setpiece_distance
+    for t, n, x, y in robots:
+        if (t, n) in fixed or (math.hypot(x - spot[0], y - spot[1]) >= d0 and not in_area(x, y)):
+            continue
+        others = [p for r, p in pos.items() if r != (t, n)]
+        for ring in range(8):
+            nx, ny = legal_spot(x, y, spot, d0 + ring * RING_STEP, others, cfg)
+            if not in_area(nx, ny):
+                break
+        pos[(t, n)] = (nx, ny)
+        moves.append((t, n, nx, ny, math.nan))  # nan: keeps its heading
+    return moves

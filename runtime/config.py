@@ -144,6 +144,8 @@ class RulesParams:
     drop_ball_inset: float = 1.0  # [m] a dropped ball is put this far inside the lines
     spot_inset: float = 0.5  # [m] free kicks and throw-ins stay this far from the lines they do not lie on
     corner_inset: float = 0.25  # [m] corner kick spot, from both lines (inside the corner arc)
+    yellow_fouls: int = 2  # a robot's 2nd foul: YELLOW_CARD; its 4th (2 x this): DOUBLE_YELLOW, sent off
+    red_fouls: int = 0  # a robot's foul number this many: RED_CARD, sent off (0: never)
 
 
 @dataclass(frozen=True)

@@ -163,6 +163,9 @@ class RefCommand(Base):
     x: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
     y: Annotated[float, Meta(description="[m] ball spot, field frame")] = 0.0
     tick: Annotated[int, Meta(description="tick at which the referee issued it")] = 0
+    robot: Annotated[
+        int, Meta(description="YELLOW_CARD, RED_CARD, DOUBLE_YELLOW, REPAIR_OUT: the robot's number; else -1")
+    ] = -1
 
 
 class Referee(Base):

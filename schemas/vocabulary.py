@@ -33,6 +33,11 @@ RefCommandName = Literal[
     "SECOND_HALF",
     "END_GAME",
     "PARK",
+    "GAMEOVER",
+    "YELLOW_CARD",
+    "RED_CARD",
+    "DOUBLE_YELLOW",
+    "REPAIR_OUT",
 ]
 StageName = Literal["PRE_GAME", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"]
 
@@ -42,7 +47,12 @@ STAGES: tuple[StageName, ...] = get_args(StageName)
 # Restarts after a stoppage: every set piece but the kick-off (which starts a half or follows a goal).
 RESTARTS: tuple[SetPieceName, ...] = tuple(s for s in get_args(SetPieceName) if s != "KICKOFF")
 
-assert set(SET_PIECES) <= REF_COMMANDS
+# Commands about one robot: they carry its team and number (RefCommand.robot).
+CARDS: frozenset[str] = frozenset({"YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW"})
+SEND_OFF: frozenset[str] = frozenset({"RED_CARD", "DOUBLE_YELLOW", "REPAIR_OUT"})  # the robot leaves the field
+ROBOT_COMMANDS: frozenset[str] = CARDS | {"REPAIR_OUT"}
+
+assert set(SET_PIECES) <= REF_COMMANDS and ROBOT_COMMANDS <= REF_COMMANDS
 
 
 def other_team(team: str) -> Team:

@@ -22,9 +22,9 @@ from tests.integration.helpers import ARENA, arena_json
 
 # From the protocol description: legacy characters (upper case cyan, lower case magenta).
 LEGACY = {"START": "s", "STOP": "S", "WELCOME": "W", "FIRST_HALF": "1", "SECOND_HALF": "2", "HALF_TIME": "h"}
-LEGACY |= {"END_GAME": "e", "DROP_BALL": "N", "PARK": "L"}
+LEGACY |= {"END_GAME": "e", "DROP_BALL": "N", "PARK": "L", "GAMEOVER": "z"}
 LEGACY_TEAM = {"KICKOFF": "K", "FREEKICK": "F", "GOALKICK": "G", "THROWIN": "T", "CORNER": "C", "GOAL": "A"}
-LEGACY_TEAM |= {"PENALTY": "P"}
+LEGACY_TEAM |= {"PENALTY": "P", "YELLOW_CARD": "Y", "RED_CARD": "R", "DOUBLE_YELLOW": "B", "REPAIR": "O"}
 CYAN, MAGENTA = "224.16.32.201", "224.16.32.202"  # the bridge's documented default targetTeam strings
 
 
@@ -162,7 +162,7 @@ def test_two_base_stations_in_a_realtime_match(tmp_path):
     names = [c for c, _ in cyan.commands]
     assert cyan.commands[:4] == [("WELCOME", CYAN), ("FIRST_HALF", ""), ("KICKOFF", CYAN), ("START", "")]
     assert in_order(cyan.commands, [("HALF_TIME", ""), ("SECOND_HALF", ""), ("KICKOFF", MAGENTA), ("START", "")])
-    assert names[-1] == "END_GAME"
+    assert names[-3:] == ["END_GAME", "PARK", "GAMEOVER"]
     # The legacy client got the very same commands, one character each.
     expected = "".join(
         LEGACY[c] if c in LEGACY else (LEGACY_TEAM[c] if t == CYAN else LEGACY_TEAM[c].lower())

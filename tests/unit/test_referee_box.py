@@ -72,7 +72,13 @@ CASES = [
         [("HALF_TIME", "", (0, 0)), ("SECOND_HALF", "", (0, 0)), ("KICKOFF", "b", (0, 0))],
         dict(stage="SECOND_HALF", attack_dir_a=-1, command="KICKOFF", start_at=HALF + KICKOFF_WAIT),
     ),
-    ("end of the match", SECOND, Clock(END), [("END_GAME", "", (0, 0))], dict(stage="END_GAME", command="END_GAME")),
+    (
+        "end of the match: END_GAME, PARK, GAMEOVER",
+        SECOND,
+        Clock(END),
+        [("END_GAME", "", (0, 0)), ("PARK", "", (0, 0)), ("GAMEOVER", "", (0, 0))],
+        dict(stage="END_GAME", command="END_GAME", start_at=-1),
+    ),
     ("nothing after the end", dict(stage="END_GAME", command="END_GAME"), Clock(END + 5), [], dict(stage="END_GAME")),
     (
         "set piece not taken in time: drop ball on its spot",
@@ -190,13 +196,90 @@ CASES = [
         dict(command_team="a"),
     ),
     (
-        "foul in a penalty area: free kick on its front line",
+        "foul by an attacker in the other penalty area: free kick on its front line",
         PLAYING,
-        ev("FOUL_PUSHING", team="b", robot=1, x=5.5, y=0.5),
-        [("STOP", "", (0, 0)), ("FREEKICK", "a", (4.5, 0.5))],
+        ev("FOUL_PUSHING", team="a", robot=1, x=5.5, y=0.5),
+        [("STOP", "", (0, 0)), ("FREEKICK", "b", (4.5, 0.5))],
         dict(),
     ),
-    ("a dead robot stops nothing", PLAYING, ev("ROBOT_DEAD", team="a", robot=2), [], dict(command="START")),
+    (
+        "foul by a defender in its own penalty area: PENALTY on the mark",
+        PLAYING,
+        ev("FOUL_PUSHING", team="b", robot=1, x=5.5, y=0.5),
+        [("STOP", "", (0, 0)), ("PENALTY", "a", (4.0, 0.0))],
+        dict(command="PENALTY", command_team="a", spot=(4.0, 0.0), start_at=100 + SETPIECE_WAIT),
+    ),
+    (
+        "penalty after the switch: the mark of the defender's goal",
+        SECOND,
+        ev("FOUL_DRIBBLING", team="a", robot=2, x=5.2, y=-2.0),
+        [("STOP", "", (0, 0)), ("PENALTY", "b", (4.0, 0.0))],
+        dict(command_team="b"),
+    ),
+    (
+        "penalty START: it must be taken",
+        dict(stage="FIRST_HALF", command="PENALTY", command_team="a", spot=(4.0, 0.0), start_at=150),
+        Clock(150),
+        [("START", "a", (4.0, 0.0))],
+        dict(take_by=150 + TAKE),
+    ),
+    # ------------------------------------------------------------- cards
+    (
+        "a robot's first foul: counted, no card",
+        PLAYING,
+        ev("FOUL_PUSHING", team="a", robot=1, x=1.0, y=2.0),
+        [("STOP", "", (0, 0)), ("FREEKICK", "b", (1.0, 2.0))],
+        dict(fouls=(("a", 1, 1),), off=()),
+    ),
+    (
+        "its second foul: YELLOW_CARD between STOP and the free kick",
+        dict(PLAYING, fouls=(("a", 1, 1), ("b", 2, 1))),
+        ev("FOUL_DRIBBLING", team="a", robot=1, x=1.0, y=2.0),
+        [("STOP", "", (0, 0)), ("YELLOW_CARD", "a", (1.0, 2.0)), ("FREEKICK", "b", (1.0, 2.0))],
+        dict(fouls=(("a", 1, 2), ("b", 2, 1)), off=(), command="FREEKICK"),
+    ),
+    (
+        "another robot's first foul: no card",
+        dict(PLAYING, fouls=(("a", 1, 1),)),
+        ev("FOUL_PUSHING", team="a", robot=2, x=1.0, y=2.0),
+        [("STOP", "", (0, 0)), ("FREEKICK", "b", (1.0, 2.0))],
+        dict(fouls=(("a", 1, 1), ("a", 2, 1))),
+    ),
+    (
+        "its fourth foul: DOUBLE_YELLOW, sent off",
+        dict(PLAYING, fouls=(("b", 2, 3),)),
+        ev("FOUL_PUSHING", team="b", robot=2, x=-1.0, y=0.0),
+        [("STOP", "", (0, 0)), ("DOUBLE_YELLOW", "b", (-1.0, 0.0)), ("FREEKICK", "a", (-1.0, 0.0))],
+        dict(fouls=(("b", 2, 4),), off=(("b", 2),)),
+    ),
+    (
+        "a foul without a robot: no card",
+        PLAYING,
+        ev("FOUL_PUSHING", team="a", x=1.0, y=2.0),
+        [("STOP", "", (0, 0)), ("FREEKICK", "b", (1.0, 2.0))],
+        dict(fouls=()),
+    ),
+    (
+        "a dead robot: REPAIR_OUT, play goes on",
+        PLAYING,
+        ev("ROBOT_DEAD", team="a", robot=2),
+        [("REPAIR_OUT", "a", (0, 0))],
+        dict(command="START", off=(("a", 2),)),
+    ),
+    (
+        "a dead robot while play is stopped: REPAIR_OUT all the same",
+        dict(stage="FIRST_HALF", command="FREEKICK", command_team="a", start_at=150),
+        ev("ROBOT_DEAD", team="b", robot=0),
+        [("REPAIR_OUT", "b", (0, 0))],
+        dict(command="FREEKICK", off=(("b", 0),)),
+    ),
+    (
+        "a robot already off: no second REPAIR_OUT",
+        dict(PLAYING, off=(("a", 2),)),
+        ev("ROBOT_DEAD", team="a", robot=2),
+        [],
+        dict(off=(("a", 2),)),
+    ),
 ]
 
 
@@ -210,6 +293,30 @@ def test_rule(name, state, change, want, fields):
         assert getattr(post, key) == value, key
     tick = change.tick
     assert all(c.tick == tick for c in cmds)
+    assert [c.robot >= 0 for c in cmds] == [
+        c.name in ("YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR_OUT") for c in cmds
+    ]
+    assert check_referee(Referee(tick=tick, stage="FIRST_HALF", command="START", commands=cmds)) is None
+
+
+RED = Rules.of(dataclasses.replace(CFG, rules=dataclasses.replace(CFG.rules, red_fouls=3)))
+
+
+@pytest.mark.parametrize(
+    ("fouls", "card"),
+    [(1, None), (2, "YELLOW_CARD"), (3, None), (4, "DOUBLE_YELLOW"), (5, None)],
+)
+def test_card_thresholds_default(fouls, card):
+    from arena.rules.referee_box import card_rule
+
+    assert card_rule(fouls, RULES) == card
+
+
+def test_red_card_threshold_sends_the_robot_off():
+    pre = RefereeState(**PLAYING, fouls=(("a", 3, 2),))
+    post, cmds = process(pre, ev("FOUL_PUSHING", team="a", robot=3, x=0.0, y=0.0), RED)
+    assert [(c.name, c.team, c.robot) for c in cmds] == [("STOP", "", -1), ("RED_CARD", "a", 3), ("FREEKICK", "b", -1)]
+    assert post.off == (("a", 3),) and post.fouls == (("a", 3, 3),)
 
 
 def test_process_is_pure():
@@ -239,6 +346,8 @@ def test_match_flow_and_append_only_log():
         "SECOND_HALF",
         "KICKOFF",
         "END_GAME",
+        "PARK",
+        "GAMEOVER",
     ]
     assert [e.id for e in box.log] == list(range(len(box.log)))
     for before, after in zip(box.log, box.log[1:]):
@@ -279,7 +388,11 @@ def _frame(**kw) -> Referee:
         (_frame(command_team="c"), "unknown team 'c'"),
         (_frame(commands=[RefCommand(name="KICKOFF", team="c")]), "KICKOFF for unknown team 'c'"),
         (_frame(commands=[RefCommand(name="KICKOFF")]), "KICKOFF without a target team"),
-        (_frame(commands=[RefCommand(name="YELLOW_CARD", team="a")]), "unknown command 'YELLOW_CARD'"),
+        (_frame(commands=[RefCommand(name="YELLOW_CARD", team="a")]), "YELLOW_CARD without a robot"),
+        (_frame(commands=[RefCommand(name="RED_CARD", robot=1)]), "RED_CARD without a target team"),
+        (_frame(commands=[RefCommand(name="REPAIR_OUT", team="b", robot=2)]), None),
+        (_frame(commands=[RefCommand(name="FREEKICK", team="b", robot=2)]), "FREEKICK with robot 2"),
+        (_frame(commands=[RefCommand(name="GAMEOVER")]), None),
         (_frame(commands=[RefCommand(name="DROP_BALL", x=float("nan"))]), "DROP_BALL spot is not finite"),
         (_frame(attack_dir_a=0), "attack_dir_a 0 (expected 1 or -1)"),
     ],

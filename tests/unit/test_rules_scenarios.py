@@ -16,7 +16,7 @@ import pytest
 from arena.processes.engine import Restarts
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.config import MatchConfig, RulesParams
-from arena.schemas.messages import Cmd, RefCommand
+from arena.schemas.messages import BallEvent, Cmd, RefCommand
 from arena.sim.physics import Physics
 
 CFG = MatchConfig(half_time=20.0, robots=3)
@@ -206,3 +206,80 @@ def test_no_progress_gives_a_drop_ball():
     m.kick_from("a", 1, -1.0, 1.0, 0.0, 0.5)  # a touch: the kickoff is taken, then the ball lies still
     m.run_until(lambda: not m.in_play(), 3.0)
     assert m.since(n) == [("STOP", ""), ("DROP_BALL", "")]
+
+
+# ------------------------------------------- penalty, cards, repair, end (issue 17)
+def _push(m: Match, offender: tuple[str, int], victim: tuple[str, int], x: float, y: float) -> None:
+    """`offender` drives from x + 1.3 (facing -x) into `victim`, standing still at (x, y)."""
+    m.ph.place_robot(*victim, x, y, 0.0)
+    m.ph.place_robot(*offender, x + 1.3, y, math.pi)
+    m.drive(*offender, vx=3.0)
+
+
+def _in_area(x: float, y: float, side: int) -> bool:
+    reach = CFG.robot.size * math.sqrt(0.5)
+    return side * x > F.length / 2 - F.penalty_area_depth - reach and abs(y) < F.penalty_area_width / 2 + reach
+
+
+def test_a_foul_by_a_defender_in_its_own_area_gives_a_penalty_with_the_procedure():
+    m = playing()  # first half: b defends the +x goal
+    n = len(m.commands)
+    _push(m, ("b", 2), ("a", 2), 5.0, 1.8)  # contact near x = 5.2: inside b's penalty area
+    m.run_until(lambda: not m.in_play())
+    assert m.since(n) == [("STOP", ""), ("PENALTY", "a")]
+    mark = (F.length / 2 - F.penalty_mark_distance, 0.0)
+    assert (m.commands[-1].x, m.commands[-1].y) == pytest.approx(mark)
+    for when in ("at PENALTY", "at START"):
+        if when == "at START":
+            m.ph.place_robot("b", 1, 5.0, -1.0, 0.0)  # walks into the area while the teams position
+            m.run_until(m.in_play, CFG.rules.setpiece_time + 0.2)
+            assert m.since(n)[-1] == ("START", "a")
+        else:
+            m.step()
+        assert m.ph.ball_state()[:2] == pytest.approx(mark, abs=1e-6), when
+        poses = {(t, k): (x, y) for t, k, x, y, *_ in m.ph.robot_states()}
+        assert poses[("b", 0)] == pytest.approx((F.length / 2 - CFG.robot.size / 2, 0.0), abs=0.01), when
+        assert poses[("a", 2)] == pytest.approx((mark[0] - 0.5, 0.0), abs=0.01), f"the taker, {when}"
+        for r, (x, y) in poses.items():
+            if r not in (("b", 0), ("a", 2)):
+                assert not _in_area(x, y, 1), f"{r} in the area {when}"
+                assert math.hypot(x - mark[0], y) >= CFG.rules.setpiece_distance - 1e-6, f"{r} {when}"
+
+
+def test_repeated_fouls_by_one_robot_give_cards_and_a_double_yellow_sends_it_off():
+    cfg = MatchConfig(half_time=20.0, robots=3, rules=RulesParams(yellow_fouls=1))  # 1st foul yellow, 2nd double
+    m = Match(cfg)
+    cards = []
+    for i in range(2):
+        m.run_until(m.in_play)
+        m.park_all()
+        n = len(m.commands)
+        _push(m, ("a", 1), ("b", 2), -1.0 + i, 1.0)
+        m.run_until(lambda: not m.in_play())
+        cards += [c for c in m.commands[n:] if c.name.endswith(("CARD", "YELLOW"))]
+    assert [(c.name, c.team, c.robot) for c in cards] == [("YELLOW_CARD", "a", 1), ("DOUBLE_YELLOW", "a", 1)]
+    m.step()
+    assert ("a", 1) in m.ph.parked() and m.box.state.off == (("a", 1),)
+    x, y = m.ph.robot_pose("a", 1)[:2]
+    assert abs(x) > F.length / 2 + F.runoff or abs(y) > F.width / 2 + F.runoff, "beyond the fence"
+    assert [s[1:] for s in m.restarts.sent_off] == [("a", 1, "DOUBLE_YELLOW")]
+    m.run_until(m.in_play, CFG.rules.setpiece_time + 0.2)  # play goes on, a short-handed
+    m.run(1.0)
+    assert ("a", 1) in m.ph.parked() and m.ph.robot_pose("a", 1)[:2] == pytest.approx((x, y))
+
+
+def test_a_dead_robot_is_taken_off_with_repair_out_and_play_goes_on():
+    m = playing()
+    n = len(m.commands)
+    m.events.append(BallEvent(kind="ROBOT_DEAD", tick=m.k, team="b", robot=1))  # as the engine reports it
+    m.run(0.3)
+    assert m.since(n) == [("REPAIR_OUT", "b")] and m.commands[-1].robot == 1
+    assert ("b", 1) in m.ph.parked() and m.in_play()
+
+
+def test_the_match_ends_with_end_game_park_and_gameover_and_play_stops():
+    cfg = MatchConfig(half_time=1.0, robots=1)
+    m = Match(cfg)
+    m.run(2 * cfg.half_time + 0.2)
+    assert [c.name for c in m.commands[-3:]] == ["END_GAME", "PARK", "GAMEOVER"]
+    assert m.commands[-1].tick == cfg.total_ticks and not m.ph.in_play

@@ -95,7 +95,7 @@ def test_a_plugin_entry_point_is_found_and_plays(monkeypatch):
         from arena.tools.inprocess import play_in_process
 
         summaries, _ = play_in_process(MatchConfig(seed=2, home="creep", away="BS", half_time=1.0), watch=())
-        assert summaries["referee"].extra["log"][-1]["command"] == "END_GAME"
+        assert [e["command"] for e in summaries["referee"].extra["log"][-3:]] == ["END_GAME", "PARK", "GAMEOVER"]
     finally:
         registry.all_strategies.cache_clear()
 
