@@ -169,7 +169,7 @@ def test_two_base_stations_in_a_realtime_match(tmp_path):
         for c, t in cyan.commands
     )
     assert magenta.chars == expected
-    assert magenta.chars.startswith("W1Ks") and "h2ks" in magenta.chars and magenta.chars.endswith("e")
+    assert magenta.chars.startswith("W1Ks") and "h2ks" in magenta.chars and magenta.chars.endswith("eLz")
 
     # Every bad worldstate counted with its reason; the match went on to the end.
     bad = {k: v for k, v in cyan.sent.items() if k != "good" and v}
@@ -215,9 +215,10 @@ def test_via_refbox_our_base_stations_through_the_bridge(tmp_path):
     )
     counts = result["refbox"]["counts"]
     assert counts["connections"] == 2 and "refused" not in counts
-    # WELCOME and every command from the first on; END_GAME may find a base station already gone.
+    # WELCOME and every command from the first on; the last tick's END_GAME, PARK and GAMEOVER
+    # may find a base station already gone.
     for team in ("a", "b"):
-        assert 0 <= result["refbox"]["commands_forwarded"] + 1 - counts[f"commands_to_{team}"] <= 1
+        assert 0 <= result["refbox"]["commands_forwarded"] + 1 - counts[f"commands_to_{team}"] <= 3
     assert counts["worldstates_a"] > 20 and counts["worldstates_b"] > 20
     review = json.loads(
         subprocess.run([*ARENA, "review", str(path), "--json"], capture_output=True, text=True, timeout=120).stdout
