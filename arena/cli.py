@@ -798,9 +798,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from arena.tools import bench
 
     if args.what == "record":
-        return bench.bench_record(args)
+        return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
     if args.what == "robot":
-        return bench.bench_robot(args)
+        return bench.bench_robot(args.strategy, args.json)
     if args.what == "throughput":
         from arena.tools import throughput
 
@@ -816,7 +816,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
             plots=args.plots,
             as_json=args.json,
         )
-    return bench.bench_match(args)
+    return bench.bench_match(args.runs, args.half_time, args.robots, args.link, args.json)
 
 
 def cmd_review(args: argparse.Namespace) -> int:

@@ -7,7 +7,6 @@ machine is shared and noisy, so every figure is a median over `--runs` runs.
 
 from __future__ import annotations
 
-import argparse
 import json
 import statistics
 import tempfile
@@ -21,32 +20,32 @@ from arena.runtime.config import MatchConfig
 from arena.tools import launcher
 
 
-def bench_match(args: argparse.Namespace) -> int:
+def bench_match(
+    runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
+) -> int:
     console = Console(stderr=True)
-    runs = []
-    for i in range(args.runs):
-        cfg = MatchConfig(seed=1000 + i, robots=args.robots, half_time=args.half_time, link=args.link)
-        console.print(
-            f"run {i + 1}/{args.runs}: 2 x {args.half_time:g} s, {args.robots}v{args.robots}, link {args.link} ..."
-        )
+    results = []
+    for i in range(runs):
+        cfg = MatchConfig(seed=1000 + i, robots=robots, half_time=half_time, link=link)
+        console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, {robots}v{robots}, link {link} ...")
         r = launcher.play_match(cfg)
-        runs.append(r)
+        results.append(r)
         console.print(f"  rtf {r['rtf']:.1f}x, {1000 * r['play_wall_seconds'] / max(1, r['ticks']):.3f} ms/tick")
-    rtf = statistics.median(r["rtf"] for r in runs)
-    ms_tick = statistics.median(1000 * r["play_wall_seconds"] / max(1, r["ticks"]) for r in runs)
-    startup = statistics.median(r["wall_seconds"] - r["play_wall_seconds"] for r in runs)
+    rtf = statistics.median(r["rtf"] for r in results)
+    ms_tick = statistics.median(1000 * r["play_wall_seconds"] / max(1, r["ticks"]) for r in results)
+    startup = statistics.median(r["wall_seconds"] - r["play_wall_seconds"] for r in results)
     per_kind: dict[str, list[float]] = {}
-    for r in runs:
+    for r in results:
         for p in r["processes"]:
             if p["tick_us_median"] is not None:
                 per_kind.setdefault(p["kind"], []).append(p["tick_us_median"])
     out = {
-        "runs": args.runs,
-        "half_time": args.half_time,
-        "robots": args.robots,
-        "link": args.link,
+        "runs": runs,
+        "half_time": half_time,
+        "robots": robots,
+        "link": link,
         "rtf_median": rtf,
-        "rtf_all": [r["rtf"] for r in runs],
+        "rtf_all": [r["rtf"] for r in results],
         "ms_per_tick_median": round(ms_tick, 4),
         "ticks_per_second": round(1000.0 / ms_tick, 1),
         "startup_seconds_median": round(startup, 2),
@@ -59,7 +58,7 @@ def bench_match(args: argparse.Namespace) -> int:
         ("process start-up [s]", f"{startup:.2f}"),
     ]
     rows += [(f"own work per tick, {k} [us]", f"{v:.0f}") for k, v in out["work_us_per_tick_median"].items()]
-    return print_metrics(out, f"arena bench match: median of {args.runs} runs", rows, args.json)
+    return print_metrics(out, f"arena bench match: median of {runs} runs", rows, as_json)
 
 
 def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: bool) -> int:
@@ -76,30 +75,32 @@ def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: b
     return 0
 
 
-def bench_record(args: argparse.Namespace) -> int:
+def bench_record(
+    runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
+) -> int:
     """The cost of `--record`: the same matches with and without a recorder, interleaved."""
     console = Console(stderr=True)
     plain, recorded, sizes = [], [], []
     with tempfile.TemporaryDirectory(prefix="arena-bench-") as tmp:
-        for i in range(args.runs):
-            base = MatchConfig(seed=1000 + i, robots=args.robots, half_time=args.half_time, link=args.link)
+        for i in range(runs):
+            base = MatchConfig(seed=1000 + i, robots=robots, half_time=half_time, link=link)
             path = Path(tmp) / f"run{i}.mcap"
             # Alternate which goes first, so that drift in the machine's load favours neither.
             order = [(False, ""), (True, str(path))]
             for rec, record in order if i % 2 == 0 else reversed(order):
                 r = launcher.play_match(base, record=record)
                 (recorded if rec else plain).append(r)
-                console.print(f"run {i + 1}/{args.runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
+                console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
             sizes.append(path.stat().st_size)
     rtf_plain = statistics.median(r["rtf"] for r in plain)
     rtf_rec = statistics.median(r["rtf"] for r in recorded)
     wall_plain = statistics.median(r["wall_seconds"] for r in plain)
     wall_rec = statistics.median(r["wall_seconds"] for r in recorded)
     out = {
-        "runs": args.runs,
-        "half_time": args.half_time,
-        "robots": args.robots,
-        "link": args.link,
+        "runs": runs,
+        "half_time": half_time,
+        "robots": robots,
+        "link": link,
         "rtf_median_plain": rtf_plain,
         "rtf_median_recorded": rtf_rec,
         "rtf_ratio": round(rtf_rec / rtf_plain, 3),
@@ -123,7 +124,7 @@ def bench_record(args: argparse.Namespace) -> int:
         ("recorder CPU [s]", f"{out['recorder_cpu_s_median']:.2f}"),
         ("MCAP file [MB]", f"{out['file_mb_median']:.2f}"),
     ]
-    return print_metrics(out, f"arena bench record: median of {args.runs} runs each", rows, args.json)
+    return print_metrics(out, f"arena bench record: median of {runs} runs each", rows, as_json)
 
 
 def robot_step_us(strategy: str = "advance-dynamic", batches: int = 200, per_batch: int = 50) -> dict[str, float]:
@@ -174,13 +175,13 @@ def robot_step_us(strategy: str = "advance-dynamic", batches: int = 200, per_bat
     return {"robot_step_us": statistics.median(samples), "fsfm_step_us": statistics.median(nav)}
 
 
-def bench_robot(args: argparse.Namespace) -> int:
+def bench_robot(strategy: str = "advance-dynamic", as_json: bool = False) -> int:
     """`arena bench robot`: median us per robot control step and per F-SFM step (5 obstacles)."""
-    out = {"strategy": args.strategy, **{k: round(v, 1) for k, v in robot_step_us(args.strategy).items()}}
-    if args.json:
+    out = {"strategy": strategy, **{k: round(v, 1) for k, v in robot_step_us(strategy).items()}}
+    if as_json:
         print(json.dumps(out, indent=2))
         return 0
-    t = Table(title=f"arena bench robot: {args.strategy}, medians of 200 batches of 50 steps")
+    t = Table(title=f"arena bench robot: {strategy}, medians of 200 batches of 50 steps")
     t.add_column("metric")
     t.add_column("value", justify="right")
     t.add_row(r"robot control step (perception, behaviour, navigation) \[us]", f"{out['robot_step_us']:.1f}")
