@@ -9,7 +9,8 @@ Per tick k (lockstep):
    the nearest legal place (`setpieces.py`, docs/rules.md), then frees the
    ball;
 2. publish every robot's `sense` for tick k, `world` (G_V), and every referee
-   period the ball `events` (G_Re) gathered since the previous frame;
+   period the ball `events` (G_Re) gathered since the previous frame, with
+   ROBOT_STUCK for robots driven but in one place (`StuckWatch`);
 3. step the physics from k to k+1 with the commands delivered by k, i.e. the
    robots' `cmd` of tick k-1: while the engine steps, the robots already think
    about tick k (a one-tick actuation delay, as on a real robot).
@@ -22,6 +23,9 @@ A robot whose process died (liveliness lost, or silent past the watchdog) is
 parked: taken off the field beyond the fence for the rest of the match, with no
 collisions, and the referee gets a ROBOT_DEAD event (docs/architecture.md,
 "Faults").
+
+A RED_CARD, DOUBLE_YELLOW or REPAIR_OUT parks its robot the same way, but its
+process plays on (`Restarts.sent_off`); PENALTY places the robots for it.
 
 Inputs are validated on the way in: a `cmd` with non-finite numbers or the
 wrong number of wheel speeds for the robot model, and a `referee` frame with
@@ -46,7 +50,7 @@ from arena.runtime.pace import Pacer
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
 from arena.schemas.vocabulary import SEND_OFF
 from arena.sim.drive import Drive
-from arena.sim.physics import Physics
+from arena.sim.physics import Physics, StuckWatch
 from arena.sim.sensors import NormalStream, sense
 
 
@@ -164,6 +168,7 @@ class EngineNode(Node):
         self.events_schedule = self.schedule("events")
         self.world_schedule = self.schedule("world")
         self.pending_events: list = []
+        self.stuck = StuckWatch(cfg)  # driven robots that stay in one place (ROBOT_STUCK)
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
         self.pacer = self._live_pacer()
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
@@ -229,6 +234,7 @@ class EngineNode(Node):
         if self.world_schedule.due(k):
             self.world_out.send(ph.world(k))
         if self.events_schedule.due(k):
+            self.pending_events.extend(self.stuck.check(ph))
             self.events_out.send(EngineEvents(tick=k, events=self.pending_events))
             self.pending_events = []
 

@@ -26,7 +26,7 @@ tabled in docs/rules.md:
 * discipline: every foul counts against the robot that committed it; its
   `yellow_fouls`-th foul adds YELLOW_CARD, its 2 x `yellow_fouls`-th
   DOUBLE_YELLOW, its `red_fouls`-th (if set) RED_CARD, between the STOP and
-  the restart. ROBOT_DEAD (at any time) gives REPAIR_OUT. DOUBLE_YELLOW,
+  the restart. ROBOT_DEAD and ROBOT_STUCK (at any time) give REPAIR_OUT. DOUBLE_YELLOW,
   RED_CARD and REPAIR_OUT send the robot off (`off`); the engine parks it.
 * END_GAME is followed on the same tick by PARK and GAMEOVER.
 
@@ -34,6 +34,10 @@ Every restart is the MSL set-piece procedure: STOP, then the command with
 its team and ball spot (`setpieces.py`), then after the positioning time
 START for the same team. Time is the tick it is handed; nothing here reads a
 clock or draws a random number.
+
+Longer than 150 lines on purpose: every rule of docs/rules.md is a few lines
+here, and they are read, tested and changed as one table, next to the state
+they share.
 """
 
 from __future__ import annotations
@@ -264,7 +268,7 @@ def send_off(st: RefereeState, c: RefCommand) -> tuple[RefereeState, tuple[RefCo
 
 
 def repair_out_rule(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result:
-    """ROBOT_DEAD: REPAIR_OUT for it, once, whether the ball is in play or not; play goes on."""
+    """ROBOT_DEAD, ROBOT_STUCK: REPAIR_OUT for it, once, whether the ball is in play or not; play goes on."""
     if ev.team not in TEAMS or ev.robot < 0 or (ev.team, ev.robot) in st.off:
         return st, []
     st, cards = send_off(*issue(st, tick, "REPAIR_OUT", ev.team, (0.0, 0.0), ev.robot))
@@ -283,7 +287,7 @@ EVENT_RULES: dict[str, EventRule] = {
 
 
 def on_event(st: RefereeState, tick: int, ev: BallEvent, rules: Rules) -> Result:
-    if ev.kind == "ROBOT_DEAD":
+    if ev.kind in ("ROBOT_DEAD", "ROBOT_STUCK"):
         return repair_out_rule(st, tick, ev, rules) if st.stage != "END_GAME" else (st, [])
     if not st.in_play or ev.tick <= st.issued_at:
         return st, []  # stopped, or it happened before START: stale

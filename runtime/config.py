@@ -146,6 +146,8 @@ class RulesParams:
     corner_inset: float = 0.25  # [m] corner kick spot, from both lines (inside the corner arc)
     yellow_fouls: int = 2  # a robot's 2nd foul: YELLOW_CARD; its 4th (2 x this): DOUBLE_YELLOW, sent off
     red_fouls: int = 0  # a robot's foul number this many: RED_CARD, sent off (0: never)
+    stuck_s: float = 20.0  # [s] driven but within stuck_radius this long: ROBOT_STUCK -> REPAIR_OUT (0: never)
+    stuck_radius: float = 0.2  # [m] see stuck_s
 
 
 @dataclass(frozen=True)

@@ -189,14 +189,17 @@ class BallEvent(Base):
 
     kind: Annotated[
         str,
-        Meta(description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, FOUL_PUSHING, FOUL_DRIBBLING, ROBOT_DEAD"),
+        Meta(
+            description="GOAL, TOUCH_LINE, GOAL_LINE, NO_PROGRESS, TOUCH, FOUL_PUSHING, FOUL_DRIBBLING, "
+            "ROBOT_DEAD, ROBOT_STUCK"
+        ),
     ]
     tick: Annotated[int, Meta(description="tick at which it happened")]
     team: Annotated[
         TeamOrNone,
         Meta(
             description="GOAL: scoring team; GOAL_LINE: the team defending that goal line; "
-            "TOUCH: toucher's team; FOUL_*: offender's team; ROBOT_DEAD: the robot's team"
+            "TOUCH: toucher's team; FOUL_*: offender's team; ROBOT_DEAD, ROBOT_STUCK: the robot's team"
         ),
     ] = ""
     robot: Annotated[int, Meta(description="robot involved (toucher, offender, dead robot), -1 if none")] = -1

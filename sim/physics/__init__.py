@@ -16,6 +16,7 @@ One `Physics` per match, assembled from one module per concern:
 * `events.py`: touches, line crossings, goals, no progress and fouls, and
   play on or off;
 * `placement.py`: robot placement, parking and kick-off positions;
+* `stuck.py`: robots driven but staying in one place (ROBOT_STUCK), asked by the engine;
 * `state.py`: the reads (poses, `World`);
 * `bodies.py`: the constants and the per-robot record.
 
@@ -35,8 +36,10 @@ from arena.sim.physics.bodies import (
     PIN_TOLERANCE,
 )
 from arena.sim.physics.model import Physics
+from arena.sim.physics.stuck import StuckWatch
 
 __all__ = [
+    "StuckWatch",
     "BOUNCE_STOP",
     "CATCH_MAX_Z",
     "CHALLENGE_DIST",

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import RobotState, World
 
@@ -16,6 +18,11 @@ class State:
             (r.team, r.n, s[r.off], s[r.off + 1], wrap_angle(s[r.off + 2]), s[r.off + 3], s[r.off + 4], s[r.off + 5])
             for r in self._robots
         ]
+
+    def commanded_speed(self, team: str, n: int) -> float:
+        """[m/s] the linear speed robot n's command asks for (within the limits); 0 when parked."""
+        r = self._by_id[(team, n)]
+        return 0.0 if r.parked else math.hypot(r.twist[0], r.twist[1])
 
     def robot_pose(self, team: str, n: int) -> tuple[float, float, float]:
         """(x [m], y [m], theta [rad] in (-pi, pi]) in the field frame."""

@@ -274,6 +274,13 @@ CASES = [
         dict(command="FREEKICK", off=(("b", 0),)),
     ),
     (
+        "a stuck robot: REPAIR_OUT, play goes on",
+        PLAYING,
+        ev("ROBOT_STUCK", team="b", robot=1, x=2.0, y=4.6),
+        [("REPAIR_OUT", "b", (0, 0))],
+        dict(command="START", off=(("b", 1),)),
+    ),
+    (
         "a robot already off: no second REPAIR_OUT",
         dict(PLAYING, off=(("a", 2),)),
         ev("ROBOT_DEAD", team="a", robot=2),

@@ -17,7 +17,7 @@ from arena.processes.engine import Restarts
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.config import MatchConfig, RulesParams
 from arena.schemas.messages import BallEvent, Cmd, RefCommand
-from arena.sim.physics import Physics
+from arena.sim.physics import Physics, StuckWatch
 
 CFG = MatchConfig(half_time=20.0, robots=3)
 F = CFG.field
@@ -35,12 +35,14 @@ class Match:
         self.ph.stop_play()
         self.box = RefereeBox(cfg)
         self.restarts = Restarts(cfg, self.ph)
+        self.stuck = StuckWatch(cfg)
         self.k = 0
         self.events = []
         self.commands: list[RefCommand] = []
 
     def step(self) -> None:
         if self.k % self.cfg.timing.referee_period == 0:
+            self.events += self.stuck.check(self.ph)  # as the engine does before it sends its events
             cmds = self.box.step(self.k, self.events)
             self.events = []
             self.commands += cmds
@@ -275,6 +277,24 @@ def test_a_dead_robot_is_taken_off_with_repair_out_and_play_goes_on():
     m.run(0.3)
     assert m.since(n) == [("REPAIR_OUT", "b")] and m.commands[-1].robot == 1
     assert ("b", 1) in m.ph.parked() and m.in_play()
+
+
+def test_a_robot_driven_into_the_fence_is_stuck_and_taken_off_with_repair_out():
+    cfg = MatchConfig(half_time=20.0, robots=3, rules=RulesParams(stuck_s=2.0))
+    m = Match(cfg)
+    m.run_until(m.in_play)
+    m.park_all()
+    n = len(m.commands)
+    fence_y = F.width / 2 + F.runoff
+    m.ph.place_robot("a", 2, 2.0, fence_y - 0.4, math.pi / 2)  # facing the fence, 0.4 m from it
+    m.ph.place_robot("b", 2, -2.0, 0.0, 0.0)  # driven freely round the field: never stuck
+    m.drive("a", 2, vx=1.0)
+    for _ in range(int(round(2.8 / cfg.timing.dt))):
+        m.drive("b", 2, vx=1.0, omega=1.0)
+        m.step()
+    assert m.since(n) == [("REPAIR_OUT", "a")] and m.commands[-1].robot == 2
+    assert m.ph.parked() == [("a", 2)] and m.in_play(), "taken off; play goes on"
+    assert m.box.log[-1].cause == "robot_stuck a/2"
 
 
 def test_the_match_ends_with_end_game_park_and_gameover_and_play_stops():

@@ -1,0 +1,46 @@
+"""Stuck robots: driven, yet in one place for `stuck_s` (docs/rules.md rule 25, REPAIR_OUT).
+
+The engine asks every referee period (`StuckWatch.check`). A robot counts as
+driven while its command asks for more than `DRIVEN_SPEED` of linear speed;
+its clock restarts whenever it is not driven, gets more than `stuck_radius`
+from where the clock started, or the ball is not in play (robots positioning
+for a set piece may wait on each other). A stuck robot is reported once as
+ROBOT_STUCK, and again only after another `stuck_s`. Pure function of the
+physics state: no clock, no randomness.
+"""
+
+from __future__ import annotations
+
+import math
+
+from arena.runtime.config import MatchConfig
+from arena.schemas.messages import BallEvent
+
+DRIVEN_SPEED = 0.1  # [m/s] commanded linear speed above which a robot is trying to move
+
+
+class StuckWatch:
+    def __init__(self, cfg: MatchConfig):
+        r = cfg.rules
+        self.ticks = int(round(r.stuck_s / cfg.timing.dt)) if r.stuck_s > 0 else 0
+        self.radius = r.stuck_radius
+        self.anchor: dict[tuple[str, int], tuple[float, float, int]] = {}  # where and when its clock started
+
+    def check(self, ph) -> list[BallEvent]:
+        """ROBOT_STUCK for every robot of `ph` (a Physics) stuck as of its current tick."""
+        if self.ticks <= 0:
+            return []
+        k, out = ph.tick, []
+        parked = set(ph.parked())
+        for t, n, x, y, *_ in ph.robot_states():
+            r = (t, n)
+            if r in parked or not ph.in_play or ph.commanded_speed(t, n) <= DRIVEN_SPEED:
+                self.anchor.pop(r, None)
+                continue
+            a = self.anchor.get(r)
+            if a is None or math.hypot(x - a[0], y - a[1]) > self.radius:
+                self.anchor[r] = (x, y, k)
+            elif k - a[2] >= self.ticks:
+                out.append(BallEvent(kind="ROBOT_STUCK", tick=k, team=t, robot=n, x=x, y=y))
+                self.anchor[r] = (x, y, k)
+        return out
