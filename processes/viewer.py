@@ -182,7 +182,7 @@ class ViewerNode(Node):
             return [p for p in self._parameters() if not param_names or p.name in param_names]
 
     def on_set_parameters(self, client, parameters, request_id=None):  # noqa: ARG002 - SDK callback
-        """Runs on the SDK's thread: queue a `Control` frame for the main loop to send."""
+        """Runs on the SDK's thread: sends a `Control` frame to the engine at once."""
         if not self.lockstep_control:
             return self._parameters()
         with self._lock:

@@ -265,6 +265,9 @@ window.addEventListener("error", function () {
     while (lo < hi) { var mid = (lo + hi) >> 1; if (frames[mid][0] < tick) lo = mid + 1; else hi = mid; }
     pos = lo; draw();
   }
+  // Timers rather than requestAnimationFrame: a page in a background tab or a headless
+  // browser keeps playing, and a browser's virtual time (tests) drives it exactly.
+  function later() { setTimeout(function () { step(performance.now()); }, 40); }
   function step(now) {
     if (!playing) { last = null; return; }
     if (last !== null) {
@@ -273,11 +276,11 @@ window.addEventListener("error", function () {
     }
     last = now;
     draw();
-    if (playing) requestAnimationFrame(step);
+    if (playing) later();
   }
   function setPlaying(p) {
     playing = p; playBtn.textContent = p ? "pause" : "play";
-    if (p) { if (pos >= frames.length - 1) pos = 0; requestAnimationFrame(step); }
+    if (p) { if (pos >= frames.length - 1) pos = 0; later(); }
   }
   playBtn.addEventListener("click", function () { setPlaying(!playing); });
   slider.addEventListener("input", function () { pos = Number(slider.value); draw(); });

@@ -85,10 +85,13 @@ def test_chromium_draws_the_field_and_six_robots_with_no_console_errors(page):
 
 def test_chromium_plays_the_match_and_a_screenshot_is_taken(page):
     tmp, html, _ = page
-    r = open_in_chromium(tmp, html.as_uri() + "#play", "--dump-dom", "--virtual-time-budget=4000")
+    r = open_in_chromium(tmp, html.as_uri() + "#play", "--dump-dom", "--virtual-time-budget=3000")
     attrs = body_attributes(r.stdout)
-    assert int(attrs["frame"]) > 0 and attrs["robots"] == "6" and attrs["errors"] == "0", attrs
+    assert 10 <= int(attrs["frame"]) <= 40 and attrs["robots"] == "6" and attrs["errors"] == "0", attrs
     assert console_errors(r.stderr) == []
+    r = open_in_chromium(tmp, html.as_uri() + "#t=12", "--dump-dom", "--virtual-time-budget=1000")
+    attrs = body_attributes(r.stdout)
+    assert attrs["frame"] == "120" and attrs["robots"] == "6", attrs  # 10 frames a second
     shot = tmp / "replay.png"
     r = open_in_chromium(tmp, html.as_uri(), f"--screenshot={shot}", "--window-size=1100,900")
     assert r.returncode == 0 and shot.stat().st_size > 10_000
