@@ -62,3 +62,41 @@ def test_start_goal_subgoal_half_time():
 def test_ignored_with_a_reason(command):
     st, cmds, why = follow(PLAYING, 5, command, (0.0, 0.0), RULES, PARAMS)
     assert st == PLAYING and cmds == [] and why
+
+
+@pytest.mark.parametrize(
+    ("command", "name", "team", "robot"),
+    [
+        (rp.Command("YELLOW_CARD", target=CYAN, robot_id=2), "YELLOW_CARD", "a", 2),
+        (rp.Command("RED_CARD", target=MAGENTA, robot_id=0), "RED_CARD", "b", 0),
+        (rp.Command("REPAIR", target=MAGENTA, robot_id=1), "REPAIR_OUT", "b", 1),  # the 2020 name of ours
+        (rp.Command("GAMEOVER"), "GAMEOVER", "", -1),
+    ],
+)
+def test_cards_repair_and_gameover_are_mirrored_with_the_robot(command, name, team, robot):
+    st, cmds, why = follow(PLAYING, 5, command, (0.0, 0.0), RULES, PARAMS)
+    assert not why
+    assert [(c.name, c.team, c.robot) for c in cmds] == [(name, team, robot)]
+    assert st.command == "STOP"  # announcements: the command in force stays
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        rp.Command("YELLOW_CARD", target=CYAN),  # the RefBox's own cards name no robot
+        rp.Command("DOUBLE_YELLOW", colour="cyan"),  # nor do the legacy ones
+        rp.Command("RED_CARD", target=CYAN, robot_id=CFG.robots),  # not one of ours
+    ],
+)
+def test_a_card_without_a_robot_of_ours_is_ignored_with_a_reason(command):
+    st, cmds, why = follow(PLAYING, 5, command, (0.0, 0.0), RULES, PARAMS)
+    assert st == PLAYING and cmds == [] and "robotID" in why
+
+
+def test_bridge_spells_robot_commands_as_the_refbox_does():
+    assert rp.encode_json(rp.OUR_TO_WIRE.get("REPAIR_OUT", "REPAIR_OUT"), "t", 2) == (
+        b'{"command":"REPAIR","targetTeam":"t","robotID":2}\0'
+    )
+    assert rp.encode_json("YELLOW_CARD", "t", 1) == b'{"command":"YELLOW_CARD","targetTeam":"t","robotID":1}\0'
+    assert rp.encode_json("KICKOFF", "t", 1) == b'{"command":"KICKOFF","targetTeam":"t"}\0'
+    assert rp.encode_legacy("DOUBLE_YELLOW", "magenta") == b"b" and rp.encode_legacy("GAMEOVER") == b"z"
