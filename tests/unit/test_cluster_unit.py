@@ -1,0 +1,86 @@
+"""tools/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
+
+The real cluster is exercised in tests/integration/test_cluster.py.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from arena.runtime.config import ConfigError
+from arena.tools import cluster
+from arena.tools.tournament import Fixture
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_fingerprint_covers_every_installed_package():
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    top = {p.split(".")[1] for p in declared if p.count(".") >= 1}
+    assert top == set(cluster.PACKAGES), "add the new package to cluster.PACKAGES so the version check sees it"
+    fp = cluster.fingerprint()
+    assert set(fp) == {"version", "git", "source"} and len(fp["source"]) == 16
+    assert cluster.source_hash() == fp["source"]
+
+
+@pytest.mark.parametrize(
+    ("text", "want"),
+    [(None, None), ("", None), ("auto", "auto"), ("10.0.0.5:6379", "10.0.0.5:6379"), ("[::1]:6379", "[::1]:6379")],
+)
+def test_addresses(text, want):
+    assert cluster.parse_address(text) == want
+
+
+@pytest.mark.parametrize("text", ["nowhere", "host:", ":6379", "host:0", "host:70000", "host:port"])
+def test_bad_addresses(text):
+    with pytest.raises(ConfigError, match="HOST:PORT"):
+        cluster.parse_address(text)
+
+
+def test_runtime_env():
+    assert cluster.parse_runtime_env(None) is None
+    assert cluster.parse_runtime_env('{"pip": ["x"]}') == {"pip": ["x"]}
+    for bad in ("{pip", "[1]", "3"):
+        with pytest.raises(ConfigError, match="--ray-runtime-env"):
+            cluster.parse_runtime_env(bad)
+
+
+def test_task_cpus_by_engine():
+    assert cluster.task_cpus(SimpleNamespace(engine="processes")) == 2.0
+    assert cluster.task_cpus(SimpleNamespace(engine="inprocess")) == 1.0
+
+
+@pytest.fixture
+def runner(tmp_path):
+    (tmp_path / "matches").mkdir()
+    (tmp_path / "logs").mkdir()
+    return SimpleNamespace(matches_dir=tmp_path / "matches", logs_dir=tmp_path / "logs", engine="processes")
+
+
+FX = Fixture(0, "basic-static", "advance-dynamic", 1, "basic-static", "advance-dynamic", 42)
+MATCH = {"score": [1, 2], "distance_m": {"a/1": 3.0}, "rtf": 20.0, "digest": "d" * 32, "engine": "processes"}
+
+
+def test_an_ok_attempt_is_written_once(runner):
+    r = cluster.finish(runner, FX, 1, {"rc": 0, "out": json.dumps(MATCH), "err": "", "wall": 1.5, "node": "n1"})
+    assert r.status == "ok" and r.score == [1, 2] and r.attempts == 1
+    saved = json.loads((runner.matches_dir / f"{FX.id}.json").read_text())
+    assert saved["digest"] == MATCH["digest"]
+    assert "played on node n1" in (runner.logs_dir / f"{FX.id}.log").read_text()
+
+
+def test_a_failed_attempt_is_played_again_then_recorded(runner):
+    mismatch = {"rc": -1, "reason": "version mismatch on node n2: ...", "node": "n2"}
+    assert cluster.finish(runner, FX, 1, mismatch) is None
+    assert not (runner.matches_dir / f"{FX.id}.json").exists()
+    r = cluster.finish(runner, FX, 2, mismatch)
+    assert r.status == "failed" and r.attempts == 2 and r.reason.startswith("version mismatch")
+    no_json = cluster.finish(runner, FX, 2, {"rc": 0, "out": "garbage", "err": "", "wall": 1.0, "node": "n1"})
+    assert no_json.status == "failed" and no_json.reason == "the match printed no JSON"
+    crashed = cluster.finish(runner, FX, 2, {"rc": 1, "out": "", "err": "boom\nlast line\n", "wall": 1.0})
+    assert crashed.reason == "last line"
