@@ -121,7 +121,9 @@ def test_sigkill_of_the_recorder_leaves_a_file_review_reads_and_calls_truncated(
     path = tmp_path / "killed.mcap"
     match = _signal_the_recorder_mid_match(path, reap, signal.SIGKILL, 400_000)
     _, err = match.communicate(timeout=60)
-    assert match.returncode == 1 and "recorder" in err, "the launcher stops a match whose child crashed"
+    # Play goes on without recording: a fault, flagged, exit 0 (issue 15; --strict would stop the match).
+    assert match.returncode == 0, err
+    assert "fault: recorder" in err and "Traceback" not in err
     r = subprocess.run([*ARENA, "review", str(path), "--json"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     review = json.loads(r.stdout)
