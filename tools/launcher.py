@@ -612,6 +612,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "events": dict(sorted(referee.extra.get("events", {}).items())) if referee else {},
         "distance_m": engine.extra.get("distance_m", {}) if engine else {},
         "parked": engine.extra.get("parked", {}) if engine else {},
+        "sent_off": engine.extra.get("sent_off", []) if engine else [],  # cards and REPAIR_OUT (docs/rules.md)
         "rejected": sum(rejected.values()),
         "rejected_reasons": dict(rejected),
         "dead": honest["dead"],
