@@ -39,6 +39,7 @@ from arena.schemas.messages import Referee, Summary
 from arena.tools import forkstart
 from arena.tools.faults import VOIDING, exit_reason
 from arena.tools.faults import outcome as match_outcome
+from arena.tools.witness import Witness
 
 _PR_SET_PDEATHSIG = 1
 
@@ -395,6 +396,7 @@ def supervise(
     progress: Progress,
     timeout: float | None = None,
     strict: bool = False,
+    witness: Witness | None = None,
 ) -> Collected:
     """Wait for every expected summary, within bounds; note every failure by name.
 
@@ -456,6 +458,8 @@ def supervise(
                         acks[name](b"ack")  # the sender repeats it until acknowledged
                     continue
                 why = implausible(s, name, cfg, expected)
+                if why is None and witness is not None:
+                    why = witness.check(name, s.digest)
                 if why is not None:
                     sums.count(name, why)
                     continue
@@ -724,6 +728,8 @@ def play_match(
         with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
+            # An external's digest is recomputed from the frames it puts (tools/witness.py).
+            witness = Witness(transport, keys, cfg.robots, {str(p) for p in external})
             if starter is not None:
                 starter.release()
             for p in cfg.processes() if starter is None else ():
@@ -748,6 +754,7 @@ def play_match(
                     [str(p) for p in cfg.processes()],
                     Progress(cfg.total_ticks, progress),
                     strict=strict,
+                    witness=witness,
                 )
             finally:
                 joins.close()
@@ -762,6 +769,7 @@ def play_match(
                 pass
         result = assemble(cfg, got, time.monotonic() - t_start, children, record)
         result["secure"] = secure
+        result["digests_verified"] = [n for n in witness.verified() if n in got.summaries]
         result["startup_seconds"] = startup_seconds(got.summaries, launched)
         result["launch"] = "exec" if starter is None else "fork"
         engine = got.summaries.get("engine")
