@@ -47,7 +47,7 @@ from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.runtime.pace import Pacer
-from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee
+from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee, encode
 from arena.schemas.vocabulary import SEND_OFF
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics, StuckWatch
@@ -172,6 +172,8 @@ class EngineNode(Node):
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
         self.pacer = self._live_pacer()
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
+        # `field` is put once, at tick 0; a late joiner (a viewer, a spectator) gets it with a `get`.
+        self.transport.serve(self.keys.key("field"), encode(self.field_spec()))
 
     def _live_pacer(self) -> Pacer | None:
         """A live lockstep match (`--live`): the viewer's pace, pause and steps (runtime/pace.py)."""

@@ -64,7 +64,7 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
     # read it; a process started by hand (`arena run`) prints the final score from it.
     reads = list(dict.fromkeys([*receives, *own_in, prefix + KEY_BY_NAME["referee"].rel()]))
     barrier = [f"{prefix}{ALIVE}/**", f"{prefix}{COLLECTOR}"]
-    config = [f"{prefix}{CONFIG}"]
+    config = [f"{prefix}{CONFIG}", prefix + KEY_BY_NAME["field"].rel()]  # both served by the engine
     perms = {
         "put/ingress": writes,
         # Who subscribes is no secret (the key table is public), and a sender

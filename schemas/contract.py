@@ -189,6 +189,123 @@ def schedules(periods: dict[str, int] | None = None) -> str:
     return "\n".join(rows)
 
 
+CLIENT = f"""
+## Writing a process in another language
+
+Everything a C++ or Rust client of a match must do beyond the message tables;
+tests/integration/readme_robot.py is a robot written from this section alone
+(plain msgpack and zenoh), and a test plays it through `arena match --external`.
+
+**Joining.** `arena match --external a/1 --listen <endpoint>` prints the
+command that starts the missing process, with the match id (`--match`), the
+router's endpoint (`--connect`) and its credentials file (`--credentials`,
+see "Security" below). Open a zenoh session in `client` mode to that endpoint
+(scouting off), then, in this order: subscribe to the keys you receive
+(`field` included: the engine also serves it as a queryable, so a late joiner
+gets it with a `get` on `arena/<match>/field`), watch liveliness on
+`arena/<match>/alive/**` and `arena/<match>/{COLLECTOR}`, and declare your own
+liveliness token `arena/<match>/{ALIVE}/<process>` (e.g. `alive/robot/a/1`).
+The engine starts tick 0 once every process's token is present. The match
+configuration is the JSON answer of a `get` on `arena/<match>/{CONFIG}` (see
+"Configuration" below).
+
+**A robot's schedule** (lockstep). For every tick k = 0 .. `total_ticks`
+(from `field` or the configuration): wait for `sense` of tick k (and, to use
+them, the `order`s due by k: sent at 1, 6, 11, ..., delivered one tick
+later), then put exactly one `cmd` with `tick` = k, and at every comm tick
+(k % `timing.comm_period` == 0) one `report` with `tick` = k, in that order
+(cmd, then report). The engine sends `sense` k only once it has every `cmd`
+of tick k-1, so the match goes exactly as fast as its slowest process; there
+are no other deadlines. **One missing scheduled frame** (a `cmd`, or a
+`report` at a comm tick) stalls every process that waits on it, and so the
+whole match, for `timing.wait_timeout` (60 s by default) of wall time; then
+its receiver treats the sender as dead for the rest of the match (the engine
+parks a dead robot beyond the fence) and the match ends
+`completed_with_faults`, naming it under `dead`. A frame for a tick that is
+not the next scheduled one is rejected and does not stand in for the missing
+one.
+
+**QoS of a put.** Every data key, `{SUMMARY}`, `{TAP}` and `{ACK}`: reliability
+RELIABLE, congestion control BLOCK, priority DATA (zenoh's default, 5),
+express off, encoding `application/msgpack`; zenoh delivers one session's
+puts in order, and the lockstep relies on it. `world` (nobody waits for it)
+is RELIABLE with congestion control DROP and is put only while a subscriber
+matches. Keys you receive: any default subscriber.
+
+**Commands and stages.** `Referee.command`, `RefCommand.name` and
+`Order.command` take only the MSL RefBox names listed in their tables; a
+frame with any other name (or an unknown `stage`) does not decode as its
+message type: it is rejected and counted as `malformed` and stands in for
+nothing (the link still waits for a good frame of that tick). The referee issues FIRST_HALF
+and KICKOFF at tick 0, HALF_TIME, SECOND_HALF and KICKOFF in one tick at half
+time, and END_GAME, PARK, GAMEOVER at tick `total_ticks`, so the `stage`
+values that occur on the wire are `FIRST_HALF`, `SECOND_HALF` and
+`END_GAME`; `PRE_GAME` and `HALF_TIME` are in the type (the RefBox's own
+names) but are never sent.
+
+**Wheels.** `Cmd.mode = "wheels"` gives one angular speed [rad/s] per wheel,
+positive = the wheel's rim moves counter-clockwise around the robot's centre
+(a positive speed on every wheel turns the robot to the left, +omega). The
+wheel count and order come from the configuration's `robot.model`:
+`omni4` (MSL default, the IRIS robot): 4 wheels at 45, 135, 225, 315 degrees
+from the body's +x axis, in that order, wheel speed
+(-sin(a) vx + cos(a) vy + l omega) / r with l = `robot.wheel_base`,
+r = `robot.wheel_radius`; `omni3` (Robotino, KRSBI-B): 3 wheels at 180, 60,
+-60 degrees, same formula; `diff`: 2 wheels, left then right. A `wheels` list
+of another length is rejected (`invalid`), as is an empty one in wheels mode.
+Speeds are saturated at `robot.max_wheel_speed` by scaling the whole vector.
+
+**NaN and infinity.** A frame with a NaN or an infinity in any float field is
+rejected as `invalid` and counted. If it was the in-sequence frame of its
+link, a safe default stands in for it, so the link still advances and nobody
+waits: a `cmd` becomes zero velocity, dribbler off, no kick; an
+`engine/events` or `referee` frame carries no new events or commands; any
+other key repeats the previous good message of its link. Your robot is then
+stopped for that tick, not the match.
+
+**Configuration** (`get` on `arena/<match>/{CONFIG}`, UTF-8 JSON). Top-level
+fields: `seed`, `robots` (per team, goalkeeper 0 included), `home`, `away`
+(strategy names), `half_time` [s], `timing` (`dt` [s], `comm_period`,
+`referee_period`, `world_period` [ticks], `wait_timeout`, `startup_timeout`
+[s], `substeps`), `robot` (`model`, `wheel_base`, `wheel_radius`,
+`max_wheel_speed`, `max_speed`, `max_omega`, `kick_max_speed`, ... in SI
+units), `field` (geometry, as in FieldSpec), `ball`, `sensor`, `rules`,
+`link` and `link_overrides` (the link emulation), `external`, `realtime`,
+`tap` (true in a recorded match: send tap batches), `refbox`, `live`, `pace`.
+`total_ticks` = 2 round(`half_time` / `dt`). Unknown fields may be added;
+ignore them.
+
+**The Summary is mandatory.** After your last tick put one `Summary` on
+`arena/<match>/{SUMMARY}/<process>`, with its MAC (see "Security"), and while
+the `{COLLECTOR}` liveliness token is present, put it again every 0.25 s
+until a sample (payload `ack`) arrives on `arena/<match>/{ACK}/<process>`,
+for at most 5 s; only then close the session. A process with no accepted
+Summary is a fault: `sent no summary`, and the match is not `completed`.
+Fill it as: `tick` = your last tick (`total_ticks`), `process`, `pid`,
+`sent` = frames put, `sent_by_key` = frames per key without the
+`arena/<match>/` prefix (their sum must equal `sent`), `rejected` and
+`rejected_reasons` (their sum must equal `rejected`; 0 and {{}} if you reject
+nothing), `dead` (processes you stopped waiting for, else []), and `extra`:
+a map of your own results, free-form for a robot or base station (the
+launcher reads `extra` only from the engine: `distance_m`, `parked`,
+`sent_off`; the referee: `score`, `events`, `log`; the recorder: `path`,
+`complete`, `gaps`); `{{}}` is fine. Every other field may keep its default.
+
+**The Summary digest** is BLAKE2b with a 16-byte digest (no key) over every
+frame you put on a data key, in the order you put them: for each frame, the
+key without the `arena/<match>/` prefix (UTF-8, e.g. `robot/a/1/cmd`), the
+payload's length as 4 bytes little-endian, and the payload bytes exactly as
+put; `digest` is its lowercase hex (32 digits). Summaries, taps and acks are
+not part of it. **It is checked:** for every `--external` process the
+launcher (the match's router) recomputes the digest from the frames it
+receives from that process (tools/witness.py), and a Summary whose digest
+differs is refused (counted under `forged_summaries`, the process gets no
+summary); the match JSON lists the processes so checked under
+`digests_verified`. The launcher's own processes are its code; their digests
+are pinned by tests (same seed, same digest).
+"""
+
+
 SECURITY = f"""
 ## Security
 
@@ -288,6 +405,7 @@ def render() -> str:
             cons = _constraints(t)
             text = description + (f" ({cons})" if cons else "")
             lines.append(f"| `{f.name}` | {_type_name(t)} | {text} | {_default(f)} |")
+    lines.append(CLIENT.rstrip("\n"))
     lines.append(SECURITY.rstrip("\n"))
     lines.append("")
     return "\n".join(lines)

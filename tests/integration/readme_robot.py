@@ -1,0 +1,169 @@
+"""A robot written from schemas/README.md alone: plain msgpack and zenoh, no arena imports.
+
+It stands in for a C++ or Rust client and so must not import the project:
+what it needs to know is what the README says (joining, the schedule, QoS,
+the wheels, the configuration, the Summary, its digest and its MAC). It
+drives every wheel at 0 rad/s, reports its sensed pose at every comm tick,
+and publishes its Summary until the collector acknowledges it.
+
+    python readme_robot.py --team a --robot 1 --match M --connect EP --credentials FILE
+
+(the arguments of the command `arena match --external a/1` prints; others are ignored).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import queue
+import sys
+import threading
+import time
+
+import msgpack
+import zenoh
+
+WHEELS = {"omni4": 4, "omni3": 3, "diff": 2}  # README, "Wheels"
+
+
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--team", required=True)
+    ap.add_argument("--robot", type=int, required=True)
+    ap.add_argument("--match", required=True)
+    ap.add_argument("--connect", required=True)
+    ap.add_argument("--credentials", required=True)
+    args, _ = ap.parse_known_args(argv)
+    me = f"robot/{args.team}/{args.robot}"
+    prefix = f"arena/{args.match}/"
+
+    # Security: the credentials file is a zenoh configuration; add only the router's endpoint.
+    with open(args.credentials) as f:
+        creds = json.load(f)
+    mac_key = bytes.fromhex(creds["metadata"]["arena"]["keys"][me])
+    conf = zenoh.Config.from_file(args.credentials)
+    conf.insert_json5("mode", '"client"')
+    conf.insert_json5("connect/endpoints", json.dumps([args.connect]))
+    conf.insert_json5("scouting/multicast/enabled", "false")
+
+    def mac(key: str, payload: bytes) -> bytes:
+        return hashlib.blake2b(key.encode() + b"\x00" + payload, key=mac_key, digest_size=16).digest()
+
+    session = zenoh.open(conf)
+    try:
+        senses: queue.Queue[bytes] = queue.Queue()
+        acked = threading.Event()
+        collector = threading.Event()
+
+        def on_collector(sample: zenoh.Sample) -> None:
+            (collector.set if sample.kind == zenoh.SampleKind.PUT else collector.clear)()
+
+        keep = [
+            session.declare_subscriber(
+                f"{prefix}robot/{args.team}/{args.robot}/sense", lambda s: senses.put(s.payload.to_bytes())
+            ),  # fmt: skip
+            session.declare_subscriber(f"{prefix}ack/{me}", lambda s: acked.set()),
+            session.liveliness().declare_subscriber(f"{prefix}collector", on_collector, history=True),
+        ]
+        qos = {
+            "encoding": zenoh.Encoding("application/msgpack"),
+            "congestion_control": zenoh.CongestionControl.BLOCK,
+            "reliability": zenoh.Reliability.RELIABLE,
+            "priority": zenoh.Priority.DATA,
+            "express": False,
+        }
+        cmd_key = f"robot/{args.team}/{args.robot}/cmd"
+        report_key = f"team/{args.team}/report/{args.robot}"
+        pubs = {k: session.declare_publisher(prefix + k, **qos) for k in (cmd_key, report_key)}
+        summary_key = f"{prefix}summary/{me}"
+        summary_pub = session.declare_publisher(summary_key, **qos)
+
+        # Configuration: the engine's queryable.
+        cfg = None
+        deadline = time.monotonic() + 60
+        while cfg is None and time.monotonic() < deadline:
+            for reply in session.get(f"{prefix}config", timeout=2.0):
+                if reply.ok is not None:
+                    cfg = json.loads(reply.ok.payload.to_bytes().decode())
+                    break
+            else:
+                time.sleep(0.2)
+        if cfg is None:
+            print("readme_robot: no configuration", file=sys.stderr)
+            return 1
+        total_ticks = 2 * round(cfg["half_time"] / cfg["timing"]["dt"])
+        # `field` is also served (what a late joiner does): its total_ticks must agree.
+        field = None
+        for reply in session.get(f"{prefix}field", timeout=5.0):
+            if reply.ok is not None:
+                field = msgpack.unpackb(reply.ok.payload.to_bytes())
+        if field is None or field["total_ticks"] != total_ticks:
+            print(f"readme_robot: field {field} disagrees with the configuration", file=sys.stderr)
+            return 1
+        comm = cfg["timing"]["comm_period"]
+        wheels = [0.0] * WHEELS[cfg["robot"]["model"]]
+        keep.append(session.liveliness().declare_token(f"{prefix}alive/{me}"))
+
+        digest = hashlib.blake2b(digest_size=16)
+        sent = {cmd_key: 0, report_key: 0}
+
+        def put(key: str, msg: dict) -> None:
+            payload = msgpack.packb(msg)
+            digest.update(key.encode())
+            digest.update(len(payload).to_bytes(4, "little"))
+            digest.update(payload)
+            sent[key] += 1
+            pubs[key].put(payload)
+
+        k = 0
+        rejected: dict[str, int] = {}
+        while k <= total_ticks:
+            try:
+                raw = senses.get(timeout=cfg["timing"]["startup_timeout"] + cfg["timing"]["wait_timeout"])
+            except queue.Empty:
+                print(f"readme_robot: no sense for tick {k}", file=sys.stderr)
+                return 1
+            try:
+                sense = msgpack.unpackb(raw)
+                tick = sense["tick"]
+            except Exception:  # noqa: BLE001 - any bad frame is counted, as the README says
+                rejected["malformed"] = rejected.get("malformed", 0) + 1
+                continue
+            if tick != k:
+                rejected["out_of_sequence"] = rejected.get("out_of_sequence", 0) + 1
+                continue
+            put(cmd_key, {"tick": k, "mode": "wheels", "wheels": wheels})
+            if k % comm == 0:
+                put(report_key, {"tick": k, "robot": args.robot, "pose": sense["pose"], "role": "readme"})
+            k += 1
+
+        summary = {
+            "tick": total_ticks,
+            "process": me,
+            "pid": os.getpid(),
+            "digest": digest.hexdigest(),
+            "sent": sum(sent.values()),
+            "rejected": sum(rejected.values()),
+            "rejected_reasons": rejected,
+            "sent_by_key": sent,
+            "extra": {"client": "readme_robot"},
+        }
+        payload = msgpack.packb(summary)
+        attachment = mac(summary_key, payload)
+        give_up = time.monotonic() + 5.0
+        while True:
+            summary_pub.put(payload, attachment=attachment)
+            if not collector.is_set() or acked.wait(0.25) or time.monotonic() > give_up:
+                break
+        print(json.dumps({"digest": summary["digest"], "sent": sent, "acked": acked.is_set(), "field": field}))
+        for entity in reversed(keep):
+            entity.undeclare()
+        return 0 if acked.is_set() or not collector.is_set() else 1
+    finally:
+        session.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
