@@ -1,5 +1,9 @@
 """Viewer process: watch a match as it plays, in the Foxglove app (docs/recording.md).
 
+Longer than 150 lines because `ViewerNode` (over 150 lines itself) holds the Foxglove
+server's wiring, its parameters and the one `watch` loop that turns frames into scene,
+log and match messages, all sharing the newest-frame rings and the server.
+
 `arena match --live [PORT]` starts it; `arena run viewer` attaches one to a
 match by hand. It serves the Foxglove WebSocket protocol (foxglove-sdk's
 server, which runs on the SDK's own threads) with:

@@ -1,8 +1,8 @@
 """Following a human referee: a real RefBox's commands turned into our referee's state.
 
-(Over ~150 lines on purpose: the transition `follow`, the `Follower` that
+Longer than 150 lines because the transition `follow`, the `Follower` that
 drives it in the referee, and `ViaRefbox`, the same follower inside our own
-base station for `--via-refbox`, are one mapping and change together.)
+base station for `--via-refbox`, are one mapping and change together.
 
 `arena match --refbox-follow HOST:PORT` (docs/refbox.md): our referee
 connects to the official MSL RefBox as a base station would

@@ -1,6 +1,6 @@
 """The MSL RefBox wire protocol, both generations, as pure functions and small readers.
 
-Longer than our usual ~150 lines because it is one protocol: the command
+Longer than 150 lines because it is one protocol: the command
 tables, both framings, the worldstate validator and the team table belong
 together and are checked together (tests/unit/test_refbox_protocol.py).
 

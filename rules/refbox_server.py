@@ -1,7 +1,7 @@
 """The RefBox's base-station server: a real TCP server on its own thread.
 
-(One class over ~150 lines: accept, identify, send, read and close each
-handle their own socket errors, and they share the connection table.)
+Longer than 150 lines because `BridgeServer` is one class: accept, identify, send, read and
+close each handle their own socket errors, and they share the connection table.
 
 What it does, as the MSL RefBox does it (rules/refbox_protocol.py has the
 sources): a base station connects; it is identified by its source address

@@ -1,5 +1,9 @@
 """Match configuration: frozen dataclasses with defaults, passed explicitly.
 
+Longer than 150 lines because it is the whole configuration tree, one frozen dataclass
+per concern (field, robot, ball, sensor, rules, timing, RefBox, match, process id),
+every constant with its unit, serialised and read as one tree.
+
 Every physical constant carries its unit next to it. The whole configuration
 travels as JSON (``MatchConfig.to_json``/``from_json``), so every process of a
 match, local or on a robot's own computer, plays from the very same numbers.

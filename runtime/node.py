@@ -1,5 +1,9 @@
 """What every process of a match shares: identity, wiring, barrier, summary.
 
+Longer than 150 lines because `Node` (over 150 lines itself) is the one base class every
+process kind shares: wiring, links, the start barrier, the loops and the summary call
+each other through the same state, which mixins would scatter.
+
 A process kind subclasses `Node`, declares its links in `__init__` with
 `out(...)` and `inp(...)`, and implements `loop()`. `run()` then does the rest:
 

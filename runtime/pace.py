@@ -1,5 +1,9 @@
 """Pacing a lockstep match for a live viewer: real-time speed, pause, step.
 
+Longer than 150 lines because the `Pacer` is one small state machine (pace, pause, step,
+anchor) shared by the engine's loop and its own thread, whose rules read best side by
+side; a fifth of it is this docstring.
+
 `arena match --live` starts a viewer (processes/viewer.py); in lockstep the
 engine then waits on a `Pacer` before each tick, as it waits on a link: the
 lockstep loop yields `(pacer, k)`, and the pacer is ready for tick k when

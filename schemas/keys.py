@@ -3,7 +3,7 @@
 `KEYS` is the single table the wire contract (schemas/README.md), the
 recorder and the process wiring are derived from.
 
-Over 150 lines for one reason: every key expression of the wire is built
+Longer than 150 lines because every key expression of the wire is built
 here and nowhere else (the table, the infrastructure keys, the builders).
 """
 

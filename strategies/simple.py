@@ -1,5 +1,9 @@
 """Chase-and-shoot: the simple baseline team play.
 
+Longer than 150 lines because `SimpleRobot` (over 150 lines itself) is the whole
+baseline robot, positioning, chasing, shooting and keeping goal, whose private helpers
+each serve its one `_play` decision.
+
 `STRATEGIES` offers it under the paper's four names; strategies/registry.py
 decides which names it gets. The behaviour:
 

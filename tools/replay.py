@@ -1,5 +1,9 @@
 """`arena replay FILE.mcap --process robot/a/1`: one process against its recorded inputs.
 
+Longer than 150 lines because `replay` is the four-step procedure below as one function,
+kept whole so that it reads in the documented order, with its result types and CLI entry
+beside it.
+
 A lockstep match is a pure function of (configuration, seed), and so is each
 process given its inputs. Replay rebuilds the `MatchConfig` from the file's
 metadata and runs that ONE process's `Node` class (processes/__init__.py)

@@ -1,5 +1,8 @@
 """`arena review FILE.mcap`: what happened in a recorded match.
 
+Longer than 150 lines because it is all of `arena review`'s output: the printed report
+and the matplotlib plots and animation, each a function over the same analysis.
+
 The analysis is `arena.recording.analysis` (shared with `arena facts` and the
 tests); this module prints it and draws the plots.
 

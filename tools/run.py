@@ -1,5 +1,9 @@
 """`arena run <kind>`: start one process of a match on its own.
 
+Longer than 150 lines because it is every way one process joins a match (configuration
+from a file, flags or the engine's queryable; credentials; duplicate refusal; the router
+of a secure match), which `run` ties together.
+
 This is the hardware-in-the-loop path: the same command runs a robot's
 process on the robot's own computer, or a base station on the team's laptop,
 against the rest of the match.

@@ -43,7 +43,7 @@ footprints within `CONTACT_GAP` of each other, `overlap_s` pair-seconds (at any
 time) with the footprints overlapping by more than `OVERLAP_DEPTH` (robots
 driving through each other), `max_overlap_m` the deepest overlap seen.
 
-Over 150 lines for one reason: `measure` is one pass over the world frames in
+Longer than 150 lines because `measure` is one pass over the world frames in
 which every fact is updated from the same per-frame state (who plays, the
 pending shots, the stuck spells); split, each part would re-walk the frames.
 """

@@ -9,7 +9,7 @@ for nobody (a loose ball). Distance per robot is the engine's Summary (physics
 at 250 Hz, the number `arena match` reports), or the world frames when the
 file has no summary.
 
-Over 150 lines for one reason: `analyse` gathers every section of the review
+Longer than 150 lines because `analyse` gathers every section of the review
 dict in one place, so that its shape (what `--json` prints) reads at once.
 """
 

@@ -9,7 +9,7 @@ paper 1 eq. 1-2): a body twist (mode "body") or wheel speeds (mode
 saturation, max_speed and max_omega, turned into the field frame once per
 tick with the heading at mid-tick.
 
-Over 150 lines for one reason: `__init__` declares the state of every
+Longer than 150 lines because `__init__` declares the state of every
 mixin in one place, so that it reads as one list.
 """
 

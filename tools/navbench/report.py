@@ -1,4 +1,8 @@
-"""The bench's results as rows: per scheme, per method, timing and local minima; `Report.to_json` for `--json`."""
+"""The bench's results as rows: per scheme, per method, timing and local minima; `Report.to_json` for `--json`.
+
+Longer than 150 lines because it holds every table the bench prints (per scheme, per
+method, timing, local minima), each a short row builder over the same results.
+"""
 
 from __future__ import annotations
 

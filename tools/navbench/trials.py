@@ -1,6 +1,6 @@
 """One trial of paper 1's experiments: the robot and its scripted opponents stepped through the engine's own physics and sensors.
 
-Over 150 lines for one reason: `run_trial` is the experiment written out as one loop (perception,
+Longer than 150 lines because `run_trial` is the experiment written out as one loop (perception,
 navigator, drive, engine tick, bookkeeping), kept whole so that it reads as the paper's procedure.
 """
 
