@@ -1,5 +1,10 @@
 """The `arena` command: one subcommand per job.
 
+Longer than 150 lines because it is the whole command line in one place: the argument
+tables of every subcommand with their examples (`build_parser`, over 150 lines itself,
+one block per subcommand) and one short `cmd_*` per subcommand that turns the flags into
+typed calls.
+
 Bad input never ends in a traceback. Exit codes, the same for every subcommand:
 
 * 0: done;

@@ -1,5 +1,10 @@
 """Recorder process: the match's MCAP log (docs/recording.md).
 
+Longer than 150 lines because the recorder is one process in two halves that share the
+file: `McapSink` writes channels, metadata and the file's end, and `RecorderNode` (over
+150 lines itself) gathers every process's taps and summaries, fills gaps and closes a
+truncated match.
+
 The recorder does not subscribe to the match's data keys: every other process
 taps what it sends and publishes it in batches (runtime/tap.py), which costs
 the match a fraction of what a second copy of every frame would. The recorder

@@ -35,7 +35,7 @@ its team and ball spot (`setpieces.py`), then after the positioning time
 START for the same team. Time is the tick it is handed; nothing here reads a
 clock or draws a random number.
 
-Longer than 150 lines on purpose: every rule of docs/rules.md is a few lines
+Longer than 150 lines because every rule of docs/rules.md is a few lines
 here, and they are read, tested and changed as one table, next to the state
 they share.
 """

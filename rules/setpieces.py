@@ -38,7 +38,7 @@ kick near its goal does not pull it out. When the positioning time is over
 just outside the distance (`legal_spot`); the robot keeps its heading.
 A penalty has its own positions (`penalty_positions`).
 
-Longer than 150 lines: the spots, the distances and the placements that
+Longer than 150 lines because the spots, the distances and the placements that
 enforce them are one procedure, checked by one set of tests.
 """
 

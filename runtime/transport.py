@@ -1,5 +1,9 @@
 """The transport behind a small interface: zenoh for real, memory for unit tests.
 
+Longer than 150 lines because it holds the one `Transport` interface with both of its
+implementations, zenoh (with the MAC-verifying channel) and in-memory, kept side by side
+so that they stay in step.
+
 Processes see only `Transport`: publishers, pull-style subscriptions (the
 main thread blocks in `recv`, the fastest receive style measured on 2 cores,
 see notes-zenoh-mcap.md), a local wake-up, liveliness, and one queryable for

@@ -1,5 +1,9 @@
 """`arena match`: one match as a group of OS processes, supervised.
 
+Longer than 150 lines because it is the whole life of a distributed match: spawning,
+joins, the collector, supervision (`supervise`) and the result (`assemble`,
+`play_match`), which share the child table and the match's deadlines.
+
 The launcher hosts the match's zenoh router (a unix socket in a private temp
 dir unless `--listen` says otherwise), starts every process with the same
 `arena run <kind> ...` command a user would type, waits for each one's

@@ -1,5 +1,9 @@
 """`arena tournament`: round-robins of strategies, with the paper's tables and statistics.
 
+Longer than 150 lines because it is one tournament end to end: schedule, resume,
+statistics (standings, coverage, Bradley-Terry), the report, and `Runner` (over 150
+lines itself: one fixture played locally or in-process, with retry and stop).
+
 Every pairing of the strategies plays `legs` matches, alternating home and
 away, each with a seed derived from the tournament seed. Every match is a full,
 isolated `arena match` process group; `--jobs` of them run at once. Each
