@@ -2,8 +2,8 @@
 
 Longer than 150 lines because the recorder is one process in two halves that share the
 file: `McapSink` writes channels, metadata and the file's end, and `RecorderNode` (over
-150 lines itself) gathers every process's taps and summaries, fills gaps and closes a
-truncated match.
+150 lines itself) gathers every process's taps and summaries, reports what the file
+lacks (`gaps`) and closes a truncated match.
 
 The recorder does not subscribe to the match's data keys: every other process
 taps what it sends and publishes it in batches (runtime/tap.py), which costs

@@ -1,8 +1,8 @@
 """Zenoh session factory, isolated by default.
 
 Longer than 150 lines because every way a zenoh session is opened (endpoints and their
-checks, scouting, lease, the environment variables that may override them) lives here,
-so that isolation is decided in one place; an eighth of it is this docstring.
+checks, scouting, lease, a user's zenoh runtime setting) lives here, so that isolation
+is decided in one place; an eighth of it is this docstring.
 
 Multicast scouting is off unless asked for, and every session has explicit
 endpoints, so twenty matches on one machine, or CI next to other zenoh
