@@ -283,14 +283,30 @@ class ZenohTransport:
     def close(self) -> None:
         with self._wake_lock:
             for waker in self._wakers.values():
-                waker.undeclare()
+                _undeclare(waker)
             self._wakers.clear()
         for entity in reversed(self._keep):
-            undeclare = getattr(entity, "undeclare", None)
-            if undeclare is not None:
-                undeclare()
+            _undeclare(entity)
         self._keep.clear()
         self._pubs.clear()
+
+
+def _undeclare(entity: object) -> None:
+    """Undeclare `entity` unless zenoh's thread is using it right now.
+
+    A SIGTERM lands on the main thread while a reactive node's lockstep runs in
+    a zenoh callback; if that callback is inside `put` on a publisher, pyo3
+    refuses to undeclare it (`RuntimeError: Already borrowed`) and the process
+    died with a traceback instead of exiting. Such an entity is left to the
+    session's own close, which undeclares everything it has.
+    """
+    undeclare = getattr(entity, "undeclare", None)
+    if undeclare is None:
+        return
+    try:
+        undeclare()
+    except RuntimeError:
+        pass
 
 
 # --------------------------------------------------------------------- memory

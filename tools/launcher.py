@@ -19,6 +19,7 @@ import ctypes
 import functools
 import hashlib
 import importlib.util
+import json
 import os
 import shutil
 import signal
@@ -377,6 +378,28 @@ SUMMARY_GRACE = 6.0
 FINISH_GRACE = 10.0
 
 
+# The router of a peer match (not --secure) relays only to clients: spectators and
+# hand-started processes; the lockstep runs on the peers' direct links. A put it
+# relays is DROP on the way out: a slow spectator on `**` loses frames instead of
+# blocking the router, which stopped reading from the peers, whose BLOCK puts then
+# held their only zenoh thread until leases lapsed (issue 20 item 6).
+SPECTATOR_SAFE = (
+    (
+        "qos/network",
+        json.dumps(
+            [
+                {
+                    "id": "spectators",
+                    "messages": ["put"],
+                    "flows": ["egress"],
+                    "overwrite": {"congestion_control": "drop"},
+                }
+            ]
+        ),  # fmt: skip
+    ),
+)
+
+
 def supervision_deadline(cfg: MatchConfig) -> float:
     """[s] wall: the longest a whole match may take before the launcher gives up.
 
@@ -713,7 +736,7 @@ def play_match(
     names = [str(p) for p in cfg.processes()]
     secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
     cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials")
-    router_extra = tuple(secrets.router_settings(tmp)) if secure else ()
+    router_extra = tuple(secrets.router_settings(tmp)) if secure else SPECTATOR_SAFE
     children: list[Child] = []
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     external = {ProcessId.parse(e) for e in cfg.external}

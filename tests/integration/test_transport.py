@@ -49,3 +49,37 @@ def test_a_callback_thread_keeps_its_python_thread_state(tmp_path):
         counts.setdefault(thread, []).append(count)
     for thread, got in counts.items():
         assert got == list(range(1, len(got) + 1)), f"thread {thread} lost its state between callbacks: {got}"
+
+
+def test_close_while_zenohs_thread_is_inside_a_put_does_not_raise(tmp_path):
+    """Issue 20 item 6: SIGTERM during a callback's blocked put crashed with `RuntimeError: Already borrowed`."""
+    sock = f"unixsock-stream/{tmp_path}/borrow.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(sock,))) as a,
+        open_session(NetConfig(mode="peer", connect=(sock,))) as b,
+    ):
+        stall, stop = threading.Event(), threading.Event()
+        sub = b.declare_subscriber("arena/borrow/k", lambda s: stall.wait(20))
+        time.sleep(0.5)
+        tr = ZenohTransport(a)
+        put = tr.publisher("arena/borrow/k")  # BLOCK, towards a receiver that does not read
+        puts = [0]
+
+        def flood() -> None:
+            while not stop.is_set():
+                put(b"x" * 60000)
+                puts[0] += 1
+
+        t = threading.Thread(target=flood, daemon=True)
+        t.start()
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and puts[0] < 3:
+            time.sleep(0.05)
+        time.sleep(0.5)  # the queue is full by now: the flood thread sits inside `put`
+        try:
+            tr.close()  # raised RuntimeError: Already borrowed
+        finally:
+            stop.set()
+            stall.set()
+            t.join(timeout=10)
+            sub.undeclare()
