@@ -234,7 +234,14 @@ RELIABLE, congestion control BLOCK, priority DATA (zenoh's default, 5),
 express off, encoding `application/msgpack`; zenoh delivers one session's
 puts in order, and the lockstep relies on it. `world` (nobody waits for it)
 is RELIABLE with congestion control DROP and is put only while a subscriber
-matches. Keys you receive: any default subscriber.
+matches. Keys you receive: any default subscriber. The router of a match
+that is not `--secure` relays every put with congestion control DROP (a
+`qos/network` overwrite on its egress): the match's own processes are
+peers with direct links to one another, so only clients (spectators, a
+`--mode client` process) receive through it, and a client that reads too
+slowly loses frames instead of stalling the match; a lockstep client must
+therefore keep reading. In a `--secure` match every frame goes through the
+router with the sender's QoS.
 
 **Commands and stages.** `Referee.command`, `RefCommand.name` and
 `Order.command` take only the MSL RefBox names listed in their tables; a
