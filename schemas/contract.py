@@ -254,17 +254,20 @@ values that occur on the wire are `FIRST_HALF`, `SECOND_HALF` and
 `END_GAME`; `PRE_GAME` and `HALF_TIME` are in the type (the RefBox's own
 names) but are never sent.
 
-**Wheels.** `Cmd.mode = "wheels"` gives one angular speed [rad/s] per wheel,
-positive = the wheel's rim moves counter-clockwise around the robot's centre
-(a positive speed on every wheel turns the robot to the left, +omega). The
-wheel count and order come from the configuration's `robot.model`:
-`omni4` (MSL default, the IRIS robot): 4 wheels at 45, 135, 225, 315 degrees
-from the body's +x axis, in that order, wheel speed
+**Wheels.** `Cmd.mode = "wheels"` gives one angular speed [rad/s] per wheel;
+the wheel count, order and sign come from the configuration's `robot.model`.
+`omni4` (MSL default, the IRIS robot): 4 wheels at a = 45, 135, 225, 315
+degrees from the body's +x axis, in that order; `omni3` (Robotino, KRSBI-B):
+3 wheels at a = 180, 60, -60 degrees, in that order. For both, wheel speed =
 (-sin(a) vx + cos(a) vy + l omega) / r with l = `robot.wheel_base`,
-r = `robot.wheel_radius`; `omni3` (Robotino, KRSBI-B): 3 wheels at 180, 60,
--60 degrees, same formula; `diff`: 2 wheels, left then right. A `wheels` list
-of another length is rejected (`invalid`), as is an empty one in wheels mode.
-Speeds are saturated at `robot.max_wheel_speed` by scaling the whole vector.
+r = `robot.wheel_radius`: positive = the rim moves counter-clockwise around
+the robot's centre, so the same positive speed on every wheel turns the robot
+left (+omega). `diff` (differential drive): 2 wheels, right then left,
+positive = rolling forward: (vx + omega l) / r and (vx - omega l) / r.
+A `wheels` list of another length is rejected (`invalid`), as is an empty
+one in wheels mode. Speeds are saturated at `robot.max_wheel_speed` by
+scaling the whole vector, then the body twist is capped at `robot.max_speed`
+and `robot.max_omega`.
 
 **NaN and infinity.** A frame with a NaN or an infinity in any float field is
 rejected as `invalid` and counted. If it was the in-sequence frame of its

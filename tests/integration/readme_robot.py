@@ -60,7 +60,16 @@ def main(argv: list[str]) -> int:
         def on_collector(sample: zenoh.Sample) -> None:
             (collector.set if sample.kind == zenoh.SampleKind.PUT else collector.clear)()
 
+        stages: set[str] = set()
+        commands: set[str] = set()
+
+        def on_referee(sample: zenoh.Sample) -> None:
+            ref = msgpack.unpackb(sample.payload.to_bytes())
+            stages.add(ref["stage"])
+            commands.update(c["name"] for c in ref.get("commands", []))
+
         keep = [
+            session.declare_subscriber(f"{prefix}referee", on_referee),  # public: what the README says occurs
             session.declare_subscriber(
                 f"{prefix}robot/{args.team}/{args.robot}/sense", lambda s: senses.put(s.payload.to_bytes())
             ),  # fmt: skip
@@ -157,7 +166,18 @@ def main(argv: list[str]) -> int:
             summary_pub.put(payload, attachment=attachment)
             if not collector.is_set() or acked.wait(0.25) or time.monotonic() > give_up:
                 break
-        print(json.dumps({"digest": summary["digest"], "sent": sent, "acked": acked.is_set(), "field": field}))
+        print(
+            json.dumps(
+                {
+                    "digest": summary["digest"],
+                    "sent": sent,
+                    "acked": acked.is_set(),
+                    "field": field,
+                    "stages": sorted(stages),
+                    "commands": sorted(commands),
+                }
+            )
+        )
         for entity in reversed(keep):
             entity.undeclare()
         return 0 if acked.is_set() or not collector.is_set() else 1

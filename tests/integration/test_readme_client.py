@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from arena.schemas.vocabulary import REF_COMMANDS
 from tests.integration.helpers import spawn, wait_for
 
 CLIENT = Path(__file__).with_name("readme_robot.py")
@@ -49,5 +50,9 @@ def test_a_client_written_from_the_readme_plays_robot_a1_and_its_digest_is_verif
     assert result["forged_summaries"] == {} and result["dead"] == []
     assert client["sent"] == {"robot/a/1/cmd": result["ticks"] + 1, "team/a/report/1": result["ticks"] // 5 + 1}
     assert result["sent_by_key"]["robot/a/1/cmd"] == result["ticks"] + 1
+    # The README: the stages that occur on the wire, and only documented command names.
+    assert client["stages"] == ["END_GAME", "FIRST_HALF", "SECOND_HALF"]
+    assert {"FIRST_HALF", "KICKOFF", "HALF_TIME", "SECOND_HALF", "END_GAME", "GAMEOVER"} <= set(client["commands"])
+    assert set(client["commands"]) <= REF_COMMANDS
     # It got `field` with a `get` (served by the engine for late joiners), not from the tick-0 put.
     assert client["field"]["total_ticks"] == result["ticks"] and client["field"]["robots_per_team"] == 3
