@@ -1,0 +1,65 @@
+"""The launcher's digest check of an external process (tools/witness.py), and the digest layout the README gives."""
+
+from __future__ import annotations
+
+import hashlib
+
+from arena.runtime.lockstep import Outbound
+from arena.schemas.keys import Keys
+from arena.schemas.messages import Cmd, Pose, Report
+from arena.tools.witness import Witness, digest_update
+
+
+class Callbacks:
+    """Test double: keeps the witness's callbacks so the test can feed them frames."""
+
+    def __init__(self) -> None:
+        self.callbacks: dict[str, object] = {}
+
+    def subscribe_callback(self, key: str, callback) -> None:
+        self.callbacks[key] = callback
+
+
+def _sent_by_a_node() -> tuple[str, list[tuple[str, bytes]]]:
+    """What runtime/lockstep.py puts and digests for robot a/1 over a few ticks."""
+    digest = hashlib.blake2b(digest_size=16)
+    wire: list[tuple[str, bytes]] = []
+    cmd = Outbound("arena/w/robot/a/1/cmd", "robot/a/1/cmd", lambda p: wire.append(("robot/a/1/cmd", p)), digest)
+    rep = Outbound("arena/w/team/a/report/1", "team/a/report/1", lambda p: wire.append(("team/a/report/1", p)), digest)
+    for k in range(7):
+        cmd.send(Cmd(tick=k, mode="wheels", wheels=[0.0] * 4))
+        if k % 5 == 0:
+            rep.send(Report(tick=k, robot=1, pose=Pose(x=1.0, y=2.0, theta=0.5)))
+    return digest.hexdigest(), wire
+
+
+def test_the_readme_digest_layout_is_the_one_the_processes_compute():
+    expected, wire = _sent_by_a_node()
+    h = hashlib.blake2b(digest_size=16)
+    for rel, payload in wire:
+        digest_update(h, rel, payload)
+    assert h.hexdigest() == expected
+
+
+def test_the_witness_accepts_the_true_digest_and_refuses_another():
+    expected, wire = _sent_by_a_node()
+    tr = Callbacks()
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"})
+    assert set(tr.callbacks) == {"arena/w/robot/a/1/cmd", "arena/w/team/a/report/1"}
+    for rel, payload in wire:
+        tr.callbacks[f"arena/w/{rel}"](payload)
+    assert w.check("robot/a/1", "0" * 32, dead=[]) is not None
+    assert w.verified() == []
+    assert w.check("robot/a/1", expected, dead=[]) is None
+    assert w.verified() == ["robot/a/1"]
+    assert w.check("engine", "0" * 32, dead=[]) is None, "only watched processes are checked"
+
+
+def test_a_process_that_muted_a_key_for_a_dead_receiver_is_accepted_unverified():
+    _, wire = _sent_by_a_node()
+    tr = Callbacks()
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"})
+    for rel, payload in wire[:3]:
+        tr.callbacks[f"arena/w/{rel}"](payload)
+    assert w.check("robot/a/1", "1" * 32, dead=["basestation/a"]) is None
+    assert w.verified() == []
