@@ -314,8 +314,11 @@ not part of it. **It is checked:** for every `--external` process the
 launcher (the match's router) recomputes the digest from the frames it
 receives from that process (tools/witness.py), and a Summary whose digest
 differs is refused (counted under `forged_summaries`, the process gets no
-summary); the match JSON lists the processes so checked under
-`digests_verified`. The launcher's own processes are its code; their digests
+summary); the match JSON lists the processes whose digest matched under
+`digests_verified`. The one exception: a Summary that lists peers in `dead`
+is accepted unverified, since a process stops putting a key whose only
+receiver is dead but keeps digesting it (so should you: the digest covers
+every frame of the schedule, put or not). The launcher's own processes are its code; their digests
 are pinned by tests (same seed, same digest).
 """
 
