@@ -38,6 +38,7 @@ from arena.schemas.keys import (
     SUMMARY,
     TAP,
     VIEWER,
+    WAITING,
     routes,
 )
 
@@ -63,7 +64,7 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
     # The referee's state is public (a RefBox broadcasts it to every team): any principal may
     # read it; a process started by hand (`arena run`) prints the final score from it.
     reads = list(dict.fromkeys([*receives, *own_in, prefix + KEY_BY_NAME["referee"].rel()]))
-    barrier = [f"{prefix}{ALIVE}/**", f"{prefix}{COLLECTOR}"]
+    barrier = [f"{prefix}{ALIVE}/**", f"{prefix}{COLLECTOR}", f"{prefix}{WAITING}/**"]
     config = [f"{prefix}{CONFIG}", prefix + KEY_BY_NAME["field"].rel()]  # both served by the engine
     perms = {
         "put/ingress": writes,
@@ -72,7 +73,7 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         "declare_subscriber/egress": [f"{prefix}**"],
         "declare_subscriber/ingress": reads,
         "put/egress": reads,
-        "liveliness_token/ingress": [f"{prefix}{ALIVE}/{principal}"],
+        "liveliness_token/ingress": [f"{prefix}{ALIVE}/{principal}", f"{prefix}{WAITING}/{principal}/*"],
         "liveliness_token/egress": barrier,
         "declare_liveliness_subscriber/ingress": barrier,
         "liveliness_query/ingress": barrier,

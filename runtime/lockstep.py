@@ -217,8 +217,21 @@ class Reactor:
     wall time is given up (wall time detects failures only, never behaviour).
     """
 
-    def __init__(self, timeout: float):
+    def __init__(
+        self,
+        timeout: float,
+        announce: Callable[[int | None], None] | None = None,
+        upstream_waiting: Callable[[str, int], bool] | None = None,
+    ):
         self.timeout = timeout
+        # A wait longer than `announce_after` is announced (a liveliness token naming the tick this
+        # process is about to act at), and a silent sender that announces a wait of its own at a
+        # tick not past the frame we miss is stalled upstream, not at fault: we keep waiting
+        # (issue 20, "correct blame"). Only the process whose sender owes a frame gives up.
+        self._announce = announce
+        self._upstream_waiting = upstream_waiting
+        self.announce_after = min(1.0, timeout / 4)
+        self._announced: int | None = None
         self.lock = threading.Lock()
         self.done = threading.Event()
         self._steps: Waits | None = None
@@ -271,16 +284,31 @@ class Reactor:
             self._advance()
         while not self.done.wait(0.1):
             with self.lock:
+                waited = time.monotonic() - self._since
+                want = self._waiting[1] if self._waiting is not None and waited >= self.announce_after else None
+            self._set_announced(want)
+            with self.lock:
                 if self._waiting is None:
                     continue
                 ib, k = self._waiting
-                if time.monotonic() - self._since >= self.timeout:
-                    ib._give_up(f"silent for {self.timeout:g} s waiting for tick {k}")
-                else:
+                if time.monotonic() - self._since < self.timeout:
                     continue
+                missing = ib.schedule.first_after(ib.last_seen)
+                if self._upstream_waiting is not None and self._upstream_waiting(ib.sender, missing):
+                    self._since = time.monotonic()  # its sender waits for its own upstream: so do we
+                    continue
+                ib._give_up(f"silent for {self.timeout:g} s waiting for tick {k}")
                 self._advance()
+        self._set_announced(None)
         if self.error is not None:
             raise self.error
+
+    def _set_announced(self, tick: int | None) -> None:
+        """Announce the wait before acting at `tick` (None: no wait worth announcing). Main thread only."""
+        if self._announce is None or tick == self._announced:
+            return
+        self._announce(tick)
+        self._announced = tick
 
 
 class Inbound(Generic[M]):

@@ -36,7 +36,7 @@ from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
-from arena.schemas.keys import KEY_BY_NAME, SIGNED_DATA, Keys
+from arena.schemas.keys import KEY_BY_NAME, SIGNED_DATA, WAITING, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 
@@ -71,7 +71,20 @@ class Node:
         # Lockstep over zenoh runs the loop in the receive callbacks (`Reactor`);
         # real time, and the memory transport of in-process runs, pull instead.
         self.reactive = not cfg.realtime and getattr(transport, "callbacks", False)
-        self.reactor = Reactor(cfg.timing.wait_timeout) if self.reactive else None
+        # Waits announced by liveliness tokens (`Reactor`): a zenoh transport has them.
+        self._announces = hasattr(transport, "declare_token")
+        self._waits: dict[str, set[int]] = {}  # peer -> the ticks it announces waiting before
+        self._wait_token: Callable[[], None] | None = None
+        self.silent: dict[str, int] = {}  # peers given up on while alive and not waiting themselves
+        self.reactor = (
+            Reactor(
+                cfg.timing.wait_timeout,
+                self._announce_wait if self._announces else None,
+                self._upstream_waiting if self._announces else None,
+            )
+            if self.reactive
+            else None
+        )
         # A cooperative driver (runtime/coop.py) bounds the waits itself: no thread.
         cooperative = getattr(transport, "cooperative", False)
         self.watchdog = Watchdog(transport, cfg.timing.wait_timeout, thread=not (self.reactive or cooperative))
@@ -177,7 +190,32 @@ class Node:
             self.dead[peer] = why
             self.dead_at[peer] = self.last_tick
             self.log.error("treating %s as dead: %s", peer, why)
+            if " silent for " in why:
+                self.silent[peer] = self.last_tick
             self.on_peer_dead(peer)
+
+    def _on_waiting(self, key: str, alive: bool) -> None:
+        peer, _, text = key.split(f"/{WAITING}/", 1)[-1].rpartition("/")
+        if not text.isdigit():
+            return  # not a token this runtime declares: ignored
+        with self._alive_cond:
+            ticks = self._waits.setdefault(peer, set())
+            if alive:
+                ticks.add(int(text))
+            else:
+                ticks.discard(int(text))
+
+    def _upstream_waiting(self, peer: str, missing: int) -> bool:
+        """Is `peer` blocked itself, before acting at a tick not past `missing` (so it owes us nothing yet)?"""
+        with self._alive_cond:
+            return any(s <= missing for s in self._waits.get(peer, ()))
+
+    def _announce_wait(self, tick: int | None) -> None:
+        if self._wait_token is not None:
+            self._wait_token()
+            self._wait_token = None
+        if tick is not None:
+            self._wait_token = self.transport.declare_token(self.keys.waiting(self.name, tick))  # type: ignore[attr-defined]
 
     def on_peer_dead(self, peer: str) -> None:
         """Hook: a peer we were waiting for is dead (its inputs no longer come)."""
@@ -206,6 +244,8 @@ class Node:
     def barrier(self) -> None:
         self.transport.watch_alive(self.keys.collector(), self._on_collector)
         self.transport.watch_alive(self.keys.alive_all(), self._on_alive)
+        if self._announces:
+            self.transport.watch_alive(self.keys.waiting_all(), self._on_waiting)
         self.transport.declare_alive(self.keys.alive(self.name))
         expected = set(self.expected_peers())
         start = time.monotonic()
@@ -337,7 +377,11 @@ class Node:
             tick_us=tick_us,
             wall_s=self._wall_s,
             cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
-            extra={**self.summary_extra(), "play_started": self.play_started},
+            extra={
+                **self.summary_extra(),
+                "play_started": self.play_started,
+                **({"silent": dict(self.silent)} if self.silent else {}),
+            },
             sent_by_key={o.rel.decode(): o.sent for o in self.outbound},
             conflicts={self.keys.rel(k): n for k, n in sorted(self.rejections.conflicts.items())},
             dead_at=dict(sorted(self.dead_at.items())),

@@ -260,6 +260,10 @@ class ZenohTransport:
     def declare_alive(self, key: str) -> None:
         self._keep.append(self.session.liveliness().declare_token(key))
 
+    def declare_token(self, key: str) -> Callable[[], None]:
+        """A liveliness token to take back later (a lockstep wait's, runtime/lockstep.py); returns its undeclare."""
+        return self.session.liveliness().declare_token(key).undeclare
+
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None:
         def cb(sample: zenoh.Sample) -> None:
             keep_thread_state()

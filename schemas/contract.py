@@ -33,6 +33,7 @@ from arena.schemas.keys import (
     SUMMARY,
     TAP,
     TAP_PERIOD,
+    WAITING,
     KeySpec,
 )
 
@@ -85,6 +86,7 @@ Infrastructure keys (not data pairs):
 | key expression | what |
 |---|---|
 | `arena/<match>/{ALIVE}/<process>` | zenoh liveliness token of each process (`engine`, `referee`, `basestation/a`, `robot/a/1`, `recorder`, `viewer`); the match starts when all are present |
+| `arena/<match>/{WAITING}/<process>/<tick>` | liveliness token of a process blocked for over a second (or a quarter of `timing.wait_timeout`) before acting at `<tick>`; taken back when the wait ends. A receiver whose sender announces a wait at a tick not past the frame it misses keeps waiting, so only the receiver of the missing frame gives up (optional for a client of your own: without it, you are only ever blamed for a frame you really owe) |
 | `arena/<match>/{CONFIG}` | queryable served by the engine: the match configuration as JSON (UTF-8) |
 | `arena/<match>/{SUMMARY}/<process>` | `Summary`, once per process at the end of the match |
 | `arena/<match>/{COLLECTOR}` | liveliness token of a summary collector (`arena match`, `arena up`); while present, a process repeats its summary until acknowledged |
@@ -224,8 +226,10 @@ are no other deadlines. **One missing scheduled frame** (a `cmd`, or a
 `report` at a comm tick) stalls every process that waits on it, and so the
 whole match, for `timing.wait_timeout` (60 s by default) of wall time; then
 its receiver treats the sender as dead for the rest of the match (the engine
-parks a dead robot beyond the fence) and the match ends
-`completed_with_faults`, naming it under `dead`. A frame for a tick that is
+parks a robot without `cmd` beyond the fence; a base station without a
+`report` stops sending that robot `order`s) and the match ends
+`completed_with_faults`, naming it alone under `dead`: everyone downstream
+waits for as long as its own sender announces a wait (`{WAITING}` above). A frame for a tick that is
 not the next scheduled one is rejected and does not stand in for the missing
 one.
 
@@ -364,9 +368,9 @@ signs the router's certificate and nothing else, so host names are not
 checked). The router's access control is generated from the key table above,
 default deny: a principal may put only on the keys it sends, declare
 subscribers only on the keys it receives (the referee state is readable by
-all), plus its own `{ALIVE}/<process>` token, `{SUMMARY}/<process>`,
-`{TAP}/<process>`, `{ACK}/<process>` and reading `{ALIVE}/**`, `{COLLECTOR}` and
-`{CONFIG}`. A put or a subscription outside that is dropped silently by the
+all), plus its own `{ALIVE}/<process>` and `{WAITING}/<process>/*` tokens,
+`{SUMMARY}/<process>`, `{TAP}/<process>`, `{ACK}/<process>` and reading
+`{ALIVE}/**`, `{WAITING}/**`, `{COLLECTOR}` and `{CONFIG}`. A put or a subscription outside that is dropped silently by the
 router. `viewer` is read-only: it may put nothing but the live `control`.
 
 **Message authentication** (every match, with or without `--secure`). The

@@ -219,6 +219,8 @@ def routes(robots: int) -> list[tuple[str, str, tuple[str, ...]]]:
 
 # Infrastructure keys (not data pairs of the paper).
 ALIVE = "alive"  # liveliness tokens: arena/<m>/alive/<process id>
+# arena/<m>/waiting/<process id>/<tick>: liveliness token of a process blocked for a while before acting at <tick>
+WAITING = "waiting"
 SUMMARY = "summary"  # arena/<m>/summary/<process id>: one Summary per process at the end
 CONFIG = "config"  # queryable: the match configuration as JSON
 ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
@@ -248,6 +250,12 @@ class Keys:
 
     def alive_all(self) -> str:
         return f"{self.prefix}{ALIVE}/**"
+
+    def waiting(self, process: str, tick: int) -> str:
+        return f"{self.prefix}{WAITING}/{process}/{tick}"
+
+    def waiting_all(self) -> str:
+        return f"{self.prefix}{WAITING}/**"
 
     def summary(self, process: str) -> str:
         return f"{self.prefix}{SUMMARY}/{process}"

@@ -56,9 +56,29 @@ def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
     else the earliest claimant's.
     """
     dead: dict[str, int] = {}
+    # A peer given up on as alive but silent (`extra["silent"]`): the claimant checked that the peer
+    # was not itself waiting for its own upstream (runtime/lockstep.py `Reactor`), so the peer owes
+    # a frame. Taken in tick order: a process already found silent is no witness against its peers
+    # (its base station muted its orders, so it then found the base station silent in turn).
+    silent = sorted(
+        (int(tick), name, peer)
+        for name, s in summaries.items()
+        if name not in lost and isinstance(s.extra.get("silent"), dict)
+        for peer, tick in s.extra["silent"].items()
+        if isinstance(tick, int) and peer in s.dead
+    )
+    witnesses_gone: set[str] = set()
+    for tick, name, peer in silent:
+        if name in witnesses_gone:
+            continue
+        dead[peer] = min(tick, dead.get(peer, tick))
+        witnesses_gone.add(peer)
+    claimed = {(name, peer) for _, name, peer in silent}
     for name, s in summaries.items():
         for peer in s.dead:
             tick = s.dead_at.get(peer, s.tick)
+            if (name, peer) in claimed or name in witnesses_gone:
+                continue
             if name in lost and peer not in lost:
                 continue  # a lost process's view of the others is no evidence
             if peer in lost or peer not in summaries:

@@ -1,12 +1,16 @@
-"""Measured cases of issues 15 and 20 with forged or missing frames: forged NaN orders.
+"""Two measured cases of issues 15 and 20: a robot that never sends its `report`, and forged NaN orders.
 
-Real processes over real zenoh. The forged orders come from a plain zenoh
-client, encoded with plain msgpack.
+Real processes over real zenoh. The silent robot is an external robot/a/1,
+started with the command the launcher prints, through `arena.cli.main` with
+one change: it never sends a `report`. The forged orders come from a plain
+zenoh client, encoded with plain msgpack.
 """
 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import msgpack
 import zenoh
@@ -19,6 +23,55 @@ MATCH = ("match", "--home", "BS", "--away", "BS", "--json")
 def finish(proc, timeout: float = 300) -> tuple[int, dict | None, str]:
     out, err = proc.communicate(timeout=timeout)
     return proc.returncode, (json.loads(out) if out.strip() else None), err
+
+
+NO_REPORT = """
+import sys
+from arena.processes.robot import RobotNode
+from arena.cli import main
+
+# Plays every tick (its cmd, its Summary) but never sends a report: the report schedule is never due.
+class Never:
+    def due(self, k):
+        return False
+
+init = RobotNode.__init__
+def patched(self, *args, **kwargs):
+    init(self, *args, **kwargs)
+    self.report_schedule = Never()
+RobotNode.__init__ = patched
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_a_robot_that_sends_cmd_but_no_report_alone_is_blamed(reap, tmp_path):
+    """Issue 20: it used to give ticks 0, the engine dead and exit 0 after every watchdog fired at once.
+
+    Its base station waits for the report, everyone downstream waits for the base station. A short
+    wait_timeout (4 s, from a --config file) keeps the test short; with it, every process announces
+    its wait, so only the base station, whose sender owes the frame, gives up.
+    """
+    endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    config = tmp_path / "quick.toml"
+    config.write_text("[timing]\nwait_timeout = 4.0\n")
+    proc = spawn(*MATCH, "--config", str(config), "--half-time", "10", "--seed", "4", "--match", "noreport",
+                 "--listen", endpoint, "--external", "a/1")  # fmt: skip
+    reap.append(proc)
+    line = ""
+    while not line.strip().startswith("arena run robot"):
+        line = wait_for(lambda: proc.stderr.readline(), 60, "the launcher's instructions")
+    robot = subprocess.Popen([sys.executable, "-c", NO_REPORT, *line.split()[1:]],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    reap.append(robot)
+    code, result, err = finish(proc, 180)
+    assert code == 0, err
+    assert result["ticks"] == 1000 and result["events"]["END_GAME"] == 1, "it used to stall at tick 0"
+    assert result["outcome"] == "completed_with_faults", result["outcome_reasons"]
+    # Only the silent robot is blamed: nobody downstream of its base station fired a watchdog of its own.
+    assert result["dead"] == ["robot/a/1"], result["faults"]
+    assert [f["process"] for f in result["faults"]] == ["robot/a/1"], result["faults"]
+    assert result["sent_by_key"]["team/a/report/1"] == 0 and result["sent_by_key"]["robot/a/1/cmd"] == 1001
+    assert "fault: robot/a/1" in err and "Traceback" not in err
 
 
 def plain_client(endpoint: str) -> zenoh.Session:

@@ -89,9 +89,22 @@ def test_a_parked_robot_leaves_the_field_for_good():
     assert ph.parked() == [("b", 1)]
 
 
-def _summary(process, dead=(), dead_at=None, tick=100, conflicts=None):
+def _summary(process, dead=(), dead_at=None, tick=100, conflicts=None, silent=None):
     return Summary(tick=tick, process=process, pid=1, digest="", sent=0, rejected=0, dead=list(dead),
-                   dead_at=dead_at or {}, conflicts=conflicts or {})  # fmt: skip
+                   dead_at=dead_at or {}, conflicts=conflicts or {},
+                   extra={"silent": silent} if silent else {})  # fmt: skip
+
+
+def test_a_peer_found_silent_while_alive_is_blamed_not_the_one_that_waited():
+    """Issue 20: a robot sends its cmd but never its report. Its base station gives up on it (it was alive,
+    and not waiting itself); muted, the robot later finds its base station silent too. Only it is dead."""
+    sums = {
+        "engine": _summary("engine"),
+        "basestation/a": _summary("basestation/a", ["robot/a/1"], {"robot/a/1": 1}, silent={"robot/a/1": 1}),
+        "robot/a/1": _summary("robot/a/1", ["basestation/a"], {"basestation/a": 210}, silent={"basestation/a": 210}),
+        "robot/a/2": _summary("robot/a/2"),
+    }
+    assert blame(sums, set()) == {"robot/a/1": 1}
 
 
 def test_a_process_that_was_lost_itself_blames_nobody():
