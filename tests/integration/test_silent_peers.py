@@ -13,6 +13,7 @@ import subprocess
 import sys
 
 import msgpack
+import pytest
 import zenoh
 
 from tests.integration.helpers import spawn, wait_for
@@ -44,18 +45,20 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_a_robot_that_sends_cmd_but_no_report_alone_is_blamed(reap, tmp_path):
+@pytest.mark.parametrize("secure", ["--no-secure", "--secure"])
+def test_a_robot_that_sends_cmd_but_no_report_alone_is_blamed(reap, tmp_path, secure):
     """Issue 20: it used to give ticks 0, the engine dead and exit 0 after every watchdog fired at once.
 
     Its base station waits for the report, everyone downstream waits for the base station. A short
     wait_timeout (4 s, from a --config file) keeps the test short; with it, every process announces
-    its wait, so only the base station, whose sender owes the frame, gives up.
+    its wait, so only the base station, whose sender owes the frame, gives up. With --secure, the
+    router's access control lets each process declare its own waiting tokens and read everyone's.
     """
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     config = tmp_path / "quick.toml"
     config.write_text("[timing]\nwait_timeout = 4.0\n")
     proc = spawn(*MATCH, "--config", str(config), "--half-time", "10", "--seed", "4", "--match", "noreport",
-                 "--listen", endpoint, "--external", "a/1")  # fmt: skip
+                 "--listen", endpoint, "--external", "a/1", secure)  # fmt: skip
     reap.append(proc)
     line = ""
     while not line.strip().startswith("arena run robot"):

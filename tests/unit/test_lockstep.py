@@ -269,6 +269,39 @@ def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
         harness.close()
 
 
+def test_the_reactor_announces_a_long_wait_and_waits_on_while_its_sender_waits_upstream():
+    """Issue 20: only the receiver of the frame that is owed gives up; a sender that waits for its own
+    upstream at a tick not past the missing frame owes nothing yet."""
+    from arena.runtime.lockstep import Reactor
+
+    h = Harness()
+    announced: list = []
+    upstream = {"robot/a/1": 0}  # the tick the sender announces it waits before; None: not waiting
+    asked: list = []
+
+    def upstream_waiting(sender, missing):
+        asked.append((sender, missing))
+        at = upstream[sender]
+        return at is not None and at <= missing
+
+    def loop():
+        for k in range(3):
+            yield h.inbound, k
+
+    reactor = Reactor(timeout=0.3, announce=announced.append, upstream_waiting=upstream_waiting)
+    runner = threading.Thread(target=reactor.run, args=(loop(),))
+    runner.start()
+    time.sleep(1.0)  # three timeouts: the sender waits before tick 0, frame 0 is missing, so we wait on
+    assert not h.inbound.dead and runner.is_alive()
+    assert announced == [1], "the wait before acting at tick 1 is announced"
+    assert asked and set(asked) == {("robot/a/1", 0)}
+    upstream["robot/a/1"] = 5  # it went past tick 0 without sending it: it owes the frame
+    runner.join(5.0)
+    assert not runner.is_alive() and h.inbound.dead and "silent" in h.dead["robot/a/1"]
+    assert announced[-1] is None, "taken back when the loop ends"
+    h.close()
+
+
 def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
     from arena.runtime.lockstep import Reactor
 
