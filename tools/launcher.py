@@ -756,7 +756,7 @@ def play_match(
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
             # An external's digest is recomputed from the frames it puts (tools/witness.py).
-            witness = Witness(transport, keys, cfg.robots, {str(p) for p in external})
+            witness = Witness(transport, keys, cfg.robots, {str(p) for p in external}, cfg.timing.periods())
             if starter is not None:
                 starter.release()
             for p in cfg.processes() if starter is None else ():

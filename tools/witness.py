@@ -17,7 +17,9 @@ from __future__ import annotations
 import hashlib
 import threading
 
-from arena.schemas.keys import Keys, routes
+import msgspec
+
+from arena.schemas.keys import Keys, routes, spec_of
 
 
 def digest_update(h: hashlib.blake2b, rel: str, payload: bytes) -> None:
@@ -30,24 +32,44 @@ def digest_update(h: hashlib.blake2b, rel: str, payload: bytes) -> None:
 class Witness:
     """Recomputes the digest of each watched process from the frames it puts."""
 
-    def __init__(self, transport, keys: Keys, robots: int, watched: set[str]):
+    def __init__(self, transport, keys: Keys, robots: int, watched: set[str], periods: dict[str, int]):
         self.digests: dict[str, hashlib.blake2b] = {name: hashlib.blake2b(digest_size=16) for name in watched}
         self.frames: dict[str, int] = dict.fromkeys(watched, 0)
         self.matched: set[str] = set()
+        self.conflicted: set[str] = set()  # someone else put a frame for a tick it had sent
         self._lock = threading.Lock()
         for rel, sender, _ in routes(robots):
             if sender in self.digests:
-                transport.subscribe_callback(keys.prefix + rel, self._on(sender, rel))
+                spec = spec_of(rel)
+                if spec is not None and spec.timing.period is not None:
+                    transport.subscribe_callback(keys.prefix + rel, self._on(sender, rel, spec, periods))
 
-    def _on(self, sender: str, rel: str):
+    def _on(self, sender: str, rel: str, spec, periods: dict[str, int]):
+        """Only the in-sequence frame of each scheduled tick counts, as for a receiver.
+
+        Anyone can put on an external's keys (outside --secure): garbage, or frames
+        for ticks it has not reached, never enter the recomputed digest; a second
+        frame for a tick already counted makes the digest unverifiable, not wrong.
+        """
         h = self.digests[sender]
+        period, phase = spec.timing.schedule(periods)
+        decode = msgspec.msgpack.Decoder(spec.message).decode
+        due = [phase]
 
         def on_frame(payload: bytes) -> None:
             if payload[:1] == b"\xc1":  # a local wake-up, never a message
                 return
+            try:
+                tick = decode(payload).tick
+            except (msgspec.DecodeError, msgspec.ValidationError):
+                return
             with self._lock:
-                digest_update(h, rel, payload)
-                self.frames[sender] += 1
+                if tick == due[0]:
+                    digest_update(h, rel, payload)
+                    self.frames[sender] += 1
+                    due[0] += period
+                elif tick < due[0]:
+                    self.conflicted.add(sender)
 
         return on_frame
 
@@ -66,7 +88,7 @@ class Witness:
             n = self.frames[name]
         if seen == digest:
             self.matched.add(name)
-        elif not dead:
+        elif not dead and name not in self.conflicted:
             return f"digest {digest} is not that of the {n} frames it sent ({seen})"
         return None
 

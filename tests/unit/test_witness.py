@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import hashlib
 
+import msgspec
+
 from arena.runtime.lockstep import Outbound
-from arena.schemas.keys import Keys
+from arena.schemas.keys import DEFAULT_PERIODS, Keys
 from arena.schemas.messages import Cmd, Pose, Report
 from arena.tools.witness import Witness, digest_update
+
+PERIODS = dict(DEFAULT_PERIODS)
 
 
 class Callbacks:
@@ -44,7 +48,7 @@ def test_the_readme_digest_layout_is_the_one_the_processes_compute():
 def test_the_witness_accepts_the_true_digest_and_refuses_another():
     expected, wire = _sent_by_a_node()
     tr = Callbacks()
-    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"})
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"}, periods=PERIODS)
     assert set(tr.callbacks) == {"arena/w/robot/a/1/cmd", "arena/w/team/a/report/1"}
     for rel, payload in wire:
         tr.callbacks[f"arena/w/{rel}"](payload)
@@ -58,8 +62,22 @@ def test_the_witness_accepts_the_true_digest_and_refuses_another():
 def test_a_process_that_muted_a_key_for_a_dead_receiver_is_accepted_unverified():
     _, wire = _sent_by_a_node()
     tr = Callbacks()
-    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"})
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"}, periods=PERIODS)
     for rel, payload in wire[:3]:
         tr.callbacks[f"arena/w/{rel}"](payload)
     assert w.check("robot/a/1", "1" * 32, dead=["basestation/a"]) is None
     assert w.verified() == []
+
+
+def test_garbage_and_frames_of_future_ticks_from_others_do_not_count_and_a_duplicate_tick_is_unverifiable():
+    expected, wire = _sent_by_a_node()
+    tr = Callbacks()
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"}, periods=PERIODS)
+    cmd = tr.callbacks["arena/w/robot/a/1/cmd"]
+    cmd(b"\x93garbage")  # not a Cmd
+    cmd(msgspec.msgpack.encode(Cmd(tick=40)))  # a tick it has not reached
+    for rel, payload in wire:
+        tr.callbacks[f"arena/w/{rel}"](payload)
+    assert w.check("robot/a/1", expected, dead=[]) is None and w.verified() == ["robot/a/1"]
+    cmd(msgspec.msgpack.encode(Cmd(tick=2, vx=3.0)))  # a forger's frame for a tick already sent
+    assert w.check("robot/a/1", "2" * 32, dead=[]) is None, "unverifiable, not refused"
