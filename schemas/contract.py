@@ -316,11 +316,15 @@ payload's length as 4 bytes little-endian, and the payload bytes exactly as
 put; `digest` is its lowercase hex (32 digits). Summaries, taps and acks are
 not part of it. **It is checked:** for every `--external` process the
 launcher (the match's router) recomputes the digest from the frames it
-receives from that process (tools/witness.py), and a Summary whose digest
+receives on that process's keys, counting, like a receiver, only the
+in-sequence frame of each scheduled tick that decodes as the key's message
+(so put nothing else: no malformed frame, no extra tick) (tools/witness.py),
+and a Summary whose digest
 differs is refused (counted under `forged_summaries`, the process gets no
 summary); the match JSON lists the processes whose digest matched under
-`digests_verified`. The one exception: a Summary that lists peers in `dead`
-is accepted unverified, since a process stops putting a key whose only
+`digests_verified`. Accepted unverified instead: a Summary when someone else put a frame on
+its keys for a tick it had already sent (a conflict), and one that lists
+peers in `dead`, since a process stops putting a key whose only
 receiver is dead but keeps digesting it (so should you: the digest covers
 every frame of the schedule, put or not). The launcher's own processes are its code; their digests
 are pinned by tests (same seed, same digest).
