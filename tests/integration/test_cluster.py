@@ -226,3 +226,58 @@ def test_interrupt_cancels_tasks_keeps_results_then_resume(cluster, tmp_path, re
     summary = arena_json(*args, "--resume")
     assert summary["skipped"] == len(kept) and len(summary["matches"]) == 3
     check_tables(summary, 2)
+
+
+@pytest.mark.slow
+def test_runtime_env_with_another_version_fails_naming_both(tmp_path):
+    """A real pip runtime_env gives the workers a wheel of version 0.0.9: every match fails, naming both versions."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    src = tmp_path / "src"
+    src.mkdir()
+    archive = subprocess.run(["git", "-C", str(root), "archive", "HEAD"], capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(src)], input=archive, check=True)
+    pyproject = src / "pyproject.toml"
+    pyproject.write_text(pyproject.read_text().replace('version = "0.1.0"', 'version = "0.0.9"'))
+    wheels = tmp_path / "wheels"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(src)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    (wheel,) = wheels.glob("soccer_arena-0.0.9-*.whl")
+    env = json.dumps({"pip": [str(wheel)]})
+    args = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--jobs", "1")
+    out = tmp_path / "out"
+    # Run outside the checkout: Ray puts the driver's working directory on the workers' sys.path.
+    r = subprocess.run(
+        [*ARENA, *args, "--ray", "--ray-runtime-env", env, "--out", str(out), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+    )
+    assert "Traceback" not in r.stderr, r.stderr[-3000:]
+    summary = json.loads(r.stdout)
+    (failed,) = summary["failed"]
+    mine = json.loads(
+        subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import json; from arena.tools import cluster; print(json.dumps(cluster.fingerprint()))",
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    )
+    assert "version mismatch" in failed["reason"]
+    assert "the worker has soccer-arena 0.0.9 (git none" in failed["reason"]
+    assert (
+        f"the driver has soccer-arena {mine['version']} (git {mine['git']}, source {mine['source']})"
+        in failed["reason"]
+    )
+    assert summary["matches"][0]["attempts"] == 2
