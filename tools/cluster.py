@@ -10,8 +10,8 @@ in its own process group with its own zenoh router (a unix socket in a private
 temp dir), so matches never hear each other, on one node or many. The task
 returns the match's JSON; the driver writes the result atomically to
 `<out>/matches/<id>.json` as it arrives (so `--resume` works), feeds the
-progress bar from `ray.wait`, and on Ctrl-C or SIGTERM cancels the pending
-tasks (`ray.cancel(force=True)` kills the worker, the match dies with it by
+progress bar from `ray.wait`, and on Ctrl-C or SIGTERM ends the Ray job
+(Ray kills the job's workers, and each match dies with its worker by
 PR_SET_PDEATHSIG) and keeps what is finished.
 
 Two kinds of failure, two mechanisms:
@@ -273,9 +273,11 @@ def _play(args, runner, todo: list, on_result) -> bool:
                     if queue:
                         submit(queue.pop(0), 1)
         except KeyboardInterrupt:
-            for ref in inflight:
-                with contextlib.suppress(Exception):
-                    ray.cancel(ref, force=True)
+            # No ray.cancel: Ray 2.60's driver aborts ("Tried to complete task
+            # that was not pending") when a force-cancelled task's reply is
+            # already on its way. Disconnecting the driver (ray.shutdown, below)
+            # ends the job, Ray kills the job's workers, and each match dies
+            # with its worker (PR_SET_PDEATHSIG).
             return True
         return False
     finally:
