@@ -76,7 +76,9 @@ def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
     assert result["dead"] == ["robot/b/1"]
     [fault] = result["faults"]
     assert fault["process"] == "robot/b/1" and "code -9" in fault["reason"]
-    assert at <= fault["tick"] <= at + 500, (at, fault)
+    # The referee may run a few ticks ahead of the engine (its links have lag 1 and it sends every 5th
+    # tick), so the engine can notice the crash at a tick just below the referee frame the test saw.
+    assert at - 10 <= fault["tick"] <= at + 500, (at, fault)
     assert "fault: robot/b/1 at tick" in err and "Traceback" not in err
     parked = result["parked"]["b/1"]
     assert fault["tick"] <= parked["tick"] <= fault["tick"] + 1
