@@ -130,8 +130,8 @@ ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),
 # router, tap batches of ~100 kB included. With tx handed over to rx, a reactive
 # node's BLOCK put on zenoh's only thread waited for queue room that only that
 # thread could make, and in secure recorded matches the engine stalled until its
-# lease expired. A transmit thread of its own ends that; the router of a secure
-# match, which carries every frame, gets one too (docs/performance.md, "Measurements
+# lease expired. A transmit thread of its own ends that; every router gets one too
+# (a secure match's carries every frame, a peer match's relays to spectators) (docs/performance.md, "Measurements
 # behind design choices").
 CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1),net:(handover:rx),app:(handover:rx))"
 
@@ -156,7 +156,9 @@ def open_session(net: NetConfig) -> zenoh.Session:
     OPENED[0] = True
     if os.environ.get("ZENOH_RUNTIME") in (None, ONE_THREAD_RUNTIME, CLIENT_RUNTIME):
         # Ours, not the user's (children inherit the launcher's environment): choose per mode.
-        relays = net.mode == "client" or any(path == "access_control" for path, _ in net.extra)
+        # A router relays to clients (a spectator on `**`): dropping for a slow one must not
+        # hold the only thread that reads the peers' links (issue 20 item 6).
+        relays = net.mode in ("client", "router") or any(path == "access_control" for path, _ in net.extra)
         os.environ["ZENOH_RUNTIME"] = CLIENT_RUNTIME if relays else ONE_THREAD_RUNTIME
     check_runtime_variable(os.environ["ZENOH_RUNTIME"])
     for ep in net.listen:
