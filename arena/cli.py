@@ -789,7 +789,23 @@ def cmd_tournament(args: argparse.Namespace) -> int:
         parse_runtime_env(args.ray_runtime_env)
     elif args.ray_runtime_env is not None:
         raise ConfigError("--ray-runtime-env needs --ray")
-    summary, interrupted = tournament.run(args)
+    opts = tournament.TournamentOptions(
+        strategies=tuple(names),
+        legs=args.legs,
+        half_time=args.half_time,
+        robots=args.robots,
+        link=args.link,
+        link_param=tuple(args.link_param),
+        seed=args.seed,
+        jobs=args.jobs,
+        out=Path(args.out),
+        resume=args.resume,
+        json=args.json,
+        engine=args.engine,
+        ray=args.ray,
+        ray_runtime_env=args.ray_runtime_env,
+    )
+    summary, interrupted = tournament.run(opts)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -810,7 +826,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.what == "throughput":
         from arena.tools import throughput
 
-        return throughput.bench_throughput(args)
+        return throughput.bench_throughput(args.runs, args.half_time, args.robots, args.link, args.strategy, args.json)
     if args.what == "nav":
         from arena.tools import navbench
 

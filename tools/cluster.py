@@ -40,8 +40,12 @@ import threading
 import time
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from arena.runtime.config import ConfigError
+
+if TYPE_CHECKING:
+    from arena.tools.tournament import TournamentOptions
 
 # CPUs a match needs, by engine: the distributed engine runs ~11 processes
 # that keep about two cores busy; the in-process engine is one thread.
@@ -217,33 +221,33 @@ def play_on_worker(job: dict, driver: dict) -> dict:
 
 
 # ------------------------------------------------------------------ driver
-def task_cpus(args) -> float:
-    return TASK_CPUS.get(getattr(args, "engine", None) or "processes", 2.0)
+def task_cpus(engine: str) -> float:
+    return TASK_CPUS.get(engine or "processes", 2.0)
 
 
-def play(args, runner, todo: list, on_result) -> bool:
+def play(opts: TournamentOptions, runner, todo: list, on_result) -> bool:
     """Play `todo` on the cluster; call on_result(Result) as each arrives. Returns interrupted."""
     # Ray's driver prints cluster events ("Raylet is terminated ...") to
     # sys.stdout, which is for the tournament's --json: they go to a log.
     with open(runner.logs_dir / "ray-driver.log", "a") as log, contextlib.redirect_stdout(log):
-        return _play(args, runner, todo, on_result)
+        return _play(opts, runner, todo, on_result)
 
 
-def _play(args, runner, todo: list, on_result) -> bool:
+def _play(opts: TournamentOptions, runner, todo: list, on_result) -> bool:
     from arena.tools import tournament as T
 
-    cpus = task_cpus(args)
-    jobs = args.jobs or T.default_jobs()
-    address = parse_address(args.ray)
-    ray = connect(address, jobs * cpus, parse_runtime_env(getattr(args, "ray_runtime_env", None)))
+    cpus = task_cpus(opts.engine)
+    jobs = opts.jobs or T.default_jobs()
+    address = parse_address(opts.ray)
+    ray = connect(address, jobs * cpus, parse_runtime_env(opts.ray_runtime_env))
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, T._interrupt)  # ray.init put in its own, which exits at once
     try:
         remote = ray.remote(play_on_worker).options(num_cpus=cpus, max_retries=SYSTEM_RETRIES, retry_exceptions=False)
         driver = fingerprint()
-        timeout = 120.0 + 2.0 * args.half_time
+        timeout = 120.0 + 2.0 * opts.half_time
         # An existing cluster decides how many run at once; --jobs caps it if given.
-        cap = jobs if address is None or args.jobs else len(todo)
+        cap = jobs if address is None or opts.jobs else len(todo)
         queue = list(todo)
         inflight: dict = {}  # ref -> (fixture, attempt)
 

@@ -22,7 +22,6 @@ the CPU bound is the one that holds for it.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import resource
@@ -44,12 +43,12 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def play(engine: str, args: argparse.Namespace, seed: int) -> dict:
-    argv = [sys.executable, "-m", "arena", "match", "--home", args.strategy, "--away", args.strategy]
-    argv += ["--robots", str(args.robots), "--half-time", str(args.half_time), "--link", args.link]
+def play(engine: str, seed: int, *, strategy: str, robots: int, half_time: float, link: str) -> dict:
+    argv = [sys.executable, "-m", "arena", "match", "--home", strategy, "--away", strategy]
+    argv += ["--robots", str(robots), "--half-time", str(half_time), "--link", link]
     argv += ["--seed", str(seed), "--engine", engine, "--json"]
     cpu0, t0 = _children_cpu(), time.time()
-    proc = subprocess.run(argv, capture_output=True, text=True, timeout=600 + 10 * args.half_time)
+    proc = subprocess.run(argv, capture_output=True, text=True, timeout=600 + 10 * half_time)
     wall, cpu = time.time() - t0, _children_cpu() - cpu0
     if proc.returncode != 0:
         tail = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
@@ -88,25 +87,24 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
     }
 
 
-def bench_throughput(args: argparse.Namespace) -> int:
+def bench_throughput(runs: int, half_time: float, robots: int, link: str, strategy: str, as_json: bool) -> int:
     console = Console(stderr=True)
     cores = os.cpu_count() or 1
     jobs = default_jobs()
-    runs: dict[str, list[dict]] = {e: [] for e in ENGINES}
-    for i in range(args.runs):
+    played: dict[str, list[dict]] = {e: [] for e in ENGINES}
+    for i in range(runs):
         seed = 1 + i
         for engine in ENGINES if i % 2 == 0 else ENGINES[::-1]:
-            console.print(f"run {i + 1}/{args.runs}: --engine {engine}, 2 x {args.half_time:g} s, seed {seed} ...")
-            r = play(engine, args, seed)
-            runs[engine].append(r)
+            console.print(f"run {i + 1}/{runs}: --engine {engine}, 2 x {half_time:g} s, seed {seed} ...")
+            r = play(engine, seed, strategy=strategy, robots=robots, half_time=half_time, link=link)
+            played[engine].append(r)
             console.print(f"  rtf {r['rtf']:.1f}, first tick after {r['launch_to_first_tick_s']:.2f} s")
-    per = {e: summarise(runs[e], jobs, cores) for e in ENGINES}
-    same = all(a["digest"] == b["digest"] for a, b in zip(runs["processes"], runs["inprocess"]))
-    ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(runs["processes"], runs["inprocess"]))
+    per = {e: summarise(played[e], jobs, cores) for e in ENGINES}
+    same = all(a["digest"] == b["digest"] for a, b in zip(played["processes"], played["inprocess"]))
+    ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
     out = {
-        "runs": args.runs,
-        "match": f"{args.strategy} v {args.strategy}, {args.robots}v{args.robots}, 2 x {args.half_time:g} s, "
-        f"link {args.link}",
+        "runs": runs,
+        "match": f"{strategy} v {strategy}, {robots}v{robots}, 2 x {half_time:g} s, link {link}",
         "cores": cores,
         "jobs": jobs,
         "engines": per,
@@ -114,14 +112,14 @@ def bench_throughput(args: argparse.Namespace) -> int:
         "digests_equal": same,
         "throughput_how": "matches/hour of 2 x 300 s = min(jobs x 3600 / (600 / rtf + start-up and teardown), "
         "cores x 3600 / (CPU s per simulated s x 600)), from the medians above",
-        "all_runs": runs,
+        "all_runs": played,
     }
-    if args.json:
+    if as_json:
         print(json.dumps(out, indent=2))
         return 0 if same else 1
     from rich.table import Table
 
-    t = Table(title=f"arena bench throughput: medians of {args.runs} interleaved runs, {out['match']}")
+    t = Table(title=f"arena bench throughput: medians of {runs} interleaved runs, {out['match']}")
     t.add_column("metric")
     for e in ENGINES:
         t.add_column(e, justify="right")

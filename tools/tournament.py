@@ -37,7 +37,6 @@ from itertools import combinations
 from pathlib import Path
 
 from arena.runtime import seeds
-from arena.strategies import registry
 
 ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
 
@@ -51,24 +50,48 @@ def plural(n: int, word: str, words: str | None = None) -> str:
 BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "seed")
 
 
-def settings(args) -> dict:
+@dataclass(frozen=True)
+class TournamentOptions:
+    """What `arena tournament` plays and how: its flags, typed (arena/cli.py builds one from argv)."""
+
+    strategies: tuple[str, ...]  # resolved names, in the order given
+    legs: int = 10
+    half_time: float = 300.0  # [s] simulated, per half
+    robots: int = 3
+    link: str = "ideal"
+    link_param: tuple[str, ...] = ()  # CLASS.PARAM=V, as given to --link-param
+    seed: int = 0
+    jobs: int = 0  # 0: one per core
+    out: Path = Path("tournament")
+    resume: bool = False
+    json: bool = False
+    engine: str = "processes"
+    ray: str | None = None  # None: no Ray; "": a local instance; else auto or HOST:PORT
+    ray_runtime_env: str | None = None  # JSON text
+
+    def link_overrides(self) -> dict[str, dict[str, float]]:
+        from arena.runtime.links import parse_override
+
+        overrides: dict[str, dict[str, float]] = {}
+        for text in self.link_param:
+            cls, param, value = parse_override(text)
+            overrides.setdefault(cls, {})[param] = value
+        return overrides
+
+
+def settings(opts: TournamentOptions) -> dict:
     """Everything needed to play the tournament again (tournament.json, report.md, --resume's check)."""
     from arena.cli import package_version
-    from arena.runtime.links import parse_override
 
-    overrides: dict[str, dict[str, float]] = {}
-    for text in getattr(args, "link_param", []) or []:
-        cls, param, value = parse_override(text)
-        overrides.setdefault(cls, {})[param] = value
     return {
-        "strategies": [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()],
-        "legs": args.legs,
-        "half_time": float(args.half_time),
-        "robots": args.robots,
-        "link": args.link,
-        "link_overrides": overrides,
-        "seed": args.seed,
-        "engine": getattr(args, "engine", "processes"),
+        "strategies": list(opts.strategies),
+        "legs": opts.legs,
+        "half_time": float(opts.half_time),
+        "robots": opts.robots,
+        "link": opts.link,
+        "link_overrides": opts.link_overrides(),
+        "seed": opts.seed,
+        "engine": opts.engine,
         "version": package_version(),
     }
 
@@ -488,8 +511,8 @@ def void_reason(m: dict) -> str:
 class Runner:
     """Plays fixtures as `arena match` subprocesses; stoppable from the main thread."""
 
-    def __init__(self, args, out: Path):
-        self.args = args
+    def __init__(self, opts: TournamentOptions, out: Path):
+        self.opts = opts
         self.matches_dir = out / "matches"
         self.matches_dir.mkdir(parents=True, exist_ok=True)
         self.logs_dir = out / "logs"
@@ -497,7 +520,7 @@ class Runner:
         self._lock = threading.Lock()
         self._running: set[subprocess.Popen] = set()
         self.stopping = False
-        self.engine = getattr(args, "engine", "processes")
+        self.engine = opts.engine
         # --engine inprocess: one worker process per job, each playing whole
         # matches in one thread, one after another; it imports once, not per match.
         self.pool = None
@@ -506,27 +529,22 @@ class Runner:
             from concurrent.futures import ProcessPoolExecutor
 
             self.pool = ProcessPoolExecutor(
-                max_workers=args.jobs or default_jobs(),
+                max_workers=opts.jobs or default_jobs(),
                 mp_context=multiprocessing.get_context("spawn"),
                 initializer=_worker_init,
             )
 
     def match_config(self, fx: Fixture):
         from arena.runtime.config import MatchConfig
-        from arena.runtime.links import parse_override
 
-        overrides: dict[str, dict[str, float]] = {}
-        for text in self.args.link_param:
-            cls, param, value = parse_override(text)
-            overrides.setdefault(cls, {})[param] = value
         cfg = MatchConfig(
             seed=fx.seed,
             home=fx.home,
             away=fx.away,
-            robots=self.args.robots,
-            half_time=self.args.half_time,
-            link=self.args.link,
-            link_overrides=overrides,
+            robots=self.opts.robots,
+            half_time=self.opts.half_time,
+            link=self.opts.link,
+            link_overrides=self.opts.link_overrides(),
         )
         cfg.validate()
         return cfg
@@ -574,7 +592,7 @@ class Runner:
                         p.kill()
 
     def command(self, fx: Fixture) -> list[str]:
-        a = self.args
+        a = self.opts
         argv = [
             sys.executable,
             "-m",
@@ -606,7 +624,7 @@ class Runner:
             return self.play_inprocess(fx)
         base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
         reason = ""
-        timeout = 120.0 + 2.0 * self.args.half_time  # generous: rtf >= 1 plus start-up
+        timeout = 120.0 + 2.0 * self.opts.half_time  # generous: rtf >= 1 plus start-up
         for attempt in (1, 2):
             if self.stopping:
                 return None
@@ -705,9 +723,9 @@ def default_jobs() -> int:
     return max(1, os.cpu_count() or 1)
 
 
-def play_local(args, runner: Runner, todo: list[Fixture], arrived) -> bool:
-    """`--jobs` matches at once in a thread pool; arrived(Result) as each is in. Returns interrupted."""
-    with ThreadPoolExecutor(max_workers=args.jobs or default_jobs()) as pool:
+def play_local(jobs: int, runner: Runner, todo: list[Fixture], arrived) -> bool:
+    """`jobs` (0: one per core) matches at once in a thread pool; arrived(Result) as each is in. Returns interrupted."""
+    with ThreadPoolExecutor(max_workers=jobs or default_jobs()) as pool:
         pending = {pool.submit(runner.play, fx) for fx in todo}
         try:
             while pending:
@@ -724,28 +742,28 @@ def play_local(args, runner: Runner, todo: list[Fixture], arrived) -> bool:
     return False
 
 
-def run(args) -> tuple[dict, bool]:
+def run(opts: TournamentOptions) -> tuple[dict, bool]:
     """Play (or resume) the tournament. Returns (summary, interrupted)."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    strategies = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
-    out = Path(args.out)
-    setup = settings(args)
-    if args.resume:
+    strategies = list(opts.strategies)
+    out = Path(opts.out)
+    setup = settings(opts)
+    if opts.resume:
         check_resume(out, setup)
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "settings.json", json.dumps(setup, indent=2))
-    fixtures = schedule(strategies, args.legs, args.seed)
-    runner = Runner(args, out)
-    have = load_results(runner.matches_dir) if args.resume else {}
+    fixtures = schedule(strategies, opts.legs, opts.seed)
+    runner = Runner(opts, out)
+    have = load_results(runner.matches_dir) if opts.resume else {}
     # Resume keeps finished matches; failed ones get another chance.
     todo = [fx for fx in fixtures if not (fx.id in have and have[fx.id].status == "ok")]
     results: dict[str, Result] = {fx.id: have[fx.id] for fx in fixtures if fx.id in have and have[fx.id].status == "ok"}
     t0 = time.monotonic()
     interrupted = False
     console = Console(stderr=True)
-    show = not args.json and sys.stderr.isatty()
+    show = not opts.json and sys.stderr.isatty()
     with Progress(
         TextColumn("[bold]tournament[/]"),
         BarColumn(),
@@ -770,16 +788,16 @@ def run(args) -> tuple[dict, bool]:
                 f"{short(r.home)} {r.score[0]}-{r.score[1]} {short(r.away)}" if r.status == "ok" else f"{r.id} failed"
             )
             bar.update(task, advance=1, last=last)
-            if not show and not args.json:
+            if not show and not opts.json:
                 console.print(f"[{len(results)}/{len(fixtures)}] {last}")
 
         try:
-            if getattr(args, "ray", None) is not None:
+            if opts.ray is not None:
                 from arena.tools import cluster  # imports Ray; never without --ray
 
-                interrupted = cluster.play(args, runner, todo, arrived)
+                interrupted = cluster.play(opts, runner, todo, arrived)
             else:
-                interrupted = play_local(args, runner, todo, arrived)
+                interrupted = play_local(opts.jobs, runner, todo, arrived)
         finally:
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
@@ -788,10 +806,10 @@ def run(args) -> tuple[dict, bool]:
     summary = report(
         ordered,
         strategies,
-        args.legs,
+        opts.legs,
         out,
         time.monotonic() - t0,
-        args.seed,
+        opts.seed,
         engine=runner.engine,
         total=len(fixtures),
         setup=setup,

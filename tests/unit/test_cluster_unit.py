@@ -51,8 +51,8 @@ def test_runtime_env():
 
 
 def test_task_cpus_by_engine():
-    assert cluster.task_cpus(SimpleNamespace(engine="processes")) == 2.0
-    assert cluster.task_cpus(SimpleNamespace(engine="inprocess")) == 1.0
+    assert cluster.task_cpus("processes") == 2.0
+    assert cluster.task_cpus("inprocess") == 1.0
 
 
 @pytest.fixture
