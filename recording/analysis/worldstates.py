@@ -26,6 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from arena.navigation.frames import wrap_angle
 from arena.runtime.stats import percentile
 from arena.schemas.messages import World, Worldstate
 
@@ -51,10 +52,6 @@ def _xy(v) -> tuple[float, float] | None:
     if type(x) not in (int, float) or type(y) not in (int, float) or not (math.isfinite(x) and math.isfinite(y)):
         return None
     return float(x), float(y)
-
-
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 def score_team(team: str, worldstates: Sequence[Worldstate], worlds: Sequence[World], dt: float) -> dict:
@@ -92,7 +89,7 @@ def score_team(team: str, worldstates: Sequence[Worldstate], worlds: Sequence[Wo
                 continue
             pos.setdefault(rid, []).append(math.hypot(xy[0] - gt.x, xy[1] - gt.y))
             if len(pose) >= 3 and type(pose[2]) in (int, float) and math.isfinite(pose[2]):
-                head.setdefault(rid, []).append(abs(_wrap(float(pose[2]) - gt.theta)))
+                head.setdefault(rid, []).append(abs(wrap_angle(float(pose[2]) - gt.theta)))
         balls = [b for b in doc.get("balls", []) if isinstance(b, dict) and _xy(b.get("position"))]
         if balls:
             best = max(balls, key=lambda b: b.get("confidence", 0) if type(b.get("confidence")) in (int, float) else 0)
