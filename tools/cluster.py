@@ -293,7 +293,6 @@ def finish(runner, fx, attempt: int, got: dict):
     """The Result of one attempt, written to --out; None if the match is to be played again."""
     from arena.tools.tournament import Result, void_reason, write_atomic
 
-    base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
     log = runner.logs_dir / f"{fx.id}.log"
     reason = got.get("reason", "")
     where = f"[cluster] attempt {attempt} played on node {got['node']}\n" if "node" in got else ""
@@ -306,19 +305,7 @@ def finish(runner, fx, attempt: int, got: dict):
         else:
             reason = void_reason(m)
         if not reason:
-            r = Result(
-                id=fx.id,
-                status="ok",
-                score=m["score"],
-                distance_m=m["distance_m"],
-                attempts=attempt,
-                wall_seconds=round(got["wall"], 2),
-                rtf=m["rtf"],
-                digest=m["digest"],
-                engine=m.get("engine", "processes"),
-                faults=m.get("faults", []),
-                **base,
-            )
+            r = Result.played(fx, m, attempt, got["wall"], m.get("engine", "processes"))
             write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
             return r
     if not reason:
@@ -326,6 +313,6 @@ def finish(runner, fx, attempt: int, got: dict):
         reason = tail[-1] if tail else f"exit code {got['rc']}"
     if attempt < 2:
         return None
-    r = Result(id=fx.id, status="failed", reason=reason, attempts=attempt, engine=runner.engine, **base)
+    r = Result.failed(fx, reason, attempt, runner.engine)
     write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
     return r

@@ -162,6 +162,11 @@ def schedule(strategies: list[str], legs: int, seed: int) -> list[Fixture]:
 
 
 # ------------------------------------------------------------------- results
+def fixture_fields(fx: Fixture) -> dict:
+    """The fields a `Result` repeats from its fixture."""
+    return {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
+
+
 @dataclass
 class Result:
     id: str
@@ -181,6 +186,27 @@ class Result:
     digest: str = ""
     engine: str = "processes"  # which engine played it (arena match --engine)
     faults: list[dict] = field(default_factory=list)  # a team's crashed process: the match counts (tools/faults.py)
+
+    @classmethod
+    def played(cls, fx: Fixture, m: dict, attempts: int, wall_seconds: float, engine: str) -> Result:
+        """Fixture `fx`'s result from its match JSON `m` (one that `void_reason` accepted)."""
+        return cls(
+            id=fx.id,
+            status="ok",
+            score=m["score"],
+            distance_m=m["distance_m"],
+            attempts=attempts,
+            wall_seconds=round(wall_seconds, 2),
+            rtf=m["rtf"],
+            digest=m["digest"],
+            engine=engine,
+            faults=m.get("faults", []),
+            **fixture_fields(fx),
+        )
+
+    @classmethod
+    def failed(cls, fx: Fixture, reason: str, attempts: int, engine: str) -> Result:
+        return cls(id=fx.id, status="failed", reason=reason, attempts=attempts, engine=engine, **fixture_fields(fx))
 
     def goals(self, team: str) -> tuple[int, int]:
         """(for, against) for `team` in this match."""
@@ -551,7 +577,6 @@ class Runner:
 
     def play_inprocess(self, fx: Fixture) -> Result | None:
         """`play` on a worker process of the pool (--engine inprocess)."""
-        base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
         reason = ""
         for attempt in (1, 2):
             if self.stopping:
@@ -565,21 +590,14 @@ class Runner:
                 reason = f"{type(exc).__name__}: {exc}".splitlines()[0]
                 (self.logs_dir / f"{fx.id}.log").write_text(reason + "\n")
                 continue
-            r = Result(
-                id=fx.id,
-                status="ok",
-                score=m["score"],
-                distance_m=m["distance_m"],
-                attempts=attempt,
-                wall_seconds=round(time.monotonic() - t0, 2),
-                rtf=m["rtf"],
-                digest=m["digest"],
-                engine=self.engine,
-                **base,
-            )
+            if void := void_reason(m):  # a void match is no result, whichever engine played it
+                reason = void
+                (self.logs_dir / f"{fx.id}.log").write_text(reason + "\n")
+                continue
+            r = Result.played(fx, m, attempt, time.monotonic() - t0, self.engine)
             write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
             return r
-        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, engine=self.engine, **base)
+        r = Result.failed(fx, reason, 2, self.engine)
         write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
         return r
 
@@ -622,7 +640,6 @@ class Runner:
         """Play one fixture (one retry on failure). None if stopped by Ctrl-C."""
         if self.pool is not None:
             return self.play_inprocess(fx)
-        base = {k: getattr(fx, k) for k in ("first", "second", "leg", "home", "away", "seed")}
         reason = ""
         timeout = 120.0 + 2.0 * self.opts.half_time  # generous: rtf >= 1 plus start-up
         for attempt in (1, 2):
@@ -656,24 +673,12 @@ class Runner:
                 if void := void_reason(m):
                     reason = void
                     continue
-                r = Result(
-                    id=fx.id,
-                    status="ok",
-                    score=m["score"],
-                    distance_m=m["distance_m"],
-                    attempts=attempt,
-                    wall_seconds=round(time.monotonic() - t0, 2),
-                    rtf=m["rtf"],
-                    digest=m["digest"],
-                    engine=self.engine,
-                    faults=m.get("faults", []),
-                    **base,
-                )
+                r = Result.played(fx, m, attempt, time.monotonic() - t0, self.engine)
                 write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
                 return r
             tail = (self.logs_dir / f"{fx.id}.log").read_text(errors="replace").strip().splitlines()
             reason = reason or (tail[-1] if tail else f"exit code {proc.returncode}")
-        r = Result(id=fx.id, status="failed", reason=reason, attempts=2, engine=self.engine, **base)
+        r = Result.failed(fx, reason, 2, self.engine)
         write_atomic(self.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
         return r
 
