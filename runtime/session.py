@@ -113,6 +113,11 @@ class NetConfig:
         c.insert_json5("listen/endpoints", json.dumps(listen))
         c.insert_json5("transport/link/tx/lease", "6000")
         c.insert_json5("transport/link/tx/keep_alive", "4")
+        if self.mode == "router" and not self.multicast and not self.connect:
+            # zenoh 1.10 starts a router with a plain sleep of `scouting/delay` (500 ms by
+            # default), meant for scouting and connecting to other routers. With neither, it
+            # only delayed every match's start by half a second (docs/performance.md, session 6).
+            c.insert_json5("scouting/delay", "0")
         for path, value in self.extra:
             c.insert_json5(path, value)
         return c
