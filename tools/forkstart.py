@@ -138,12 +138,35 @@ class ForkedProcess:
         self.send_signal(signal.SIGKILL)
 
 
+def starter(count: int, kinds: set[str], strategies: set[str]) -> Starter | None:
+    """How to start a match's `count` processes: this process's zygote if it has one
+    (tools/zygote.py), else a fork of this process if it can, else None (exec)."""
+    from arena.tools import zygote
+
+    z = zygote.running()
+    if z is not None:
+        try:
+            return Starter(z, count)
+        except OSError:
+            zygote.stop()
+    if not enabled():
+        return None
+    preload(kinds, strategies)
+    return Starter()
+
+
 class Starter:
     """Forks the children of one match; `release` lets them open their sessions."""
 
-    def __init__(self) -> None:
+    def __init__(self, zygote=None, count: int = 0) -> None:
+        """Fork here, or with `zygote` (tools/zygote.py) hand `count` jobs to its parked children."""
         self._go_r, self._go_w = os.pipe()
         self._count = 0
+        self._frozen = False
+        self._zygote = zygote
+        self._parked = zygote.take(count) if zygote is not None else []
+        if zygote is not None:
+            return
         # The children inherit the parent's objects as frozen: their first full
         # collection (`settle_heap`, before the first tick) then scans only what they
         # made themselves, not every imported module's objects (~100 ms a child), and
@@ -154,6 +177,9 @@ class Starter:
 
     def fork(self, argv: list[str], log_path: Path) -> ForkedProcess:
         """Fork `arena <argv>` (argv as after `python -m arena`), logging to `log_path`."""
+        if self._zygote is not None:
+            self._count += 1
+            return self._zygote.launch(self._parked.pop(), argv, log_path, self._go_r)
         sys.stdout.flush()
         sys.stderr.flush()
         parent = os.getpid()
@@ -163,6 +189,18 @@ class Starter:
         self._count += 1
         return ForkedProcess(pid)
 
+    @property
+    def how(self) -> str:
+        return "fork" if self._zygote is None else "zygote"
+
+    def refill(self) -> None:
+        """Have the zygote, if any, fork children for the next match (in the background)."""
+        if self._zygote is not None:
+            try:
+                self._zygote.prepare(self._count)
+            except OSError:
+                pass
+
     def release(self) -> None:
         """The router is up: every forked child may start."""
         if self._go_w >= 0:
@@ -170,6 +208,13 @@ class Starter:
             self.close()
 
     def close(self) -> None:
+        for pid, sock in self._parked:  # more taken from a zygote than forked: they exit on end-of-file
+            sock.close()
+            try:
+                os.waitpid(pid, 0)
+            except ChildProcessError:
+                pass
+        self._parked = []
         if self._frozen:
             gc.unfreeze()
             self._frozen = False
@@ -211,7 +256,8 @@ def retitle(argv: list[str]) -> None:
 def _child(argv: list[str], log_path: Path, go_r: int, go_w: int, parent: int) -> None:
     code = 1
     try:
-        os.close(go_w)
+        if go_w >= 0:
+            os.close(go_w)
         os.setsid()
         try:
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)

@@ -744,10 +744,9 @@ def play_match(
     try:
         # Fork the processes before any zenoh session exists here (tools/forkstart.py);
         # they open theirs once the router is up.
-        if forkstart.enabled():
-            local = [p for p in cfg.processes() if p not in external]
-            forkstart.preload({p.kind for p in local}, {cfg.home, cfg.away})
-            starter = forkstart.Starter()
+        local = [p for p in cfg.processes() if p not in external]
+        starter = forkstart.starter(len(local), {p.kind for p in local}, {cfg.home, cfg.away})
+        if starter is not None:
             for p in local:
                 argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
                 log_path = logs / (str(p).replace("/", "_") + ".log")
@@ -772,6 +771,8 @@ def play_match(
                 announce(instructions(sorted(external), match, endpoint, record, cred_paths, secure))
             try:
                 joins.wait(cfg.timing.startup_timeout, children)
+                if starter is not None:
+                    starter.refill()  # a zygote forks the next match's children while this one plays
                 got = supervise(
                     transport,
                     collector,
@@ -798,7 +799,7 @@ def play_match(
         result["secure"] = secure
         result["digests_verified"] = witness.verified()
         result["startup_seconds"] = startup_seconds(got.summaries, launched)
-        result["launch"] = "exec" if starter is None else "fork"
+        result["launch"] = "exec" if starter is None else starter.how
         engine = got.summaries.get("engine")
         result["play_started_unix"] = engine.extra.get("play_started") if engine is not None else None
         if result["outcome"] != "completed" and log_dir is None:
