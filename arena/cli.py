@@ -17,6 +17,7 @@ Bad input never ends in a traceback. Exit codes, the same for every subcommand:
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import logging
 import math
@@ -190,6 +191,22 @@ def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tr
         default=[],
         metavar="CLASS.PARAM=V",
         help="override one link parameter, e.g. wifi.latency_ms=12 (repeatable)",
+    )
+    p.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="a robot at tick k sees the sense of tick k - TICKS (the model; changes digests), e.g. "
+        "--perception-latency 0 for the pre-2026-11-25 model (default: timing.perception_latency)",
+    )
+    p.add_argument(
+        "--batch",
+        type=int,
+        default=None,
+        metavar="N",
+        help="sense/cmd frames per message, 1..perception latency; 0 = as many as it allows (a transport "
+        "detail: digests are the same for every N), e.g. --batch 1 for one frame per message (0)",
     )
 
 
@@ -502,7 +519,13 @@ def match_config(
     resolve(link, overrides)  # validates preset, classes and values
     home = registry.resolve_name(args.home or base.home)
     away = registry.resolve_name(args.away or base.away)
+    timing = base.timing
+    if getattr(args, "perception_latency", None) is not None:
+        timing = dataclasses.replace(timing, perception_latency=args.perception_latency)
+    if getattr(args, "batch", None) is not None:
+        timing = dataclasses.replace(timing, batch=args.batch)
     cfg = base.replace(
+        timing=timing,
         seed=args.seed if args.seed is not None else base.seed,
         home=home,
         away=away,

@@ -166,6 +166,8 @@ class EngineNode(Node):
         self.cmd_in = {(team, n): self.inp("cmd", team, n, check=self.check_cmd) for team, n in self.robots}
         self.ref_in = self.inp("referee", check=check_referee)
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
+        for ob in self.sense_out.values():  # L ticks of senses per message (runtime/config.py `frames_per_message`)
+            ob.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
         self.world_out = self.out("world", viewers_only=True)
         self.events_out = self.out("events")
         self.field_out = self.out("field")

@@ -1,6 +1,7 @@
 """Robot process: perception in, behaviour, command out (one per robot).
 
-Inputs: `sense` from the engine (the robot acts on what it senses now) and
+Inputs: `sense` from the engine (the robot acts at tick k on the sense of tick
+k - L, L the configured perception latency, `timing.perception_latency`) and
 its base station's `order` (Wi-Fi). Outputs: `cmd` (the engine applies it from
 the next tick on, a one-tick actuation delay) and `report`. Schedules and lags
 are the keys' (`KeySpec.timing`, schemas/README.md).
@@ -22,9 +23,11 @@ class RobotNode(Node):
         cfg = self.cfg
         team, n = self.pid.team, self.pid.robot
         self.report_schedule = self.schedule("report")
-        self.sense_in = self.inp("sense", team, n)
+        # The perception latency L: at tick k the robot sees the sense of tick k - L.
+        self.sense_in = self.inp("sense", team, n, lag=cfg.timing.perception_latency)
         self.order_in = self.inp("order", team, n)
         self.cmd_out = self.out("cmd", team, n)
+        self.cmd_out.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
         self.report_out = self.out("report", team, n)
         strategy = registry.get(cfg.strategy_of(team))
         self.brain = strategy.make_robot(RobotContext(cfg=cfg, team=team, n=n, rng=self.rng("strategy")))

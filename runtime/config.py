@@ -28,6 +28,7 @@ from arena.schemas.keys import DEFAULT_PERIODS
 from arena.schemas.vocabulary import TEAMS
 
 MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
+MAX_PERCEPTION_LATENCY = 25  # [ticks] 0.5 s at 50 Hz: far beyond any real vision pipeline
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
@@ -161,12 +162,29 @@ class TimingParams:
     comm_period: int = DEFAULT_PERIODS["comm"]  # [ticks] robot <-> base station Wi-Fi period (10 Hz)
     referee_period: int = DEFAULT_PERIODS["referee"]  # [ticks] engine events -> referee -> everyone (10 Hz)
     world_period: int = DEFAULT_PERIODS["world"]  # [ticks] ground-truth `world` for viewers and the recorder
+    # [ticks] perception latency L: a robot acting at tick k sees the `sense` of tick k - L
+    # (omni-vision pipelines of MSL robots: 30-60 ms). The model; docs/architecture.md.
+    perception_latency: int = 0
+    # [frames] `sense` and `cmd` frames per message in lockstep: a transport detail, never
+    # the model (the digests are the same for every value). 0: as many as L allows (L, or 1).
+    batch: int = 0
     startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
     # [s] wall: last-resort bound on one lockstep wait. Dead and hung peers are
     # caught by liveliness (~2 s, runtime/session.py); this catches a peer that
     # is alive but silent. Long, because everyone downstream of a stalled peer
     # waits too and must not be taken for dead.
     wait_timeout: float = 60.0
+
+    def frames_per_message(self, realtime: bool = False) -> int:
+        """`sense`/`cmd` frames per message: `batch`, or L when 0; always 1 in real time.
+
+        At most L: the engine's batch for ticks k..k+n-1 needs the commands of up to
+        k+n-2, which the robots send once they have the senses of up to k+n-2-L; with
+        n <= L those came in an earlier batch, so nobody waits for a batch not yet sent.
+        """
+        if realtime:
+            return 1
+        return self.batch or max(1, self.perception_latency)
 
     def periods(self) -> dict[str, int]:
         """The periods the key table's schedules name (schemas/keys.py `Timing`), in ticks."""
@@ -295,6 +313,15 @@ class MatchConfig:
         t = self.timing
         if t.dt <= 0 or t.substeps < 1 or t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
             raise ConfigError("timing: dt must be > 0 and every period >= 1 tick")
+        if not 0 <= t.perception_latency <= MAX_PERCEPTION_LATENCY:
+            raise ConfigError(
+                f"--perception-latency must be 0..{MAX_PERCEPTION_LATENCY} ticks, got {t.perception_latency}"
+            )
+        if not 0 <= t.batch <= max(1, t.perception_latency):
+            raise ConfigError(
+                f"--batch must be 0 (auto) or 1..{max(1, t.perception_latency)} (at most the perception "
+                f"latency, else the engine and the robots would wait for each other), got {t.batch}"
+            )
         for name in ("startup_timeout", "wait_timeout"):
             value = getattr(t, name)
             if not (math.isfinite(value) and value > 0):

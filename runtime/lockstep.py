@@ -52,6 +52,7 @@ import msgspec
 
 from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
+from arena.schemas.keys import MAX_BATCH
 from arena.schemas.messages import Base
 from arena.schemas.validate import nonfinite, safe_default
 
@@ -160,10 +161,23 @@ def _drop(payload: bytes) -> None:  # noqa: ARG001 - a muted Outbound's put
     return None
 
 
-class Outbound(Generic[M]):
-    """One outbound key: encodes, adds the frame to the process digest, publishes."""
+# The first byte of a msgpack array (fixarray, array 16, array 32): a batch of frames.
+# A frame itself is always a map (schemas/messages.py `Base`), so the two never meet.
+# A longer array than MAX_BATCH is rejected whole.
+BATCH_HEADS = frozenset((*range(0x90, 0xA0), 0xDC, 0xDD))
+decode_batch = msgspec.msgpack.Decoder(list[bytes]).decode
 
-    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent")
+
+class Outbound(Generic[M]):
+    """One outbound key: encodes, adds the frame to the process digest, publishes.
+
+    `batch(n, last)`: put the frames of ticks k..k+n-1 (k a multiple of n) as one
+    message, a msgpack array of the frames' bytes (schemas/README.md, "Batches"),
+    and whatever is left at tick `last`. A transport detail: the frames, their
+    digest and their order are the same whatever n is.
+    """
+
+    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last")
 
     def __init__(self, key: str, rel: str, put: Callable[[bytes], None], digest: hashlib.blake2b):
         self.key = key
@@ -172,6 +186,22 @@ class Outbound(Generic[M]):
         self._digest = digest
         self._encode = msgspec.msgpack.Encoder().encode
         self.sent = 0
+        self._buf: list[bytes] | None = None  # None: one frame per message
+        self._size = 1
+        self._last = 0
+
+    def batch(self, size: int, last: int) -> None:
+        """Send `size` frames per message (ticks aligned to multiples of `size`); 1: one per message."""
+        self._buf = [] if size > 1 else None
+        self._size = size
+        self._last = last
+
+    def flush(self) -> None:
+        """Put what the batch holds now (the end of a loop that stopped early)."""
+        buf = self._buf
+        if buf:
+            self._put(self._encode(buf))
+            buf.clear()
 
     def mute(self) -> None:
         """Stop putting this key on the wire: its only receiver is dead (digest and count go on).
@@ -191,7 +221,15 @@ class Outbound(Generic[M]):
         d.update(len(payload).to_bytes(4, "little"))
         d.update(payload)
         self.sent += 1
-        self._put(payload)
+        buf = self._buf
+        if buf is None:
+            self._put(payload)
+            return payload
+        buf.append(payload)
+        tick = msg.tick
+        if (tick + 1) % self._size == 0 or tick >= self._last:
+            self._put(self._encode(buf))
+            buf.clear()
         return payload
 
 
@@ -368,7 +406,24 @@ class Inbound(Generic[M]):
         return self._accept_frame(raw, now_tick)
 
     def _accept_frame(self, raw: bytes, now_tick: int | None) -> bool:
-        """`_accept` for what is known not to be a WAKE."""
+        """`_accept` for what is known not to be a WAKE: one frame, or a batch of them (`Outbound.batch`)."""
+        if raw[:1] and raw[0] in BATCH_HEADS:
+            try:
+                frames = decode_batch(raw)
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self._rej.reject(self.key, "malformed", f"batch: {str(exc)[:120]}")
+                return False
+            if not frames or len(frames) > MAX_BATCH:
+                self._rej.reject(self.key, "malformed", f"a batch of {len(frames)} frames (1 to {MAX_BATCH})")
+                return False
+            got = False
+            for frame in frames:
+                got = self._accept_one(frame, now_tick) or got
+            return got
+        return self._accept_one(raw, now_tick)
+
+    def _accept_one(self, raw: bytes, now_tick: int | None) -> bool:
+        """One frame's bytes: decode, check the sequence, emulate the link."""
         try:
             msg = self._decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:

@@ -29,6 +29,7 @@ from arena.schemas.keys import (
     KEYS,
     MAC_BYTES,
     MAC_KEY_BYTES,
+    MAX_BATCH,
     SIGNED_DATA,
     SUMMARY,
     TAP,
@@ -215,14 +216,19 @@ The engine starts tick 0 once every process's token is present. The match
 configuration is the JSON answer of a `get` on `arena/<match>/{CONFIG}` (see
 "Configuration" below).
 
-**A robot's schedule** (lockstep). For every tick k = 0 .. `total_ticks`
-(from `field` or the configuration): wait for `sense` of tick k (and, to use
-them, the `order`s due by k: sent at 1, 6, 11, ..., delivered one tick
+**A robot's schedule** (lockstep). The configuration's
+`timing.perception_latency` L (ticks) is the model's perception latency: a
+robot acting at tick k sees the `sense` of tick k - L, and no `sense` before
+tick L. For every tick k = 0 .. `total_ticks` (from `field` or the
+configuration): wait for `sense` of tick k - L (nothing when k < L; and, to
+use them, the `order`s due by k: sent at 1, 6, 11, ..., delivered one tick
 later), then put exactly one `cmd` with `tick` = k, and at every comm tick
 (k % `timing.comm_period` == 0) one `report` with `tick` = k, in that order
 (cmd, then report). The engine sends `sense` k only once it has every `cmd`
-of tick k-1, so the match goes exactly as fast as its slowest process; there
-are no other deadlines. **One missing scheduled frame** (a `cmd`, or a
+of tick k-1, so it may run up to L ticks ahead of the robots, and the match
+goes exactly as fast as its slowest process; there are no other deadlines.
+(A robot that waits for `sense` k itself before its `cmd` k still plays, with
+less latency than the model says and more slowly.) **One missing scheduled frame** (a `cmd`, or a
 `report` at a comm tick) stalls every process that waits on it, and so the
 whole match, for `timing.wait_timeout` (60 s by default) of wall time; then
 its receiver treats the sender as dead for the rest of the match (the engine
@@ -232,6 +238,18 @@ parks a robot without `cmd` beyond the fence; a base station without a
 waits for as long as its own sender announces a wait (`{WAITING}` above). A frame for a tick that is
 not the next scheduled one is rejected and does not stand in for the missing
 one.
+
+**Batches of frames.** In lockstep the engine puts N consecutive `sense`
+frames of a robot as one message, N = `timing.batch`, or L when `batch` is 0
+(at least 1): a msgpack array (at most {MAX_BATCH} elements) whose elements are
+the frames' own msgpack bytes (bin), for ticks jN .. jN+N-1, and the last tick
+`total_ticks` closes a batch early. A frame itself is always a map, so the
+first byte tells a batch from a frame. Receivers of `sense` and `cmd` accept
+both: a robot may put each `cmd` alone, or N of them as one batch in the same
+way, but never more than L ticks' worth (the engine's batch for ticks k ..
+k+N-1 needs the commands up to k+N-2, and a robot has those only if N <= L).
+With `--realtime` every frame is its own message. The batch size is a
+transport detail: the digest covers the frames, one by one, not the messages.
 
 **QoS of a put.** Every data key, `{SUMMARY}`, `{TAP}` and `{ACK}`: reliability
 RELIABLE, congestion control BLOCK, priority DATA (zenoh's default, 5),
@@ -284,8 +302,8 @@ stopped for that tick, not the match.
 **Configuration** (`get` on `arena/<match>/{CONFIG}`, UTF-8 JSON). Top-level
 fields: `seed`, `robots` (per team, goalkeeper 0 included), `home`, `away`
 (strategy names), `half_time` [s], `timing` (`dt` [s], `comm_period`,
-`referee_period`, `world_period` [ticks], `wait_timeout`, `startup_timeout`
-[s], `substeps`), `robot` (`model`, `wheel_base`, `wheel_radius`,
+`referee_period`, `world_period`, `perception_latency`, `batch` [ticks],
+`wait_timeout`, `startup_timeout` [s], `substeps`), `robot` (`model`, `wheel_base`, `wheel_radius`,
 `max_wheel_speed`, `max_speed`, `max_omega`, `kick_max_speed`, ... in SI
 units), `field` (geometry, as in FieldSpec), `ball`, `sensor`, `rules`,
 `link` and `link_overrides` (the link emulation), `external`, `realtime`,

@@ -85,7 +85,15 @@ EVERY_TICK = Timing("tick", 0, lag=1)
 KEYS: tuple[KeySpec, ...] = (
     KeySpec("field", "field", m.FieldSpec, "S_G / G_S", "engine", "all", Timing(None), "wired", "once, at tick 0"),
     KeySpec(
-        "sense", "robot/<team>/<n>/sense", m.Sense, "G_R_n", "engine", "robot n", Timing("tick", 0, lag=0), "sensor"
+        "sense",
+        "robot/<team>/<n>/sense",
+        m.Sense,
+        "G_R_n",
+        "engine",
+        "robot n",
+        Timing("tick", 0, lag=0),
+        "sensor",
+        "the robot uses the sense of tick s from tick s + L, L = `timing.perception_latency`",
     ),
     KeySpec(
         "cmd",
@@ -160,6 +168,7 @@ KEY_BY_NAME = {k.name: k for k in KEYS}
 # Data keys whose frames carry their sender's MAC in the zenoh attachment (runtime/mac.py),
 # besides every `summary/<p>` and `tap/<p>`; relative to arena/<match>/.
 SIGNED_DATA = ("engine/events", "referee", "world")
+MAX_BATCH = 64  # frames in one batch message at most (runtime/lockstep.py `Outbound.batch`)
 MAC_BYTES = 16  # BLAKE2b digest size of a MAC
 MAC_KEY_BYTES = 32  # a process's MAC key
 

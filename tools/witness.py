@@ -19,6 +19,7 @@ import threading
 
 import msgspec
 
+from arena.runtime.lockstep import BATCH_HEADS, MAX_BATCH, decode_batch
 from arena.schemas.keys import Keys, routes, spec_of
 
 
@@ -59,6 +60,17 @@ class Witness:
         def on_frame(payload: bytes) -> None:
             if payload[:1] == b"\xc1":  # a local wake-up, never a message
                 return
+            if payload[:1] and payload[0] in BATCH_HEADS:  # several ticks' frames in one message (`Outbound.batch`)
+                try:
+                    frames = decode_batch(payload)
+                except (msgspec.DecodeError, msgspec.ValidationError):
+                    return
+                for frame in frames if len(frames) <= MAX_BATCH else ():
+                    one(frame)
+            else:
+                one(payload)
+
+        def one(payload: bytes) -> None:
             try:
                 tick = decode(payload).tick
             except (msgspec.DecodeError, msgspec.ValidationError):

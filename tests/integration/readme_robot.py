@@ -126,27 +126,39 @@ def main(argv: list[str]) -> int:
             sent[key] += 1
             pubs[key].put(payload)
 
-        k = 0
+        latency = cfg["timing"]["perception_latency"]  # L: at tick k the robot sees the sense of tick k - L
+        wait = cfg["timing"]["startup_timeout"] + cfg["timing"]["wait_timeout"]
         rejected: dict[str, int] = {}
-        while k <= total_ticks:
-            try:
-                raw = senses.get(timeout=cfg["timing"]["startup_timeout"] + cfg["timing"]["wait_timeout"])
-            except queue.Empty:
-                print(f"readme_robot: no sense for tick {k}", file=sys.stderr)
-                return 1
-            try:
-                sense = msgpack.unpackb(raw)
-                tick = sense["tick"]
-            except Exception:  # noqa: BLE001 - any bad frame is counted, as the README says
-                rejected["malformed"] = rejected.get("malformed", 0) + 1
-                continue
-            if tick != k:
-                rejected["out_of_sequence"] = rejected.get("out_of_sequence", 0) + 1
-                continue
+
+        def bad(reason: str) -> None:
+            rejected[reason] = rejected.get(reason, 0) + 1
+
+        pose = {"x": 0.0, "y": 0.0, "theta": 0.0}  # no sense before tick L
+        expected = 0  # the tick of the next sense frame
+        for k in range(total_ticks + 1):
+            while expected <= k - latency:
+                try:
+                    raw = senses.get(timeout=wait)
+                except queue.Empty:
+                    print(f"readme_robot: no sense for tick {expected}", file=sys.stderr)
+                    return 1
+                try:
+                    got = msgpack.unpackb(raw)
+                    # A batch: an array of the frames' bytes; a frame: a map.
+                    frames = [msgpack.unpackb(f) for f in got] if isinstance(got, list) else [got]
+                    ticks = [f["tick"] for f in frames]
+                except Exception:  # noqa: BLE001 - any bad frame is counted, as the README says
+                    bad("malformed")
+                    continue
+                for sense, tick in zip(frames, ticks):
+                    if tick != expected:
+                        bad("out_of_sequence")
+                        continue
+                    pose = sense["pose"]
+                    expected += 1
             put(cmd_key, {"tick": k, "mode": "wheels", "wheels": wheels})
             if k % comm == 0:
-                put(report_key, {"tick": k, "robot": args.robot, "pose": sense["pose"], "role": "readme"})
-            k += 1
+                put(report_key, {"tick": k, "robot": args.robot, "pose": pose, "role": "readme"})
 
         summary = {
             "tick": total_ticks,
