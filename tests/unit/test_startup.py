@@ -13,3 +13,24 @@ def test_a_lone_router_does_not_sleep_before_it_starts():
     assert linked.get_json("scouting/delay") != "0"
     peer = NetConfig(mode="peer", connect=("unixsock-stream/x.sock",)).zenoh_config()
     assert peer.get_json("scouting/delay") != "0"
+
+
+def test_bench_throughput_reports_both_start_ups_with_their_definitions():
+    from arena.tools import throughput
+
+    def run(rtf, command, play_match):
+        return {
+            "rtf": rtf,
+            "sim_seconds": 120.0,
+            "command_wall_s": 3.0,
+            "command_cpu_s": 6.0,
+            "launch_to_first_tick_s": command,
+            "play_match_to_first_tick_s": play_match,
+            "launch": "fork",
+            "overhead_s": 0.5,
+        }
+
+    s = throughput.summarise([run(40, 0.6, 0.3), run(50, 0.5, 0.2), run(45, 0.7, 0.25)], jobs=2, cores=2)
+    assert s["launch_to_first_tick_s"] == 0.6 and s["play_match_to_first_tick_s"] == 0.25
+    assert s["launch"] == ["fork"]
+    assert set(throughput.LAUNCH_DEFINITIONS) == {"command", "play_match"}
