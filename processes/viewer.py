@@ -52,7 +52,7 @@ POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
 SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
 REPEAT_S = 0.5  # [s] wall: a match standing still (paused, starting) has its last scene sent again this often
 LINGER_S = 0.25  # [s] wall: at the end, wait this long for the last frames, then for the clients
-NICE = 10  # [-] added niceness (Linux): the lockstep processes come first
+NICE = 10  # [-] niceness (Linux) of the viewer's threads and of its autogroup: the match's processes come first
 RING = 4096  # [frames] referee and event frames kept between two polls (each carries commands)
 MATCH_TOPIC = "/match"
 MATCH_SCHEMA = {
@@ -92,6 +92,41 @@ def downsampling(keys: Keys) -> str:
         rules.append({"key_expr": keys.key("order", team, 0), "freq": BELIEF_HZ})
         rules += [{"key_expr": keys.key("report", team, n), "freq": BELIEF_HZ} for n in range(MAX_ROBOTS)]
     return json.dumps([{"flows": ["ingress"], "messages": ["put"], "rules": rules}])
+
+
+def lower_priority(idle: bool) -> list[str]:
+    """Put every thread of this process behind the match's; returns what was done.
+
+    Niceness is per thread on Linux, and zenoh's receive threads and the
+    Foxglove server's exist before the loop starts, so each thread of
+    /proc/self/task is reniced. With autogroups (a desktop kernel's default)
+    a process in a session of its own, as `arena match` starts every process,
+    competes as its own group and a thread's niceness counts only inside
+    it: the group's niceness is set too, only when the session is the
+    viewer's alone. `idle` (an unpaced lockstep match, which takes every
+    cycle it can): SCHED_IDLE, so any match process that wakes takes the
+    processor from the viewer at once. Anything refused is left as it was.
+    """
+    done = []
+    if os.getsid(0) == os.getpid():
+        try:
+            with open("/proc/self/autogroup", "w") as f:
+                f.write(str(NICE))
+            done.append(f"autogroup nice {NICE}")
+        except OSError:
+            pass
+    tids = os.listdir("/proc/self/task") if os.path.isdir("/proc/self/task") else [str(os.getpid())]
+    policy = []
+    for tid in map(int, tids):
+        try:
+            os.setpriority(os.PRIO_PROCESS, tid, max(NICE, os.getpriority(os.PRIO_PROCESS, tid)))
+            if idle:
+                os.sched_setscheduler(tid, os.SCHED_IDLE, os.sched_param(0))
+            policy.append(tid)
+        except (OSError, AttributeError):
+            pass
+    done.append(f"{len(policy)} of {len(tids)} threads at nice {NICE}" + (", SCHED_IDLE" if idle else ""))
+    return done
 
 
 class _Listener(ServerListener):
@@ -327,8 +362,9 @@ class ViewerNode(Node):
     # ---------------------------------------------------------------- loops
     def loop(self) -> None:
         """The same watch loop in both modes: the viewer takes part in no lockstep."""
-        if threading.current_thread() is threading.main_thread():
-            os.nice(NICE)  # a process of its own (arena run viewer); never a test's thread
+        if threading.current_thread() is threading.main_thread():  # a process of its own, never a test's thread
+            idle = self.lockstep_control and self.pace == 0
+            self.log.info("viewer priority: %s", "; ".join(lower_priority(idle)))
         try:
             self.watch()
         finally:
