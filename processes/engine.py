@@ -50,7 +50,7 @@ from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
-from arena.runtime.pace import Pacer
+from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee, encode
 from arena.schemas.vocabulary import SEND_OFF
 from arena.sim.drive import Drive
@@ -176,6 +176,7 @@ class EngineNode(Node):
         self.pending_events: list = []
         self.stuck = StuckWatch(cfg)  # driven robots that stay in one place (ROBOT_STUCK)
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
+        self.world_gate: WireGate | None = None
         self.pacer = self._live_pacer()
         self.transport.serve(self.keys.config(), cfg.to_json().encode())
         # `field` is put once, at tick 0; a late joiner (a viewer, a spectator) gets it with a `get`.
@@ -187,6 +188,13 @@ class EngineNode(Node):
             return None
         pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log)
         key = self.keys.control()
+        # Unpaced, the viewer draws at most 30 frames a second of wall time: only every
+        # Nth world frame goes on the wire, and the held one whenever the pacer holds
+        # the match. Every frame is still digested (and recorded: the tap is in `send`).
+        every = round(1.0 / (LIVE_WORLD_HZ * self.cfg.timing.dt * self.world_schedule.period))
+        self.world_gate = WireGate(every)
+        self.world_out.put_through(self.world_gate.wrap)
+        pacer.on_hold = self.world_gate.flush
 
         def on_control(raw: bytes) -> None:
             problem = pacer.control_raw(raw)
@@ -292,6 +300,8 @@ class EngineNode(Node):
             self.publish(k)
             self.last_tick = k
             if k == last:
+                if self.world_gate is not None:
+                    self.world_gate.flush()
                 self.timed(t0)
                 break
             work = time.perf_counter() - t0

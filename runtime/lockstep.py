@@ -213,6 +213,10 @@ class Outbound(Generic[M]):
         """
         self._put = _drop
 
+    def put_through(self, wrap: Callable[[Callable[[bytes], None]], Callable[[bytes], None]]) -> None:
+        """Put this key's frames through `wrap(put)` (runtime/pace.py `WireGate`); digest and count unchanged."""
+        self._put = wrap(self._put)
+
     def send(self, msg: M) -> bytes:
         """Encode, digest and put `msg`; returns the payload (for a tap, runtime/tap.py)."""
         payload = self._encode(msg)

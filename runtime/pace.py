@@ -20,6 +20,12 @@ them to `control`. In reactive lockstep (runtime/lockstep.py, `Reactor`) the
 loop runs in zenoh's callbacks, so nothing may sleep there: a small thread of
 the pacer calls `poke` (the Reactor's) when a tick's time has come, and a
 control frame pokes it too. In pull mode `sync` blocks on the main thread.
+
+`WireGate`: an unpaced live match puts only every Nth `world` frame on the
+wire (`LIVE_WORLD_HZ` of match time), and the last frame whenever the pacer
+holds the match (paused, stepped, paced, the end), so a viewer always shows
+the tick the engine holds. Every frame is still encoded and digested
+(runtime/lockstep.py `Outbound.send`): what goes on the wire changes no digest.
 """
 
 from __future__ import annotations
@@ -33,6 +39,47 @@ from arena.schemas.messages import Control
 
 BEHIND_S = 0.25  # [s] wall: further behind its schedule than this, the pacer restarts it from now (no sprint)
 POLL_S = 0.05  # [s] wall: pull mode, how often a paused engine looks for control frames
+LIVE_WORLD_HZ = 10.0  # [Hz] match time: world frames an unpaced live match puts on the wire
+
+
+def _nowhere(payload: bytes) -> None:  # noqa: ARG001 - a gate not yet in front of a put
+    return None
+
+
+class WireGate:
+    """A put function that passes every `every`-th payload and holds the others; `flush` puts the held one.
+
+    Called from one thread at a time: the engine's loop (publish, and `Pacer.ready`'s hold).
+    """
+
+    __slots__ = ("_put", "every", "_n", "_held", "passed")
+
+    def __init__(self, every: int):
+        self._put: Callable[[bytes], None] = _nowhere
+        self.every = max(1, every)
+        self._n = 0
+        self._held: bytes | None = None
+        self.passed = 0
+
+    def wrap(self, put: Callable[[bytes], None]) -> WireGate:
+        """For `Outbound.put_through`: this gate in front of `put`."""
+        self._put = put
+        return self
+
+    def __call__(self, payload: bytes) -> None:
+        if self._n % self.every == 0:
+            self._held = None
+            self._put(payload)
+            self.passed += 1
+        else:
+            self._held = payload
+        self._n += 1
+
+    def flush(self) -> None:
+        if self._held is not None:
+            payload, self._held = self._held, None
+            self._put(payload)
+            self.passed += 1
 
 
 class Pacer:
@@ -59,9 +106,17 @@ class Pacer:
         self._thread: threading.Thread | None = None
         self._pending: Callable[[], bytes | None] | None = None
         self.controls = 0  # control frames applied
+        self.on_hold: Callable[[], None] | None = None  # called (on the loop's thread) whenever a tick is held
 
     # ------------------------------------------------------------- the gate
     def ready(self, k: int) -> bool:
+        if self._gate(k):
+            return True
+        if self.on_hold is not None:
+            self.on_hold()
+        return False
+
+    def _gate(self, k: int) -> bool:
         with self._cond:
             if self.paused and k > self.until:
                 self._due = None

@@ -9,7 +9,7 @@ import time
 import pytest
 
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.runtime.pace import Pacer
+from arena.runtime.pace import Pacer, WireGate
 from arena.schemas.messages import Control, encode
 
 
@@ -30,6 +30,26 @@ def test_pause_holds_the_next_tick_and_step_lets_exactly_n_through():
     assert not p.ready(5)
     p.control(Control(tick=4, seq=3, paused=False))
     assert p.ready(5)
+
+
+def test_the_wire_gate_passes_every_nth_frame_and_the_held_one_when_the_pacer_holds():
+    wire: list[bytes] = []
+    gate = WireGate(5).wrap(wire.append)
+    p = Pacer(0.02, 0.0)
+    p.on_hold = gate.flush
+    for k in range(12):
+        assert p.ready(k)
+        gate(b"%d" % k)
+    assert wire == [b"0", b"5", b"10"]
+    p.control(Control(tick=11, seq=1, paused=True))
+    assert not p.ready(12) and wire[-1] == b"11"  # a held match shows the tick it holds
+    assert not p.ready(12) and wire.count(b"11") == 1  # once
+    p.control(Control(tick=11, seq=2, paused=True, step=1))
+    assert p.ready(12)
+    gate(b"12")
+    assert not p.ready(13) and wire[-1] == b"12" and gate.passed == len(wire) == 5
+    gate.flush()
+    assert len(wire) == 5  # nothing held: nothing sent twice
 
 
 def test_a_pace_waits_for_the_wall_clock():
