@@ -26,10 +26,11 @@ Rules kept:
 
 `ARENA_LAUNCH=exec` keeps the former exec start (for comparison runs and as a
 fallback). It is also used off the main thread, and in a process that has
-already opened a zenoh session (a second match played by the same process,
-as `arena bench match` does): zenoh's runtime threads outlive the session,
-and a fork would inherit its state without them (measured: the children of
-such a fork did not play).
+already opened a zenoh session (a second match played by the same process)
+unless that process started a fork server first (tools/zygote.py, as `arena
+bench match` does): zenoh's runtime threads outlive the session, and a fork
+would inherit its state without them (measured: the children of such a fork
+did not play).
 """
 
 from __future__ import annotations

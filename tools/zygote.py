@@ -34,6 +34,7 @@ Rules kept:
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import gc
 import json
@@ -253,6 +254,9 @@ def start(kinds: set[str] | None = None, strategies: set[str] | None = None, rea
     except (OSError, RuntimeError):
         return None
     _ONE.append(z)
+    # Reaped before this process exits, so that the zygote's CPU (its imports, its forks)
+    # and its parked children's count in this process's children, as a whole-process timing reads them.
+    atexit.register(stop)
     try:
         z.ready(ready)
     except OSError:
