@@ -808,17 +808,23 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
                 signal.signal(signal.SIGTERM, previous)
     runner.close()
     ordered = [results[fx.id] for fx in fixtures if fx.id in results]
-    summary = report(
-        ordered,
-        strategies,
-        opts.legs,
-        out,
-        time.monotonic() - t0,
-        opts.seed,
-        engine=runner.engine,
-        total=len(fixtures),
-        setup=setup,
-    )
+    try:
+        summary = report(
+            ordered,
+            strategies,
+            opts.legs,
+            out,
+            time.monotonic() - t0,
+            opts.seed,
+            engine=runner.engine,
+            total=len(fixtures),
+            setup=setup,
+        )
+    finally:
+        if opts.ray is not None:
+            from arena.tools import cluster
+
+            cluster.closed()  # Ray shut down in the background while the report was written
     summary["skipped"] = len(fixtures) - len(todo)
     summary["interrupted"] = interrupted
     return summary, interrupted
