@@ -89,11 +89,14 @@ def warm() -> None:
     from arena.runtime.config import MatchConfig
     from arena.schemas import messages
 
-    cli.parser()
-    MatchConfig.from_json(MatchConfig().to_json())
-    for value in vars(messages).values():
-        if isinstance(value, type) and issubclass(value, messages.Base):
-            msgspec.msgpack.Decoder(value)
+    try:  # only ever a head start: whatever fails here, each child does again (and reports) itself
+        cli.parser()
+        MatchConfig.from_json(MatchConfig().to_json())
+        for value in vars(messages).values():
+            if isinstance(value, type) and issubclass(value, messages.Base):
+                msgspec.msgpack.Decoder(value)
+    except Exception:  # noqa: BLE001, S110
+        pass
 
 
 class ForkedProcess:

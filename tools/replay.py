@@ -1,23 +1,23 @@
 """`arena replay FILE.mcap --process robot/a/1`: one process against its recorded inputs.
 
-Longer than 150 lines because `replay` is the four-step procedure below as one function,
+Longer than 150 lines because `replay` is the three-step procedure below as one function,
 kept whole so that it reads in the documented order, with its result types and CLI entry
 beside it.
 
 A lockstep match is a pure function of (configuration, seed), and so is each
 process given its inputs. Replay rebuilds the `MatchConfig` from the file's
 metadata and runs that ONE process's `Node` class (processes/__init__.py)
-over an in-memory bus, in this process:
+over an in-memory bus, in this process and this thread, with the in-process
+engine's cooperative driver (runtime/coop.py):
 
-1. the other processes' liveliness tokens are faked on the bus, so the node
-   passes its start barrier as in the match;
-2. every frame recorded on each of its input keys is put on the bus, in the
+1. every frame recorded on each of its input keys is put on the bus, in the
    order its sender sent them. The node's own link emulators, seeded from the
    configuration, drop and delay exactly the frames they did in the match;
-3. once the node plays, the other processes' tokens are withdrawn: their
-   wake-ups queue behind the recorded frames, so the node uses every recorded
-   frame and stops waiting only where the recording ends (a truncated file);
-4. what the node publishes on its output keys is compared, frame by frame,
+2. the node's lockstep generator is driven to its end. It uses every recorded
+   frame; where the recording ends (a truncated file) nobody else can send,
+   and the driver gives those waits up at once, as a match gives up on a
+   process that has gone;
+3. what the node publishes on its output keys is compared, frame by frame,
    with what the file recorded for that process.
 
 The result is `match: true`, or the first frame (lowest tick) that differs,
@@ -31,7 +31,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import sys
-import threading
 from dataclasses import dataclass, field
 
 import msgspec
@@ -39,10 +38,8 @@ import msgspec
 from arena.processes import node_class
 from arena.recording.reader import Recording, RecordingError, load
 from arena.runtime.config import ConfigError, ProcessId
-from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.runtime.coop import CoopBus, CoopTransport, NodeFailed, Task, drive
 from arena.schemas.keys import Keys
-
-REPLAY_TIMEOUT = 600.0  # [s] wall: give up on a replay that does not finish (a bug, never a slow file)
 
 
 class ReplayError(ValueError):
@@ -108,47 +105,18 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
         raise ReplayError("this match ran with --realtime, which is not deterministic: only lockstep matches replay")
     cfg = cfg.replace(tap=False)  # the replayed node taps nothing
     name = str(pid)
-    bus = MemoryBus()
+    bus = CoopBus()
     keys = Keys("replay")
-    node = node_class(pid.kind)(pid, cfg, MemoryTransport(bus), keys)
+    node = node_class(pid.kind)(pid, cfg, CoopTransport(bus), keys)
     outputs = [(keys.rel(ob.key), bus.subscribe(None, ob.key)) for ob in node.outbound]
     for ib in node.inbound:
         for payload in rec.payloads(keys.rel(ib.key)):
             bus.deliver(ib.key, payload)
-    others = [str(p) for p in cfg.processes() if p != pid]
-    token_owner = object()
-    for other in others:
-        bus.set_alive(keys.alive(other), token_owner, True)
-
-    playing = threading.Event()
-    errors: list[BaseException] = []
-    summary = []
-    loop = node.loop
-
-    def play() -> None:
-        playing.set()
-        loop()
-
-    node.loop = play
-
-    def run() -> None:
-        try:
-            summary.append(node.run())
-        except BaseException as exc:  # handed to the caller below
-            errors.append(exc)
-        finally:
-            playing.set()
-
-    thread = threading.Thread(target=run, name=f"replay {name}", daemon=True)
-    thread.start()
-    playing.wait(REPLAY_TIMEOUT)
-    for other in others:
-        bus.set_alive(keys.alive(other), token_owner, False)
-    thread.join(REPLAY_TIMEOUT)
-    if thread.is_alive():
-        raise ReplayError(f"{name} did not finish within {REPLAY_TIMEOUT:g} s")
-    if errors:
-        raise errors[0]
+    try:
+        drive(bus, [Task(name, node.lockstep())])
+    except NodeFailed as exc:
+        raise exc.__cause__ from None  # the node's own error, as if it had run alone
+    summary = [node.conclude()]
 
     first: Difference | None = None
     counts: dict[str, int] = {}
