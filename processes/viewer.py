@@ -10,8 +10,12 @@ server, which runs on the SDK's own threads) with:
 
 * `/scene` (`foxglove.SceneUpdate`, recording/scene.py): the field, robots by
   team with id and role, the ball with its height, score and clock, and
-  faintly what the teams believe: each robot's perceived ball (its `report`)
-  and each base station's fused P_ball (its `order` to robot 0). The field is
+  faintly what the teams believe: each robot's perceived ball (its last
+  `report`) and each base station's fused P_ball (its last `order` to robot
+  0), asked for `BELIEF_HZ` times a second of wall time: their senders serve
+  them (runtime/node.py), so a viewer costs a robot nothing per report, where
+  a subscription cost it one more put per report, hundreds a second in an
+  unpaced match. The field is
   part of every update, and the last update is sent again while the match
   stands still, so a viewer that connects late sees the field at once;
 * `/referee_log` (`foxglove.Log`): every referee command and engine event;
@@ -23,15 +27,17 @@ server, which runs on the SDK's own threads) with:
 It is in nobody's lockstep and has none of its own: it subscribes with rings
 that keep the newest frames (a viewer that falls behind drops, never blocks),
 `world` is published with congestion control DROP, it sends no data key (its
-digest is empty and `arena match` leaves it out of the match digest), and it
-runs at a lower CPU priority. So the same loop (`watch`) serves lockstep and
+digest is empty and `arena match` leaves it out of the match digest), an
+unpaced live match puts only every 5th `world` frame on the wire
+(runtime/pace.py `WireGate`), and the viewer runs behind the match's
+processes on the processor (`lower_priority`). So the same loop (`watch`) serves lockstep and
 `--realtime` alike, and a match digests the same with and without it.
 """
 
 from __future__ import annotations
 
+import collections
 import functools
-import json
 import os
 import threading
 import time
@@ -44,10 +50,8 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Node
-from arena.schemas.keys import Keys
 from arena.schemas.messages import Control, EngineEvents, FieldSpec, Order, Referee, Report, World
 
-MAX_ROBOTS = 6  # [-] per team, MatchConfig's bound: the session is configured before the match's count is known
 POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
 SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
 REPEAT_S = 0.5  # [s] wall: a match standing still (paused, starting) has its last scene sent again this often
@@ -73,25 +77,8 @@ MATCH_SCHEMA = {
 }
 
 
-BELIEF_HZ = 20.0  # [Hz] wall: report and order frames let in per key (zenoh ingress downsampling)
-
-
-def downsampling(keys: Keys) -> str:
-    """zenoh `downsampling` config (JSON) for the viewer's own session.
-
-    An unpaced match sends 10 Hz x its speed reports and orders per robot (a
-    few thousand a second); the viewer draws the beliefs at most `SCENE_HZ`
-    times a second. zenoh drops the surplus as it comes in, one rate per
-    concrete key, before any Python runs. Never `world` (downsampling drops
-    the newest frame too, and a paused or stepped match must show the tick it
-    holds: the ring of one keeps the newest instead), nor the referee's or the
-    engine's events: every command is logged.
-    """
-    rules = []
-    for team in TEAMS:
-        rules.append({"key_expr": keys.key("order", team, 0), "freq": BELIEF_HZ})
-        rules += [{"key_expr": keys.key("report", team, n), "freq": BELIEF_HZ} for n in range(MAX_ROBOTS)]
-    return json.dumps([{"flows": ["ingress"], "messages": ["put"], "rules": rules}])
+BELIEF_HZ = 10.0  # [Hz] wall: how often the viewer asks each robot and base station what it believes
+ASK_S = 1.0  # [s] wall: an answer later than this is not waited for
 
 
 def lower_priority(idle: bool) -> list[str]:
@@ -156,11 +143,11 @@ class ViewerNode(Node):
         self.field_in = tr.subscribe(keys.key("field"), latest=1)  # drawn from the configuration; checked against it
         self.referee_in = tr.subscribe(keys.key("referee"), latest=RING, **self._owned("referee", "referee"))
         self.events_in = tr.subscribe(keys.key("events"), latest=RING, **self._owned("events", "engine"))
-        # one subscription per key: the access control of a secure match allows no wildcard
-        self.report_in = {
-            (t, n): tr.subscribe(keys.key("report", t, n), latest=8) for t in TEAMS for n in range(cfg.robots)
-        }
-        self.order_in = {t: tr.subscribe(keys.key("order", t, 0), latest=8) for t in TEAMS}
+        # What the teams believe is asked for (their senders serve the last frame, runtime/node.py),
+        # one key at a time: the access control of a secure match allows no wildcard.
+        self.report_keys = {keys.key("report", t, n): t for t in TEAMS for n in range(cfg.robots)}
+        self.order_keys = {keys.key("order", t, 0): t for t in TEAMS}
+        self._answers: collections.deque[tuple[str, bytes]] = collections.deque(maxlen=RING)  # transport threads
         self.control_put = tr.publisher(keys.control())
         # The engine asks for the viewer's state once before tick 0 (a pause set before
         # the start holds tick 0); every change after that is put on the same key.
@@ -283,28 +270,41 @@ class ViewerNode(Node):
                 continue
             for b in self.builder.events_log(ev, self._ns(ev.tick)):
                 self.log_ch.base.log(b, self._ns(ev.tick))
-        for (team, _), channel in self.report_in.items():
-            while (raw := channel.try_recv()) is not None:
-                try:
-                    r = self._dec_report(raw)
-                except (msgspec.DecodeError, msgspec.ValidationError):
-                    continue
-                self.builder.roles[(team, r.robot)] = r.role or self.builder.roles.get((team, r.robot), "")
-                if r.ball.visible:
-                    self.seen[(team, r.robot)] = (r.ball.x, r.ball.y)
-                else:
-                    self.seen.pop((team, r.robot), None)
-        for team in TEAMS:
-            while (raw := self.order_in[team].try_recv()) is not None:
-                try:
-                    o = self._dec_order(raw)
-                except (msgspec.DecodeError, msgspec.ValidationError):
-                    continue
-                if o.ball_valid:
-                    self.fused[team] = (o.ball_x, o.ball_y, o.ball_z)
-                else:
-                    self.fused.pop(team, None)
+        while self._answers:
+            self._belief(*self._answers.popleft())
         return moved
+
+    def ask_beliefs(self) -> None:
+        """Ask every robot for its last report and every base station for its order to robot 0."""
+        for key in (*self.report_keys, *self.order_keys):
+            self.transport.ask(key, functools.partial(self._answer, key), ASK_S)
+
+    def _answer(self, key: str, raw: bytes) -> None:
+        """On the transport's thread: a deque's append is thread-safe, the loop takes them in turn."""
+        self._answers.append((key, raw))
+
+    def _belief(self, key: str, raw: bytes) -> None:
+        try:
+            if key in self.order_keys:
+                o = self._dec_order(raw)
+            else:
+                r = self._dec_report(raw)
+        except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+            self.rejections.reject(key, "malformed", str(exc)[:120])
+            return
+        if key in self.order_keys:
+            team = self.order_keys[key]
+            if o.ball_valid:
+                self.fused[team] = (o.ball_x, o.ball_y, o.ball_z)
+            else:
+                self.fused.pop(team, None)
+            return
+        team = self.report_keys[key]
+        self.builder.roles[(team, r.robot)] = r.role or self.builder.roles.get((team, r.robot), "")
+        if r.ball.visible:
+            self.seen[(team, r.robot)] = (r.ball.x, r.ball.y)
+        else:
+            self.seen.pop((team, r.robot), None)
 
     def _ns(self, tick: int) -> int:
         return round(tick * self.cfg.timing.dt * 1e9)
@@ -342,10 +342,13 @@ class ViewerNode(Node):
 
     def watch(self) -> None:
         every = 1.0 / SCENE_HZ
-        next_scene = last_scene = 0.0
+        next_scene = last_scene = next_ask = 0.0
         while True:
             moved = self._drain()
             now = time.monotonic()
+            if now >= next_ask and self.world is not None:
+                self.ask_beliefs()
+                next_ask = now + 1.0 / BELIEF_HZ
             if (moved and now >= next_scene) or now - last_scene >= REPEAT_S:
                 self.act()
                 next_scene, last_scene = now + every, now

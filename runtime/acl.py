@@ -15,6 +15,8 @@ read-only `viewer`) gets a zenoh `access_control` policy, matched on its
 * its own liveliness token `alive/<p>`, and reading `alive/**` and the
   collector's token (the start barrier and dead-peer detection);
 * querying the engine's `config` queryable (the engine: serving it);
+* the robots' `report`s and the base stations' `order`s are also served
+  (`SERVED`): their senders answer the viewer's queries with the last frame;
 * the viewer: reading `world`, `referee`, `field`, `engine/events` and the
   teams' `report`s and `order`s (the live viewer draws what each robot and
   base station believes), and the live viewer's `control` (pause, step,
@@ -35,6 +37,7 @@ from arena.schemas.keys import (
     CONTROL,
     KEY_BY_NAME,
     REFUSED,
+    SERVED,
     SUMMARY,
     TAP,
     VIEWER,
@@ -82,6 +85,12 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         "declare_queryable/egress": config,
     }
     control = [f"{prefix}{CONTROL}"]  # the live viewer's pause/step/pace, to the engine
+    # The keys of SERVED: their sender answers the viewer's queries with its last frame.
+    served = [prefix + rel for rel, sender, _ in table if sender == principal and _served(rel)]
+    if served:
+        perms["declare_queryable/ingress"] = served
+        perms["reply/ingress"] = served
+        perms["query/egress"] = served
     if principal == "engine":
         perms.update({"declare_queryable/ingress": config, "reply/ingress": config, "query/egress": config})
         perms["declare_subscriber/ingress"] = [*reads, *control]
@@ -95,7 +104,16 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
     if principal == VIEWER:
         perms["put/ingress"] = [*writes, *control]
         perms.update({"declare_queryable/ingress": control, "reply/ingress": control, "query/egress": control})
+        asked = [prefix + rel for rel, _, receivers in table if VIEWER in receivers and _served(rel)]
+        perms["query/ingress"] = [*config, *asked]
+        perms["reply/egress"] = [*config, *asked]
+        perms["declare_queryable/egress"] = [*config, *asked]
     return {k: v for k, v in perms.items() if v}
+
+
+def _served(rel: str) -> bool:
+    """Is the key `rel` (relative to arena/<m>/) one of `SERVED`'s?"""
+    return any(rel.startswith(KEY_BY_NAME[name].pattern.split("<")[0]) for name in SERVED)
 
 
 def principals(processes: list[str]) -> list[str]:

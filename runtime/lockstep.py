@@ -161,6 +161,28 @@ def _drop(payload: bytes) -> None:  # noqa: ARG001 - a muted Outbound's put
     return None
 
 
+class Latest:
+    """A put-through (`Outbound.put_through`) that keeps the last payload put, for a key
+    whose sender also serves it (`Node.out(served=True)`)."""
+
+    __slots__ = ("last", "_put")
+
+    def __init__(self) -> None:
+        self.last: bytes | None = None
+        self._put: Callable[[bytes], None] = _drop
+
+    def wrap(self, put: Callable[[bytes], None]) -> Latest:
+        self._put = put
+        return self
+
+    def __call__(self, payload: bytes) -> None:
+        self.last = payload
+        self._put(payload)
+
+    def get(self) -> bytes | None:
+        return self.last
+
+
 # The first byte of a msgpack array (fixarray, array 16, array 32): a batch of frames.
 # A frame itself is always a map (schemas/messages.py `Base`), so the two never meet.
 # A longer array than MAX_BATCH is rejected whole.

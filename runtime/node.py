@@ -30,13 +30,13 @@ from typing import Any, TypeVar
 from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
-from arena.runtime.lockstep import Inbound, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
+from arena.runtime.lockstep import Inbound, Latest, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
 from arena.runtime.mac import Keyring
 from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
-from arena.schemas.keys import KEY_BY_NAME, SIGNED_DATA, WAITING, Keys
+from arena.schemas.keys import KEY_BY_NAME, SERVED, SIGNED_DATA, WAITING, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 
@@ -115,7 +115,8 @@ class Node:
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
         """An outbound key. `viewers_only`: nobody in the lockstep waits for it, so it
-        is not put on the wire while nobody listens (it still counts in the digest)."""
+        is not put on the wire while nobody listens (it still counts in the digest).
+        A key of `SERVED` (schemas/keys.py) is also served: a query gets its last frame."""
         key = self.keys.key(name, team, n)
         sign = self.keyring.signer(key) if self.keys.rel(key) in SIGNED_DATA else None
         put = self.transport.publisher(key, when_matched=viewers_only, sign=sign)
@@ -123,6 +124,10 @@ class Node:
             ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
         else:
             ob = TappedOutbound(key, self.keys.rel(key), put, self.digest, self.tap)
+        if name in SERVED:
+            latest = Latest()
+            ob.put_through(latest.wrap)
+            self.transport.serve(key, latest.get)
         self.outbound.append(ob)
         return ob
 

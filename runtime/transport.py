@@ -2,12 +2,14 @@
 
 Longer than 150 lines because it holds the one `Transport` interface with both of its
 implementations, zenoh (with the MAC-verifying channel) and in-memory, kept side by side
-so that they stay in step.
+so that they stay in step; `ZenohTransport` is over 150 lines itself because it is that
+whole interface on zenoh, one short method per operation.
 
 Processes see only `Transport`: publishers, pull-style subscriptions (the
 main thread blocks in `recv`, the fastest receive style measured on 2 cores,
-see notes-zenoh-mcap.md), a local wake-up, liveliness, and one queryable for
-the match configuration. `MemoryTransport` implements the same interface in
+see notes-zenoh-mcap.md), a local wake-up, liveliness, queryables (the match
+configuration, the field, the last frame of a `SERVED` key) and queries, the
+viewer's without waiting (`ask`). `MemoryTransport` implements the same interface in
 one Python process, so process logic can be driven with scripted inputs and no
 zenoh at all; it is never what a feature claims to run on.
 """
@@ -90,10 +92,13 @@ class Transport(Protocol):
 
     def declare_alive(self, key: str) -> None: ...
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
-    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
-        """Answer queries on `key` with `payload`, or with what `payload()` returns at the time."""
+    def serve(self, key: str, payload: bytes | Callable[[], bytes | None]) -> None:
+        """Answer queries on `key` with `payload`, or with what `payload()` returns at the time (None: no answer)."""
 
     def query(self, key: str, timeout: float) -> bytes | None: ...
+    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
+        """Query `key` without waiting: `on_reply(payload)` runs on the transport's thread for each answer."""
+
     def close(self) -> None: ...
 
 
@@ -271,10 +276,12 @@ class ZenohTransport:
 
         self._keep.append(self.session.liveliness().declare_subscriber(key_expr, cb, history=True))
 
-    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
+    def serve(self, key: str, payload: bytes | Callable[[], bytes | None]) -> None:
         def cb(query: zenoh.Query) -> None:
             keep_thread_state()
-            query.reply(key, payload if isinstance(payload, bytes) else payload())
+            answer = payload if isinstance(payload, bytes) else payload()
+            if answer is not None:
+                query.reply(key, answer)
 
         self._keep.append(self.session.declare_queryable(key, cb))
 
@@ -283,6 +290,14 @@ class ZenohTransport:
             if reply.ok is not None:
                 return reply.ok.payload.to_bytes()
         return None
+
+    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
+        def cb(reply: zenoh.Reply) -> None:
+            keep_thread_state()
+            if reply.ok is not None:
+                on_reply(reply.ok.payload.to_bytes())
+
+        self.session.get(key, cb, timeout=timeout)
 
     def close(self) -> None:
         with self._wake_lock:
@@ -422,6 +437,11 @@ class MemoryTransport:
     def query(self, key: str, timeout: float) -> bytes | None:
         payload = self.bus._served.get(key)
         return payload if payload is None or isinstance(payload, bytes) else payload()
+
+    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:  # noqa: ARG002
+        payload = self.query(key, timeout)
+        if payload is not None:
+            on_reply(payload)
 
     def close(self) -> None:
         for key in self._tokens:

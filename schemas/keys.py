@@ -168,6 +168,10 @@ KEY_BY_NAME = {k.name: k for k in KEYS}
 # Data keys whose frames carry their sender's MAC in the zenoh attachment (runtime/mac.py),
 # besides every `summary/<p>` and `tap/<p>`; relative to arena/<match>/.
 SIGNED_DATA = ("engine/events", "referee", "world")
+# Keys (by name) whose sender also serves its last frame: the live viewer asks for what the
+# teams believe a few times a second (processes/viewer.py) instead of subscribing, which
+# would cost every robot and base station one more put per frame, many a second unpaced.
+SERVED = ("report", "order")
 MAX_BATCH = 64  # frames in one batch message at most (runtime/lockstep.py `Outbound.batch`)
 MAC_BYTES = 16  # BLAKE2b digest size of a MAC
 MAC_KEY_BYTES = 32  # a process's MAC key

@@ -17,7 +17,6 @@ Where the match configuration comes from:
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 import os
@@ -219,10 +218,6 @@ def run(
 
     where = ", ".join(net.connect or net.listen)
     last_ref: list[bytes] = []
-    if pid.kind == "viewer":
-        from arena.processes.viewer import downsampling
-
-        net = dataclasses.replace(net, extra=(*net.extra, ("downsampling", downsampling(keys))))
     with open_until(net, startup_timeout, where, tell) as session:
         transport = ZenohTransport(session, keyring)
         ref_sub = None

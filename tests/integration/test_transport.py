@@ -83,3 +83,29 @@ def test_close_while_zenohs_thread_is_inside_a_put_does_not_raise(tmp_path):
             stall.set()
             t.join(timeout=10)
             sub.undeclare()
+
+
+def test_a_served_key_answers_an_ask_with_its_last_frame_and_nothing_before_one(tmp_path):
+    """How the live viewer reads what the teams believe (runtime/node.py `SERVED`, processes/viewer.py)."""
+    from arena.runtime.lockstep import Latest
+
+    endpoint = f"unixsock-stream/{tmp_path}/ask.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as robot,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as viewer,
+    ):
+        tx, rx = ZenohTransport(robot), ZenohTransport(viewer)
+        latest = Latest().wrap(tx.publisher("arena/t/team/a/report/0"))
+        tx.serve("arena/t/team/a/report/0", latest.get)
+        time.sleep(0.3)  # the queryable's declaration reaches the viewer
+        answers: list[bytes] = []
+        rx.ask("arena/t/team/a/report/0", answers.append, 2.0)
+        time.sleep(0.5)
+        assert answers == [], "nothing sent yet: no answer"
+        for frame in (b"r1", b"r2"):
+            latest(frame)
+        got = threading.Event()
+        rx.ask("arena/t/team/a/report/0", lambda p: (answers.append(p), got.set()), 2.0)
+        assert got.wait(5.0) and answers == [b"r2"]
+        tx.close()
+        rx.close()
