@@ -165,6 +165,12 @@ KEYS: tuple[KeySpec, ...] = (
 
 KEY_BY_NAME = {k.name: k for k in KEYS}
 
+# [bytes] the longest frame a receiver reads on a data key; a longer one is counted as
+# `too-large` and dropped unread. The largest legitimate frame (a `world` or `sense` with
+# every robot of a full MSL match) is a few kB; 64 KiB is one zenoh batch, so no data
+# frame ever needs zenoh's fragmentation, which relayed megabyte frames lose (schemas/contract.py).
+MAX_FRAME_BYTES = 1 << 16
+
 # Data keys whose frames carry their sender's MAC in the zenoh attachment (runtime/mac.py),
 # besides every `summary/<p>` and `tap/<p>`; relative to arena/<match>/.
 SIGNED_DATA = ("engine/events", "referee", "world")

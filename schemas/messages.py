@@ -269,7 +269,7 @@ class Summary(Base):
     pid: Annotated[int, Meta(description="OS process id")]
     digest: Annotated[str, Meta(description="hex BLAKE2b of every (key, payload) it sent, in order")]
     sent: Annotated[int, Meta(description="frames sent")]
-    rejected: Annotated[int, Meta(description="malformed, out-of-sequence, conflicting or invalid inputs")]
+    rejected: Annotated[int, Meta(description="malformed, too-large, out-of-sequence, conflicting or invalid inputs")]
     rejected_reasons: dict[str, int] = {}
     links: Annotated[
         dict[str, dict[str, float]],

@@ -97,6 +97,19 @@ def test_garbage_and_wrong_types_are_rejected_and_counted(h):
     assert len(h.inbound.take(1)) == 1
 
 
+def test_a_frame_over_the_size_limit_is_counted_too_large_unread_and_the_link_goes_on(h):
+    from arena.schemas.keys import MAX_FRAME_BYTES
+
+    at_limit = encode({"tick": 0, "vx": 1.0, "pad": "x" * (MAX_FRAME_BYTES - 30)})  # an unknown field pads it
+    assert len(at_limit) <= MAX_FRAME_BYTES
+    h.put(encode({"tick": 0, "vx": 9.0, "pad": "x" * MAX_FRAME_BYTES}))  # in sequence, but too long
+    h.put(at_limit)
+    h.put(encode(Cmd(tick=1, vx=2.0)))
+    h.inbound.sync(2)
+    assert h.rej.by_reason == {"too-large": 1}
+    assert [c.vx for c in h.inbound.take(2)] == [1.0, 2.0]
+
+
 def test_out_of_sequence_frames_are_rejected(h):
     h.put(encode(Cmd(tick=0)))
     h.put(encode(Cmd(tick=5)))  # skips ticks 1-4
