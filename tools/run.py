@@ -17,6 +17,7 @@ Where the match configuration comes from:
 
 from __future__ import annotations
 
+import faulthandler
 import json
 import logging
 import os
@@ -208,6 +209,8 @@ def run(
     stderr what it connected to, whom it waits for, and the final score.
     """
     signal.signal(signal.SIGTERM, _sigterm)
+    # `kill -USR1 PID` writes every thread's Python stack to this process's log: what a hung match waits in.
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
     keys = Keys(match)
     log = logging.getLogger(f"arena.{pid}")
     talk = cfg is None or sys.stderr.isatty()
