@@ -22,6 +22,8 @@ message types (../shared/notes-foxglove-refbox-ray.md).
 
 from __future__ import annotations
 
+import contextlib
+import faulthandler
 import json
 import math
 import os
@@ -166,7 +168,15 @@ class Launcher:
         threading.Thread(target=lambda: self.err.extend(iter(self.proc.stderr.readline, "")), daemon=True).start()
 
     def line(self, prefix: str, timeout: float) -> str:
-        return wait_for(lambda: next((x for x in self.err if x.strip().startswith(prefix)), None), timeout, prefix)
+        def found() -> str | None:
+            if self.proc.poll() is not None:  # it will print no more
+                pytest.fail(f"arena match exited {self.proc.returncode}:\n{''.join(self.err)}", pytrace=False)
+            return next((x for x in self.err if x.strip().startswith(prefix)), None)
+
+        try:
+            return wait_for(found, timeout, f"{prefix!r} from arena match")
+        except AssertionError as exc:
+            pytest.fail(f"{exc}; it printed:\n{''.join(self.err)}", pytrace=False)
 
     def finish(self, timeout: float) -> str:
         """The launcher's stdout once it exits, or a failure that says what every process was doing."""
@@ -257,12 +267,24 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
     assert result["process_digests"] == GOLDEN["digests"], "nothing well-formed went in: the match is unchanged"
 
 
+@contextlib.contextmanager
+def stacks_after(seconds: float):
+    """Past every bound above, the test's own threads are stuck somewhere: print where."""
+    faulthandler.dump_traceback_later(seconds, exit=False)
+    try:
+        yield
+    finally:
+        faulthandler.cancel_dump_traceback_later()
+
+
 def test_fuzzing_every_key_with_1000_payloads_changes_nothing_and_counts_everything(tmp_path, reap):
     """The default suite's share: 1,000 payloads of every kind, then 20 of 1 MB or with huge arrays."""
-    fuzz_a_match(tmp_path, reap, 1000, 20)
+    with stacks_after(240):
+        fuzz_a_match(tmp_path, reap, 1000, 20)
 
 
 @pytest.mark.slow
 def test_fuzzing_every_key_with_10000_payloads_changes_nothing_and_counts_everything(tmp_path, reap):
     """10,000 payloads, then 100 of 1 MB (noise, or decodable with padding) and huge arrays."""
-    fuzz_a_match(tmp_path, reap, 10_000, 100)
+    with stacks_after(600):
+        fuzz_a_match(tmp_path, reap, 10_000, 100)
