@@ -250,8 +250,9 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
         if n_huge:
             inject(n_huge, True)
         # Counted whenever they arrive, even after the start: no payload is at a tick anybody expects.
-        robot = subprocess.Popen([*ARENA, *command[1:]], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        reap.append(robot)
+        # Its stderr into a file: a pipe nobody reads would stall a robot that says what it waits for.
+        with open(launcher.logs / "external_robot_a_0.log", "wb") as log:
+            reap.append(subprocess.Popen([*ARENA, *command[1:]], stdout=log, stderr=subprocess.STDOUT))
         out = launcher.finish(90)
     assert launcher.proc.returncode == 0, "".join(launcher.err)
     assert not any("Traceback" in x for x in launcher.err)
