@@ -162,12 +162,11 @@ class TimingParams:
     comm_period: int = DEFAULT_PERIODS["comm"]  # [ticks] robot <-> base station Wi-Fi period (10 Hz)
     referee_period: int = DEFAULT_PERIODS["referee"]  # [ticks] engine events -> referee -> everyone (10 Hz)
     world_period: int = DEFAULT_PERIODS["world"]  # [ticks] ground-truth `world` for viewers and the recorder
-    # [ticks] perception latency L: a robot acting at tick k sees the `sense` of tick k - L
-    # (omni-vision pipelines of MSL robots: 30-60 ms). The model; docs/architecture.md.
-    perception_latency: int = 0
-    # [frames] `sense` and `cmd` frames per message in lockstep: a transport detail, never
-    # the model (the digests are the same for every value). 0: as many as L allows (L, or 1).
-    batch: int = 0
+    # The perception latency L is the model (omni-vision pipelines of MSL robots: 30-60 ms;
+    # docs/architecture.md); the batch is a transport detail: the digests are the same for
+    # every batch. 0 and 0 are allowed (no latency; as many frames as L allows, L or 1).
+    perception_latency: int = 0  # [ticks] a robot acting at tick k sees the `sense` of tick k - L
+    batch: int = 0  # [frames] `sense`/`cmd` frames per message in lockstep (0: L, or 1)
     startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
     # [s] wall: last-resort bound on one lockstep wait. Dead and hung peers are
     # caught by liveliness (~2 s, runtime/session.py); this catches a peer that

@@ -39,6 +39,10 @@ def _comments(cls: type) -> dict[str, str]:
     return dict(re.findall(r"^\s+(\w+): [^=\n]+=[^#\n]*#\s*(.+)$", source, flags=re.M))
 
 
+# Numbers of those sections for which 0 means something (MatchConfig.validate checks their range).
+ZERO_ALLOWED = frozenset({"perception_latency", "batch"})
+
+
 def _known(section: str) -> dict[str, Any]:
     return {f.name: f for f in dataclasses.fields(getattr(MatchConfig(), section))}
 
@@ -68,7 +72,7 @@ def _check_values(cfg: MatchConfig, where: str) -> None:
                 continue
             if not math.isfinite(value) or value < 0:
                 raise ConfigError(f"{where}: {section}.{f.name} must be a finite number >= 0, got {value}")
-            if section in ("field", "ball", "timing") and value == 0:
+            if section in ("field", "ball", "timing") and value == 0 and f.name not in ZERO_ALLOWED:
                 raise ConfigError(f"{where}: {section}.{f.name} must be > 0")
     fp = cfg.field
     if fp.goal_width >= fp.width or fp.penalty_area_width >= fp.width or fp.penalty_area_depth * 2 >= fp.length:
