@@ -285,15 +285,18 @@ class Reactor:
         self,
         timeout: float,
         announce: Callable[[int | None], None] | None = None,
-        upstream_waiting: Callable[[str, int], bool] | None = None,
+        upstream_waited: Callable[[str, int], float | None] | None = None,
     ):
         self.timeout = timeout
         # A wait longer than `announce_after` is announced (a liveliness token naming the tick this
-        # process is about to act at), and a silent sender that announces a wait of its own at a
-        # tick not past the frame we miss is stalled upstream, not at fault: we keep waiting
-        # (issue 20, "correct blame"). Only the process whose sender owes a frame gives up.
+        # process is about to act at). A sender owes the frame we miss only since it was last seen
+        # announcing a wait of its own at a tick not past that frame (`upstream_waited`: the
+        # monotonic time, now while it still announces one): before, it was stalled upstream, not at
+        # fault. So only the process whose sender owes a frame gives up (issue 20, "correct blame").
+        # Counting from the start of our own wait instead blamed a sender that had just moved on
+        # from one stalled wait to the next: its new wait is announced only `announce_after` later.
         self._announce = announce
-        self._upstream_waiting = upstream_waiting
+        self._upstream_waited = upstream_waited
         self.announce_after = min(1.0, timeout / 4)
         self._announced: int | None = None
         self.lock = threading.Lock()
@@ -355,11 +358,15 @@ class Reactor:
                 if self._waiting is None:
                     continue
                 ib, k = self._waiting
-                if time.monotonic() - self._since < self.timeout:
+                now = time.monotonic()
+                if now - self._since < self.timeout:
                     continue
                 missing = ib.schedule.first_after(ib.last_seen)
-                if self._upstream_waiting is not None and self._upstream_waiting(ib.sender, missing):
-                    self._since = time.monotonic()  # its sender waits for its own upstream: so do we
+                waited = None if self._upstream_waited is None else self._upstream_waited(ib.sender, missing)
+                if waited is not None and now - waited < self.timeout:
+                    # Its sender waits for its own upstream, or did until lately: it owes the frame
+                    # only since then. Asked again at the next look; our own wait stays announced
+                    # (resetting `_since` here took our token back for `announce_after`).
                     continue
                 ib._give_up(f"silent for {self.timeout:g} s waiting for tick {k}")
                 self._advance()

@@ -74,13 +74,14 @@ class Node:
         # Waits announced by liveliness tokens (`Reactor`): a zenoh transport has them.
         self._announces = hasattr(transport, "declare_token")
         self._waits: dict[str, set[int]] = {}  # peer -> the ticks it announces waiting before
+        self._waited: dict[str, dict[int, float]] = {}  # peer -> tick -> when it took that announcement back
         self._wait_token: Callable[[], None] | None = None
         self.silent: dict[str, int] = {}  # peers given up on while alive and not waiting themselves
         self.reactor = (
             Reactor(
                 cfg.timing.wait_timeout,
                 self._announce_wait if self._announces else None,
-                self._upstream_waiting if self._announces else None,
+                self._upstream_waited if self._announces else None,
             )
             if self.reactive
             else None
@@ -203,17 +204,24 @@ class Node:
         peer, _, text = key.split(f"/{WAITING}/", 1)[-1].rpartition("/")
         if not text.isdigit():
             return  # not a token this runtime declares: ignored
+        tick = int(text)
         with self._alive_cond:
             ticks = self._waits.setdefault(peer, set())
             if alive:
-                ticks.add(int(text))
+                ticks.add(tick)
             else:
-                ticks.discard(int(text))
+                ticks.discard(tick)
+                # Wall time for failure detection only: from here on it may owe its frames.
+                self._waited.setdefault(peer, {})[tick] = time.monotonic()
 
-    def _upstream_waiting(self, peer: str, missing: int) -> bool:
-        """Is `peer` blocked itself, before acting at a tick not past `missing` (so it owes us nothing yet)?"""
+    def _upstream_waited(self, peer: str, missing: int) -> float | None:
+        """When `peer` was last seen blocked itself, before acting at a tick not past `missing`
+        (it owed us nothing then): now while it still announces such a wait, the monotonic time
+        it took the last one back otherwise, None if it never announced one."""
         with self._alive_cond:
-            return any(s <= missing for s in self._waits.get(peer, ()))
+            if any(s <= missing for s in self._waits.get(peer, ())):
+                return time.monotonic()
+            return max((t for s, t in self._waited.get(peer, {}).items() if s <= missing), default=None)
 
     def _announce_wait(self, tick: int | None) -> None:
         if self._wait_token is not None:

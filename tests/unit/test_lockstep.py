@@ -292,27 +292,97 @@ def test_the_reactor_announces_a_long_wait_and_waits_on_while_its_sender_waits_u
     upstream = {"robot/a/1": 0}  # the tick the sender announces it waits before; None: not waiting
     asked: list = []
 
-    def upstream_waiting(sender, missing):
+    def upstream_waited(sender, missing):
         asked.append((sender, missing))
         at = upstream[sender]
-        return at is not None and at <= missing
+        return time.monotonic() if at is not None and at <= missing else None
 
     def loop():
         for k in range(3):
             yield h.inbound, k
 
-    reactor = Reactor(timeout=0.3, announce=announced.append, upstream_waiting=upstream_waiting)
+    reactor = Reactor(timeout=0.3, announce=announced.append, upstream_waited=upstream_waited)
     runner = threading.Thread(target=reactor.run, args=(loop(),))
     runner.start()
     time.sleep(1.0)  # three timeouts: the sender waits before tick 0, frame 0 is missing, so we wait on
     assert not h.inbound.dead and runner.is_alive()
-    assert announced == [1], "the wait before acting at tick 1 is announced"
+    assert announced == [1], "the wait before acting at tick 1 is announced, and stays so while it goes on"
     assert asked and set(asked) == {("robot/a/1", 0)}
     upstream["robot/a/1"] = 5  # it went past tick 0 without sending it: it owes the frame
     runner.join(5.0)
     assert not runner.is_alive() and h.inbound.dead and "silent" in h.dead["robot/a/1"]
     assert announced[-1] is None, "taken back when the loop ends"
     h.close()
+
+
+def test_a_sender_owes_a_frame_only_since_it_stopped_waiting_upstream():
+    """Issue 20, the co-blamed engine: a sender stalled upstream moves on from one stalled wait to the
+    next (the engine got robot a/0's cmd, then waited for a/1's) and announces the new one only
+    `announce_after` later. A receiver whose own timeout fell in that gap gave up on it. Its silence
+    is counted from when it took its last announcement back, and the receiver's own wait stays
+    announced meanwhile (it used to take its token back for `announce_after` whenever it waited on)."""
+    from arena.runtime.lockstep import Reactor
+
+    h = Harness()
+    timeout = 0.8  # announce_after 0.2: a token taken back would show at the next look, 0.1 s later
+    announced: list = []
+    took_back: dict = {"at": None}  # when the sender took back its announced wait; None: never announced one
+
+    def upstream_waited(sender, missing):
+        return took_back["at"]
+
+    def loop():
+        yield h.inbound, 1
+
+    reactor = Reactor(timeout=timeout, announce=announced.append, upstream_waited=upstream_waited)
+    runner = threading.Thread(target=reactor.run, args=(loop(),))
+    t0 = time.monotonic()
+    runner.start()
+    time.sleep(timeout - 0.15)
+    took_back["at"] = time.monotonic()  # just before our timeout: it stopped waiting upstream only now
+    time.sleep(0.5)  # our own wait is past the timeout, the sender's debt is not
+    assert not h.inbound.dead and runner.is_alive()
+    runner.join(5.0)  # nothing comes: it is silent a full timeout after it took its announcement back
+    assert not runner.is_alive() and h.inbound.dead and "silent" in h.dead["robot/a/1"]
+    assert time.monotonic() - t0 >= (timeout - 0.15) + timeout
+    assert announced == [1, None], "announced once, until it gave up"
+    h.close()
+
+    # A sender that took its announcement back before we started to wait owes the frame all along.
+    h2 = Harness()
+    took_back["at"] = time.monotonic() - 10.0
+
+    def loop2():
+        yield h2.inbound, 1
+
+    t1 = time.monotonic()
+    Reactor(timeout=0.3, upstream_waited=upstream_waited).run(loop2())
+    assert h2.inbound.dead and time.monotonic() - t1 < 1.0
+    h2.close()
+
+
+def test_a_node_remembers_when_a_peer_stopped_waiting_before_each_tick():
+    """`Node._upstream_waited`, fed by the peers' `waiting/<process>/<tick>` tokens."""
+    from arena.runtime.node import Node
+
+    node = Node.__new__(Node)  # only the waiting-token bookkeeping
+    node._alive_cond = threading.Condition()
+    node._waits, node._waited = {}, {}
+    key = "arena/m/waiting/{}/{}".format
+    assert node._upstream_waited("engine", 4) is None, "never announced a wait"
+    node._on_waiting(key("engine", 3), True)
+    before = time.monotonic()
+    assert node._upstream_waited("engine", 4) >= before, "waits now"
+    assert node._upstream_waited("engine", 2) is None, "before acting at 3, it owes frame 2"
+    node._on_waiting(key("engine", 3), False)
+    gone = node._upstream_waited("engine", 4)
+    assert before <= gone <= time.monotonic(), "until the moment it took its token back"
+    time.sleep(0.01)
+    assert node._upstream_waited("engine", 4) == gone
+    node._on_waiting(key("engine", 7), True)
+    assert node._upstream_waited("engine", 4) == gone, "a wait past the missing frame is no excuse"
+    node._on_waiting(key("robot/a/1", 2), True)
+    assert node._upstream_waited("robot/a/1", 2) is not None and node._upstream_waited("engine", 3) == gone
 
 
 def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
