@@ -95,13 +95,16 @@ class Secrets:
         frag["metadata"] = {"arena": {"match": self.match, "process": principal, "keys": keys}}
         return frag
 
-    def write(self, directory: Path) -> dict[str, Path]:
-        """Write every principal's fragment (mode 0600) into `directory`; returns their paths."""
+    def write(self, directory: Path, more: dict[str, dict] | None = None) -> dict[str, Path]:
+        """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
+
+        `more`: zenoh settings added to some principals' fragments (top-level keys),
+        e.g. the launcher's own peers' `qos` (tools/launcher.py, `relay_safe`)."""
         directory.mkdir(parents=True, exist_ok=True)
         out = {}
         for p in principals(self.processes):
             path = directory / f"{user_of(p)}.json5"
-            _write_private(path, json.dumps(self.fragment(p), indent=2) + "\n")
+            _write_private(path, json.dumps(self.fragment(p) | (more or {}).get(p, {}), indent=2) + "\n")
             out[p] = path
         return out
 

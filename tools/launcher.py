@@ -400,6 +400,26 @@ SPECTATOR_SAFE = (
 )
 
 
+def new_zid() -> str:
+    """A zenoh id for the match's router, chosen before it starts so its peers can name it (32 hex digits, no leading 0)."""
+    import secrets
+
+    return f"{secrets.randbits(127) | 1 << 126:x}"
+
+
+def relay_safe(router_zid: str) -> dict:
+    """Zenoh settings of a peer this launcher starts in a peer match: what it puts towards the
+    router is DROP, on its direct links to the other peers BLOCK as before.
+
+    The router relays only to clients (spectators, hand-started processes), so nothing of the
+    lockstep waits on it. Under BLOCK, a router behind on a peer's link filled that peer's
+    queue towards it, and a put made in a zenoh callback (reactive nodes) then waited on
+    zenoh's only thread, the one that would write the queue out: 5 s (`wait_before_close`),
+    then the link closed and the router saw the peer's token vanish (issue 20 item 6)."""
+    rule = {"id": "to-router", "zids": [router_zid], "messages": ["put"], "flows": ["egress"]}
+    return {"qos": {"network": [rule | {"overwrite": {"congestion_control": "drop"}}]}}
+
+
 def supervision_deadline(cfg: MatchConfig) -> float:
     """[s] wall: the longest a whole match may take before the launcher gives up.
 
@@ -735,11 +755,13 @@ def play_match(
     logs.mkdir(parents=True, exist_ok=True)
     names = [str(p) for p in cfg.processes()]
     secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
-    cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials")
-    router_extra = tuple(secrets.router_settings(tmp)) if secure else SPECTATOR_SAFE
+    external = {ProcessId.parse(e) for e in cfg.external}
+    router_zid = new_zid()
+    more = {} if secure else {str(p): relay_safe(router_zid) for p in cfg.processes() if p not in external}
+    cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials", more)
+    router_extra = tuple(secrets.router_settings(tmp)) if secure else (("id", json.dumps(router_zid)), *SPECTATOR_SAFE)
     children: list[Child] = []
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
-    external = {ProcessId.parse(e) for e in cfg.external}
     starter = None
     try:
         # Fork the processes before any zenoh session exists here (tools/forkstart.py);
