@@ -29,3 +29,16 @@ def test_zenoh_takes_the_fragment_and_the_routers_id():
     frag = Secrets.new("m1", 1, NAMES, secure=False).fragment("engine") | relay_safe(zid)
     zenoh.Config.from_json5(json.dumps(frag))  # a wrong field would raise
     zenoh.Config().insert_json5("id", json.dumps(zid))
+
+
+def test_a_secure_router_opens_with_the_viewers_drop_rule(tmp_path):
+    """In a secure match only what goes to the viewer is DROP (the viewer's fragment carries its id)."""
+    from arena.runtime.session import NetConfig, open_session
+    from arena.tools.launcher import viewer_safe
+
+    path, value = viewer_safe(new_zid())
+    [rule] = json.loads(value)
+    assert path == "qos/network" and rule["messages"] == ["put"] and rule["overwrite"] == {"congestion_control": "drop"}
+    net = NetConfig(mode="router", listen=(f"unixsock-stream/{tmp_path}/r.sock",), extra=((path, value),))
+    with open_session(net):  # zenoh checks the rule's fields only here
+        pass
