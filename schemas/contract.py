@@ -265,8 +265,12 @@ that is not `--secure` relays every put with congestion control DROP (a
 peers with direct links to one another, so only clients (spectators, a
 `--mode client` process) receive through it, and a client that reads too
 slowly loses frames instead of stalling the match; a lockstep client must
-therefore keep reading. A client's own puts reach the peers through the
-router too, so DROP applies to them on the way out: a frame over one zenoh
+therefore keep reading. The peers the match's launcher starts also put
+towards the router with DROP (their credentials fragment names the router's
+zenoh id), so a client may lose frames when the router itself falls behind,
+not only when it reads slowly (docs/architecture.md, "Spectators"). A
+client's own puts reach the peers through the router too, so DROP applies
+to them on the way out: a frame over one zenoh
 batch (64 KiB, so fragmented) that the router cannot queue for a peer within
 50 ms (zenoh's `max_wait_before_drop_fragments`) is dropped by zenoh before
 any process sees it, and nobody counts it. Measured with
@@ -274,7 +278,8 @@ tests/integration/test_fuzz.py injecting as a client: 1 to 3 of every 100
 megabyte frames lost, none of 3,000 to 10,000 small ones. Frames of a match
 are far below {MAX_FRAME_BYTES:,} bytes, and a process injecting as a peer
 (direct links, BLOCK end to end) had every frame counted. In a `--secure`
-match every frame goes through the router with the sender's QoS.
+match every frame goes through the router with the sender's QoS, except
+towards the `viewer` principal, whom the router serves with DROP.
 
 **Commands and stages.** `Referee.command`, `RefCommand.name` and
 `Order.command` take only the MSL RefBox names listed in their tables; a
