@@ -408,6 +408,12 @@ def new_zid() -> str:
     return f"{secrets.randbits(127) | 1 << 126:x}"
 
 
+def drop_puts_towards(name: str, zid: str) -> list[dict]:
+    """A zenoh `qos/network` setting: puts this session sends to the session `zid` are DROP."""
+    rule = {"id": name, "zids": [zid], "messages": ["put"], "flows": ["egress"]}
+    return [rule | {"overwrite": {"congestion_control": "drop"}}]
+
+
 def relay_safe(router_zid: str) -> dict:
     """Zenoh settings of a peer this launcher starts in a peer match: what it puts towards the
     router is DROP, on its direct links to the other peers BLOCK as before.
@@ -417,8 +423,7 @@ def relay_safe(router_zid: str) -> dict:
     queue towards it, and a put made in a zenoh callback (reactive nodes) then waited on
     zenoh's only thread, the one that would write the queue out: 5 s (`wait_before_close`),
     then the link closed and the router saw the peer's token vanish (issue 20 item 6)."""
-    rule = {"id": "to-router", "zids": [router_zid], "messages": ["put"], "flows": ["egress"]}
-    return {"qos": {"network": [rule | {"overwrite": {"congestion_control": "drop"}}]}}
+    return {"qos": {"network": drop_puts_towards("to-router", router_zid)}}
 
 
 def viewer_safe(viewer_zid: str) -> tuple[str, str]:
@@ -430,8 +435,7 @@ def viewer_safe(viewer_zid: str) -> tuple[str, str]:
     The viewer is the one principal nobody waits for; its credentials fragment carries
     the zenoh id this names (so one viewer per credentials file at a time: zenoh refuses a
     second session with the same id at connect)."""
-    rule = {"id": "viewer", "zids": [viewer_zid], "messages": ["put"], "flows": ["egress"]}
-    return "qos/network", json.dumps([rule | {"overwrite": {"congestion_control": "drop"}}])
+    return "qos/network", json.dumps(drop_puts_towards("viewer", viewer_zid))
 
 
 def supervision_deadline(cfg: MatchConfig) -> float:
