@@ -44,12 +44,23 @@ import secrets
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from arena.runtime.acl import COLLECTOR_PRINCIPAL, access_control, principals, user_of
+from arena.runtime.acl import COLLECTOR_PRINCIPAL, VIEWER, access_control, principals, user_of
 
 __all__ = ["COLLECTOR_PRINCIPAL", "Secrets", "load_fragment", "loopback_only", "make_tls", "secure_endpoint"]
 from arena.runtime.mac import Keyring, new_key
 
 OFFICIAL_VERIFIES = {"engine": ["referee"], "referee": ["engine"], "viewer": ["engine", "referee"]}
+
+
+def new_zid() -> str:
+    """A zenoh id chosen before its session starts, so others can name it (32 hex digits, no leading 0)."""
+    return f"{secrets.randbits(127) | 1 << 126:x}"
+
+
+def drop_puts_towards(name: str, zid: str) -> list[dict]:
+    """A zenoh `qos/network` setting: puts this session sends to the session `zid` are DROP."""
+    rule = {"id": name, "zids": [zid], "messages": ["put"], "flows": ["egress"]}
+    return [rule | {"overwrite": {"congestion_control": "drop"}}]
 
 
 @dataclass
@@ -63,6 +74,7 @@ class Secrets:
     ca_pem: bytes = b""
     router_cert_pem: bytes = b""
     router_key_pem: bytes = b""
+    viewer_zid: str = ""  # secure: the viewer's zenoh id, which the router serves with DROP
 
     @classmethod
     def new(cls, match: str, robots: int, processes: list[str], secure: bool, tls: bool = False) -> Secrets:
@@ -72,6 +84,8 @@ class Secrets:
             s.mac_keys[p] = new_key()
         if tls:
             s.ca_pem, s.router_cert_pem, s.router_key_pem = make_tls()
+        if secure:
+            s.viewer_zid = new_zid()
         return s
 
     def keyring(self, principal: str) -> Keyring:
@@ -91,6 +105,8 @@ class Secrets:
             if self.ca_pem:
                 tls = {"root_ca_certificate_base64": base64.b64encode(self.ca_pem).decode()}
                 frag["transport"]["link"] = {"tls": tls | {"verify_name_on_connect": False}}
+            if principal == VIEWER and self.viewer_zid:
+                frag["id"] = self.viewer_zid  # `router_settings`: the router serves this id with DROP
         keys = {p: k.hex() for p, k in ring.keys.items()}
         frag["metadata"] = {"arena": {"match": self.match, "process": principal, "keys": keys}}
         return frag
@@ -117,6 +133,13 @@ class Secrets:
             ("transport/auth/usrpwd/dictionary_file", json.dumps(str(dictionary))),
             ("access_control", json.dumps(acl)),
         ]
+        if self.viewer_zid:
+            # Every process of a secure match is a client and every frame goes through the router
+            # with its sender's QoS (BLOCK), so a viewer reading slowly held the router on its queue
+            # and paced the whole match (a 5 ms-per-sample viewer: about 8 s instead of 3 s). The
+            # viewer is the one principal nobody waits for: what the router puts towards it is DROP.
+            # One viewer per credentials file at a time: zenoh refuses a second session with that id.
+            items.append(("qos/network", json.dumps(drop_puts_towards("viewer", self.viewer_zid))))
         if self.router_cert_pem:
             for name, pem in (
                 ("listen_certificate", self.router_cert_pem),

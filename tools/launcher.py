@@ -34,13 +34,12 @@ from pathlib import Path
 import msgspec
 import zenoh
 
-from arena.runtime.acl import VIEWER
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.credentials import Secrets, loopback_only, secure_endpoint
+from arena.runtime.credentials import Secrets, drop_puts_towards, loopback_only, new_zid, secure_endpoint
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys
+from arena.schemas.keys import Keys, routes
 from arena.schemas.messages import Referee, Summary
 from arena.tools import forkstart
 from arena.tools.faults import VOIDING, exit_reason
@@ -401,20 +400,7 @@ SPECTATOR_SAFE = (
 )
 
 
-def new_zid() -> str:
-    """A zenoh id for the match's router, chosen before it starts so its peers can name it (32 hex digits, no leading 0)."""
-    import secrets
-
-    return f"{secrets.randbits(127) | 1 << 126:x}"
-
-
-def drop_puts_towards(name: str, zid: str) -> list[dict]:
-    """A zenoh `qos/network` setting: puts this session sends to the session `zid` are DROP."""
-    rule = {"id": name, "zids": [zid], "messages": ["put"], "flows": ["egress"]}
-    return [rule | {"overwrite": {"congestion_control": "drop"}}]
-
-
-def relay_safe(router_zid: str) -> dict:
+def relay_safe(router_zid: str, peer: str, match: str, robots: int, external: set[str]) -> dict:
     """Zenoh settings of a peer this launcher starts in a peer match: what it puts towards the
     router is DROP, on its direct links to the other peers BLOCK as before.
 
@@ -422,20 +408,22 @@ def relay_safe(router_zid: str) -> dict:
     lockstep waits on it. Under BLOCK, a router behind on a peer's link filled that peer's
     queue towards it, and a put made in a zenoh callback (reactive nodes) then waited on
     zenoh's only thread, the one that would write the queue out: 5 s (`wait_before_close`),
-    then the link closed and the router saw the peer's token vanish (issue 20 item 6)."""
-    return {"qos": {"network": drop_puts_towards("to-router", router_zid)}}
+    then the link closed and the router saw the peer's token vanish (issue 20 item 6).
 
-
-def viewer_safe(viewer_zid: str) -> tuple[str, str]:
-    """The secure router's setting: what it puts towards the viewer is DROP.
-
-    In a secure match every process is a client and every frame goes through the router
-    with its sender's QoS (BLOCK), so a viewer reading slowly held the router on its
-    queue and paced the whole match (a 5 ms-per-sample viewer: about 8 s instead of 3 s).
-    The viewer is the one principal nobody waits for; its credentials fragment carries
-    the zenoh id this names (so one viewer per credentials file at a time: zenoh refuses a
-    second session with the same id at connect)."""
-    return "qos/network", json.dumps(drop_puts_towards("viewer", viewer_zid))
+    Except for what an `--external` process (a client, through the router) receives: it
+    waits for those frames in its lockstep, and a dropped one would stall it and blame it,
+    so they stay BLOCK (the key table's receivers, and `referee`, which a process started
+    by hand reads for the score). Then the rule names only the keys that may be dropped.
+    """
+    rule = drop_puts_towards("to-router", router_zid)
+    if external:
+        keys = Keys(match)
+        table = routes(robots)
+        kept = {rel for rel, _, receivers in table if external & set(receivers)} | {"referee"}
+        dropped = [keys.prefix + rel for rel, sender, _ in table if sender == peer and rel not in kept]
+        dropped += [keys.summary(peer), keys.tap(peer)]  # a summary is re-sent until acked
+        rule[0]["key_exprs"] = dropped
+    return {"qos": {"network": rule}}
 
 
 def supervision_deadline(cfg: MatchConfig) -> float:
@@ -774,12 +762,15 @@ def play_match(
     names = [str(p) for p in cfg.processes()]
     secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
     external = {ProcessId.parse(e) for e in cfg.external}
-    router_zid, viewer_zid = new_zid(), new_zid()
-    if secure:
-        more = {VIEWER: {"id": viewer_zid}}
-        router_extra = (*secrets.router_settings(tmp), viewer_safe(viewer_zid))
+    if secure:  # the viewer is served with DROP (Secrets.router_settings)
+        more: dict[str, dict] = {}
+        router_extra = tuple(secrets.router_settings(tmp))
     else:
-        more = {str(p): relay_safe(router_zid) for p in cfg.processes() if p not in external}
+        router_zid = new_zid()
+        ext = {str(e) for e in external}
+        more = {
+            str(p): relay_safe(router_zid, str(p), match, cfg.robots, ext) for p in cfg.processes() if p not in external
+        }
         router_extra = (("id", json.dumps(router_zid)), *SPECTATOR_SAFE)
     cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials", more)
     children: list[Child] = []
