@@ -267,8 +267,9 @@ peers with direct links to one another, so only clients (spectators, a
 slowly loses frames instead of stalling the match; a lockstep client must
 therefore keep reading. The peers the match's launcher starts also put
 towards the router with DROP (their credentials fragment names the router's
-zenoh id), so a client may lose frames when the router itself falls behind,
-not only when it reads slowly (docs/architecture.md, "Spectators"). A
+zenoh id), except the keys an `--external` process receives, so a spectator
+may lose frames when the router itself falls behind, not only when it reads
+slowly (docs/architecture.md, "Spectators"). A
 client's own puts reach the peers through the router too, so DROP applies
 to them on the way out: a frame over one zenoh
 batch (64 KiB, so fragmented) that the router cannot queue for a peer within
