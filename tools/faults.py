@@ -66,9 +66,10 @@ def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
     """
     dead: dict[str, int] = {}
     # A peer given up on as alive but silent (`extra["silent"]`): the claimant checked that the peer
-    # was not itself waiting for its own upstream, nor had been for `wait_timeout` (runtime/lockstep.py
-    # `Reactor`), so the peer owes a frame. Taken in tick order: a process already found silent is no witness against its peers
-    # (its base station muted its orders, so it then found the base station silent in turn).
+    # was not itself waiting for its own upstream, nor had been for `wait_timeout`
+    # (runtime/lockstep.py `Reactor`), so the peer owes a frame. Taken in tick order: a process
+    # already found silent is no witness against its peers (its base station muted its orders,
+    # so it then found the base station silent in turn).
     silent = sorted(
         (int(tick), name, peer)
         for name, s in summaries.items()
