@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import subprocess
 import sys
 import time
@@ -17,6 +18,35 @@ def arena_json(*args: str, timeout: float = 240.0, env: dict | None = None) -> d
     r = subprocess.run([*ARENA, *args, "--json"], capture_output=True, text=True, timeout=timeout, env=env)
     assert r.returncode == 0, f"exit {r.returncode}\n{r.stderr[-3000:]}"
     return json.loads(r.stdout)
+
+
+def free_ports(n: int = 1) -> list[int]:
+    """`n` distinct free ports on 127.0.0.1: all are held at once, so no two of them are the same."""
+    socks = [socket.socket() for _ in range(n)]
+    try:
+        for s in socks:
+            s.bind(("127.0.0.1", 0))
+        return [s.getsockname()[1] for s in socks]
+    finally:
+        for s in socks:
+            s.close()
+
+
+def free_port() -> int:
+    return free_ports(1)[0]
+
+
+def stop(*procs: subprocess.Popen | None) -> None:
+    """Kill what still runs, reap it and close its pipes (no process or file is left to the collector)."""
+    for p in procs:
+        if p is None:
+            continue
+        if p.poll() is None:
+            p.kill()
+        try:
+            p.communicate(timeout=30)
+        except (subprocess.TimeoutExpired, ValueError, OSError):
+            pass
 
 
 def spawn(*args: str, **kw) -> subprocess.Popen:

@@ -3,19 +3,13 @@
 from __future__ import annotations
 
 import json
-import socket
 import subprocess
 import time
 
-from tests.integration.helpers import ARENA, spawn, wait_for
+from tests.integration.helpers import ARENA, free_port, spawn, wait_for
 
 ROBOT = ("run", "robot", "--match", "hand", "--team", "a", "--robot", "1")
 
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_no_router_is_said_at_once_and_the_robot_gives_up_with_exit_2():

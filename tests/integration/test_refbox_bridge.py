@@ -18,7 +18,7 @@ import time
 
 from mcap.reader import make_reader
 
-from tests.integration.helpers import ARENA, arena_json
+from tests.integration.helpers import ARENA, arena_json, free_port
 
 # From the protocol description: legacy characters (upper case cyan, lower case magenta).
 LEGACY = {"START": "s", "STOP": "S", "WELCOME": "W", "FIRST_HALF": "1", "SECOND_HALF": "2", "HALF_TIME": "h"}
@@ -27,11 +27,6 @@ LEGACY_TEAM = {"KICKOFF": "K", "FREEKICK": "F", "GOALKICK": "G", "THROWIN": "T",
 LEGACY_TEAM |= {"PENALTY": "P", "YELLOW_CARD": "Y", "RED_CARD": "R", "DOUBLE_YELLOW": "B", "REPAIR": "O"}
 CYAN, MAGENTA = "224.16.32.201", "224.16.32.202"  # the bridge's documented default targetTeam strings
 
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def connect(port: int, timeout: float = 90.0) -> socket.socket:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import stat
 import subprocess
 import time
@@ -19,7 +18,7 @@ import zenoh
 from mcap.reader import make_reader
 
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, Referee, Summary, TapBatch, TapFrame, encode
-from tests.integration.helpers import ARENA, arena_json, spawn, wait_for
+from tests.integration.helpers import ARENA, arena_json, free_port, spawn, wait_for
 
 GAME = ("--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "4")
 
@@ -28,11 +27,6 @@ GAME = ("--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "4")
 def baseline() -> dict:
     return arena_json("match", *GAME)
 
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _client(fragment: dict | None, endpoint: str) -> zenoh.Config:
@@ -52,7 +46,7 @@ def _refused(fragment: dict | None, endpoint: str) -> bool:
 
 
 def test_a_secure_match_keeps_team_b_out_of_team_a_and_a_hand_started_robot_plays(tmp_path, reap, baseline):
-    port = _free_port()
+    port = free_port()
     creds = tmp_path / "creds"
     match = spawn(
         "match", *GAME, "--secure", "--listen", f"tcp/127.0.0.1:{port}", "--credentials", str(creds),

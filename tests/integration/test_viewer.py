@@ -9,25 +9,19 @@ count can pass before it listens.
 from __future__ import annotations
 
 import json
-import socket
 import subprocess
 import time
 
 from tests.integration.foxglove_client import FoxgloveClient, log_entry, scene_entities
-from tests.integration.helpers import ARENA, arena_json
+from tests.integration.helpers import ARENA, arena_json, free_ports, stop
 
 ROBOTS = {f"robot/{t}/{n}" for t in "ab" for n in range(3)}
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
 
 def start_live(match: str, *flags: str):
     """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1)."""
-    port, zport = free_port(), free_port()
+    port, zport = free_ports(2)
     endpoint = f"tcp/127.0.0.1:{zport}"
     argv = [*ARENA, "match", "--home", "BS", "--away", "BS", "--live", str(port), "--external", "a/1"]
     argv += ["--match", match, "--listen", endpoint, "--json", *flags]
@@ -40,6 +34,16 @@ def start_live(match: str, *flags: str):
         said.append(line)
     robot_argv = [*ARENA, *next(x for x in said if "arena run robot" in x).split()[1:]]
     return proc, f"ws://127.0.0.1:{port}", lambda: subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL)
+
+
+def connect(url: str, proc: subprocess.Popen) -> FoxgloveClient:
+    """The client, or a failure that says what the match printed (a viewer that could not serve, say)."""
+    try:
+        return FoxgloveClient(url, timeout=60)
+    except OSError as exc:
+        proc.kill()
+        _, said = proc.communicate(timeout=30)
+        raise AssertionError(f"no Foxglove server at {url} ({exc}); the match said:\n{said[-3000:]}") from exc
 
 
 def finish(proc: subprocess.Popen, robot: subprocess.Popen | None) -> dict:
@@ -55,7 +59,7 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command()
     proc, url, start_robot = start_live("viewer-rt", "--realtime", "--half-time", "5", "--secure")
     robot = None
     try:
-        client = FoxgloveClient(url, timeout=60)
+        client = connect(url, proc)
         assert {"/scene", "/referee_log", "/match"} <= set(client.channels)
         assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
         client.subscribe("/scene", "/referee_log", "/match")
@@ -76,9 +80,7 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command()
         client.close()
         result = finish(proc, robot)
     finally:
-        for p in (proc, robot):
-            if p is not None and p.poll() is None:
-                p.kill()
+        stop(proc, robot)
     assert result["realtime"] and result["ticks"] == 500
     assert full >= 40, f"only {full} complete scene updates"
     assert beliefs == {"seen", "p_ball"}, "the robots' perceived ball and the base stations' P_ball are drawn"
@@ -94,7 +96,7 @@ def test_pause_step_resume_over_the_protocol_keeps_the_digest():
     proc, url, start_robot = start_live("viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0")
     robot = None
     try:
-        client = FoxgloveClient(url, timeout=60)
+        client = connect(url, proc)
         assert "parameters" in client.info["capabilities"]
         client.subscribe("/match")
         client.set_parameters(paused=True)
@@ -111,9 +113,7 @@ def test_pause_step_resume_over_the_protocol_keeps_the_digest():
         client.close()
         result = finish(proc, robot)
     finally:
-        for p in (proc, robot):
-            if p is not None and p.poll() is None:
-                p.kill()
+        stop(proc, robot)
     # unpaced, the viewer shows at most SCENE_HZ frames a second, and a late world frame may be dropped
     assert after and 10 < after[-1] <= result["ticks"] == reference["ticks"]
     assert result["digest"] == reference["digest"]
