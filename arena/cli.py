@@ -331,7 +331,8 @@ def build_parser() -> Parser:
         type=int,
         const=8765,
         metavar="PORT",
-        help="start a viewer: the Foxglove app connects to ws://127.0.0.1:PORT (8765); in lockstep the "
+        help="start a viewer: the Foxglove app connects to ws://127.0.0.1:PORT (8765; 0: a free port, "
+        "printed); in lockstep the "
         "viewer's parameters pause, step and pace the match",
     )
     m.add_argument(
@@ -704,14 +705,16 @@ def live_config(cfg: MatchConfig, live: int | None, pace: float | None, host: st
     if pace is not None and cfg.realtime:
         raise ConfigError("--pace applies to lockstep; --realtime already plays at the wall clock's speed")
     pace = 0.0 if cfg.realtime else (1.0 if pace is None else pace)
-    if 0 < live <= 65535:
+    if 0 <= live <= 65535:
         # A port in use would stop the viewer after every other process had started: say so now.
+        # Port 0 is a free port chosen here, so the address printed is the one to connect to.
         with socket.socket() as s:
             s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             try:
                 s.bind((host, live))
             except OSError as exc:
                 raise ConfigError(f"--live {live}: cannot serve on {host}:{live}: {exc.strerror}") from None
+            live = s.getsockname()[1]
     timing = cfg.timing
     if not cfg.realtime:
         # Everybody waits while the viewer pauses the engine: a pause is not a failure.

@@ -450,12 +450,15 @@ def supervise(
     timeout: float | None = None,
     strict: bool = False,
     witness: Witness | None = None,
+    announce=None,
 ) -> Collected:
     """Wait for every expected summary, within bounds; note every failure by name.
 
     `strict`: the first child to fail ends the match (MatchError), as for CI.
     Otherwise a failed team process or recorder is a fault and the match plays
     on; a failed engine or referee makes it void at once (tools/faults.py).
+    `announce(text)` hears of each failure when it happens (a viewer that
+    could not serve, say), with the last line of the process's log.
     """
     decode_summary = msgspec.msgpack.Decoder(Summary).decode
     decode_ref = msgspec.msgpack.Decoder(Referee).decode
@@ -488,8 +491,13 @@ def supervise(
             raise MatchError(f"{name}{pid} {why}:\n{c.tail() if c else ''}")
         into[name] = why
         waiting.discard(name)
-        if name.split("/")[0] in VOIDING and not got.void:
+        voids = name.split("/")[0] in VOIDING and not got.void
+        if voids:
             got.void = f"{name} {why}"
+        if announce is not None:
+            last = c.tail(1).strip() if c is not None else ""
+            then = "the match is void" if voids else "the match plays on"
+            announce(f"{name} {why}; {then}" + (f" (its log: {last})" if last else ""))
 
     got.forged = sums.forged
     acks: dict[str, object] = {}
@@ -818,6 +826,7 @@ def play_match(
                     Progress(cfg.total_ticks, progress),
                     strict=strict,
                     witness=witness,
+                    announce=announce,
                 )
             finally:
                 joins.close()

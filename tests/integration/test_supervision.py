@@ -95,4 +95,6 @@ def test_a_hung_robot_is_declared_dead_after_a_bounded_wait(reap, tmp_path):
     result = json.loads(out)
     assert result["dead"] == ["robot/b/2"]
     assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
+    # said when it happened, not only in the result
+    assert "robot/b/2 stopped responding: its liveliness token vanished" in err and "the match plays on" in err, err
     wait_for(lambda: not alive(victim), 10, "the hung robot to be stopped")
