@@ -11,7 +11,6 @@ from tests.integration.helpers import ARENA, free_port, spawn, wait_for
 ROBOT = ("run", "robot", "--match", "hand", "--team", "a", "--robot", "1")
 
 
-
 def test_no_router_is_said_at_once_and_the_robot_gives_up_with_exit_2():
     port = free_port()
     robot = subprocess.Popen(

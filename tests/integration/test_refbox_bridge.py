@@ -28,7 +28,6 @@ LEGACY_TEAM |= {"PENALTY": "P", "YELLOW_CARD": "Y", "RED_CARD": "R", "DOUBLE_YEL
 CYAN, MAGENTA = "224.16.32.201", "224.16.32.202"  # the bridge's documented default targetTeam strings
 
 
-
 def connect(port: int, timeout: float = 90.0) -> socket.socket:
     deadline = time.monotonic() + timeout
     while True:

@@ -28,7 +28,6 @@ def baseline() -> dict:
     return arena_json("match", *GAME)
 
 
-
 def _client(fragment: dict | None, endpoint: str) -> zenoh.Config:
     c = zenoh.Config.from_json5(json.dumps(fragment)) if fragment else zenoh.Config()
     c.insert_json5("mode", '"client"')

@@ -18,7 +18,6 @@ from tests.integration.helpers import ARENA, arena_json, free_ports, stop
 ROBOTS = {f"robot/{t}/{n}" for t in "ab" for n in range(3)}
 
 
-
 def start_live(match: str, *flags: str):
     """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1)."""
     port, zport = free_ports(2)
