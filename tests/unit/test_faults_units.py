@@ -9,7 +9,7 @@ import pytest
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
-from arena.schemas.validate import nonfinite, safe_default
+from arena.schemas.validate import nonfinite, safe_default, suspect
 from arena.sim.physics import Physics
 from arena.tools.faults import blame, outcome
 from tests.unit.test_lockstep import Harness
@@ -146,3 +146,13 @@ def test_a_process_that_lost_everyone_while_nobody_lost_it_is_the_one_blamed():
         "robot/a/1": _summary("robot/a/1", ["basestation/a", "engine"], {"engine": 1012, "basestation/a": 1011}),
     }
     assert blame(sums, set()) == {"robot/a/1": 1011}
+
+
+def test_the_one_scan_finds_exactly_the_four_suspect_pairs():
+    """suspect() is the four scans it replaced (0xca/0xcb then 0x7f/0xff), for every pair of bytes."""
+    pairs = (b"\xcb\x7f", b"\xcb\xff", b"\xca\x7f", b"\xca\xff")
+    for a in range(256):
+        for b in range(256):
+            raw = bytes([0x93, a, b, 0x01])
+            assert suspect(raw) == any(p in raw for p in pairs), raw
+    assert not suspect(b"") and suspect(msgspec.msgpack.encode([1.0, float("-inf")]))
