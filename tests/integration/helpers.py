@@ -36,19 +36,6 @@ def free_port() -> int:
     return free_ports(1)[0]
 
 
-def stop(*procs: subprocess.Popen | None) -> None:
-    """Kill what still runs, reap it and close its pipes (no process or file is left to the collector)."""
-    for p in procs:
-        if p is None:
-            continue
-        if p.poll() is None:
-            p.kill()
-        try:
-            p.communicate(timeout=30)
-        except (subprocess.TimeoutExpired, ValueError, OSError):
-            pass
-
-
 def spawn(*args: str, **kw) -> subprocess.Popen:
     return subprocess.Popen([*ARENA, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 

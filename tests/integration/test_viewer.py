@@ -13,18 +13,21 @@ import subprocess
 import time
 
 from tests.integration.foxglove_client import FoxgloveClient, log_entry, scene_entities
-from tests.integration.helpers import ARENA, arena_json, free_ports, stop
+from tests.integration.helpers import ARENA, arena_json, free_ports
 
 ROBOTS = {f"robot/{t}/{n}" for t in "ab" for n in range(3)}
 
 
-def start_live(match: str, *flags: str):
-    """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1)."""
+def start_live(reap: list, match: str, *flags: str):
+    """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1).
+
+    Both processes go on `reap` (conftest.py), which kills and reaps what a failed test left running."""
     port, zport = free_ports(2)
     endpoint = f"tcp/127.0.0.1:{zport}"
     argv = [*ARENA, "match", "--home", "BS", "--away", "BS", "--live", str(port), "--external", "a/1"]
     argv += ["--match", match, "--listen", endpoint, "--json", *flags]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    reap.append(proc)
     # The robot is started with the command the match prints (with its credentials in a secure match).
     said = []
     while not any("arena run robot" in line for line in said):
@@ -32,7 +35,12 @@ def start_live(match: str, *flags: str):
         assert line, "".join(said) + proc.stderr.read()
         said.append(line)
     robot_argv = [*ARENA, *next(x for x in said if "arena run robot" in x).split()[1:]]
-    return proc, f"ws://127.0.0.1:{port}", lambda: subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL)
+
+    def start_robot() -> subprocess.Popen:
+        reap.append(robot := subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL))
+        return robot
+
+    return proc, f"ws://127.0.0.1:{port}", start_robot
 
 
 def connect(url: str, proc: subprocess.Popen) -> FoxgloveClient:
@@ -53,33 +61,29 @@ def finish(proc: subprocess.Popen, robot: subprocess.Popen | None) -> dict:
     return json.loads(out)
 
 
-def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command():
+def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command(reap):
     # --secure: the viewer is the read-only `viewer` principal of the match's access control
-    proc, url, start_robot = start_live("viewer-rt", "--realtime", "--half-time", "5", "--secure")
-    robot = None
-    try:
-        client = connect(url, proc)
-        assert {"/scene", "/referee_log", "/match"} <= set(client.channels)
-        assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
-        client.subscribe("/scene", "/referee_log", "/match")
-        robot = start_robot()
-        full, beliefs, referee_logs, last_match = 0, set(), [], None
-        for topic, _, payload in client.messages(60):
-            if topic == "/scene":
-                ids = set(scene_entities(payload))
-                if {"field", "ball", "score"} | ROBOTS <= ids:
-                    full += 1
-                beliefs |= {i.split("/")[0] for i in ids if i.startswith(("seen/", "p_ball/"))}
-            elif topic == "/referee_log":
-                entry = log_entry(payload)
-                if entry["name"] == "referee":
-                    referee_logs.append(entry["message"])
-            elif topic == "/match":
-                last_match = json.loads(payload)
-        client.close()
-        result = finish(proc, robot)
-    finally:
-        stop(proc, robot)
+    proc, url, start_robot = start_live(reap, "viewer-rt", "--realtime", "--half-time", "5", "--secure")
+    client = connect(url, proc)
+    assert {"/scene", "/referee_log", "/match"} <= set(client.channels)
+    assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
+    client.subscribe("/scene", "/referee_log", "/match")
+    robot = start_robot()
+    full, beliefs, referee_logs, last_match = 0, set(), [], None
+    for topic, _, payload in client.messages(60):
+        if topic == "/scene":
+            ids = set(scene_entities(payload))
+            if {"field", "ball", "score"} | ROBOTS <= ids:
+                full += 1
+            beliefs |= {i.split("/")[0] for i in ids if i.startswith(("seen/", "p_ball/"))}
+        elif topic == "/referee_log":
+            entry = log_entry(payload)
+            if entry["name"] == "referee":
+                referee_logs.append(entry["message"])
+        elif topic == "/match":
+            last_match = json.loads(payload)
+    client.close()
+    result = finish(proc, robot)
     assert result["realtime"] and result["ticks"] == 500
     assert full >= 40, f"only {full} complete scene updates"
     assert beliefs == {"seen", "p_ball"}, "the robots' perceived ball and the base stations' P_ball are drawn"
@@ -90,29 +94,25 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command()
     assert last_match["stage"] == "END_GAME"
 
 
-def test_pause_step_resume_over_the_protocol_keeps_the_digest():
+def test_pause_step_resume_over_the_protocol_keeps_the_digest(reap):
     reference = arena_json("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--seed", "5")
-    proc, url, start_robot = start_live("viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0")
-    robot = None
-    try:
-        client = connect(url, proc)
-        assert "parameters" in client.info["capabilities"]
-        client.subscribe("/match")
-        client.set_parameters(paused=True)
-        time.sleep(0.3)
-        robot = start_robot()  # the match starts, and holds before tick 0
-        held = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
-        assert held == [], f"the engine played while paused: {held[-3:]}"
-        client.set_parameters(step=10)  # ticks 0..9
-        stepped = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
-        assert stepped and max(stepped) == 9, stepped[-5:]
-        assert client.parameters.get("paused") is True
-        client.set_parameters(paused=False)
-        after = [json.loads(p)["tick"] for _, _, p in client.messages(60)]
-        client.close()
-        result = finish(proc, robot)
-    finally:
-        stop(proc, robot)
+    proc, url, start_robot = start_live(reap, "viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0")
+    client = connect(url, proc)
+    assert "parameters" in client.info["capabilities"]
+    client.subscribe("/match")
+    client.set_parameters(paused=True)
+    time.sleep(0.3)
+    robot = start_robot()  # the match starts, and holds before tick 0
+    held = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+    assert held == [], f"the engine played while paused: {held[-3:]}"
+    client.set_parameters(step=10)  # ticks 0..9
+    stepped = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+    assert stepped and max(stepped) == 9, stepped[-5:]
+    assert client.parameters.get("paused") is True
+    client.set_parameters(paused=False)
+    after = [json.loads(p)["tick"] for _, _, p in client.messages(60)]
+    client.close()
+    result = finish(proc, robot)
     # unpaced, the viewer shows at most SCENE_HZ frames a second, and a late world frame may be dropped
     assert after and 10 < after[-1] <= result["ticks"] == reference["ticks"]
     assert result["digest"] == reference["digest"]
