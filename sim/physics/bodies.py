@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import pymunk
 from pymunk import batch as pmbatch
+from pymunk._chipmunk_cffi import ffi, lib  # pymunk 7's own binding of Chipmunk (pyproject: pymunk <8)
 
 from arena.schemas.messages import Cmd
 
@@ -49,6 +50,47 @@ _ALL_FIELDS = (
     | pmbatch.BodyFields.ANGULAR_VELOCITY
 )
 _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
+
+# The per-substep calls straight into Chipmunk, without pymunk's Python wrappers
+# around them (its `__setattr__` hook, the batch set-up, `Space.step`'s queues):
+# the same C functions with the same arguments, so the same floats, for about a
+# third of the Python work of a substep (docs/performance.md, session 9).
+# tests/unit/test_physics.py checks them against pymunk's public API.
+step_space = lib.cpSpaceStep  # (space._space, dt): `Space.step` without its add/remove-later queues
+set_velocity = lib.cpBodySetVelocity  # (body._body, (vx, vy)): `Body.velocity = vx, vy`
+set_angular_velocity = lib.cpBodySetAngularVelocity  # (body._body, w): `Body.angular_velocity = w`
+
+
+class BodyReader:
+    """Every body's (x, y, angle, vx, vy, omega), flat, in one C call.
+
+    What `pmbatch.get_space_bodies(space, _ALL_FIELDS, buf)` then
+    `memoryview(buf.float_buf()).cast("d").tolist()` gives, with the batch
+    descriptor built once instead of on every read. `Space.step` is called
+    around it straight through `step_space`, so the space's collision
+    callbacks must not add or remove anything (ours only record, and the
+    changes they lead to are made after the step).
+    """
+
+    __slots__ = ("_space", "_buf", "_data", "_arr", "_each", "_iterate")
+
+    def __init__(self, space: pymunk.Space) -> None:
+        self._space = space._space
+        self._buf = pmbatch.Buffer()  # owns the C arrays the reads fill
+        data = ffi.new("pmBatchedData *")
+        data.fields = _ALL_FIELDS.value
+        data.floatArray = self._buf._float_arr
+        data.intArray = self._buf._int_arr
+        self._data = data
+        self._arr = self._buf._float_arr
+        self._each = lib.cpSpaceEachBody
+        self._iterate = ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")
+
+    def __call__(self) -> list[float]:
+        arr = self._arr
+        arr.num = 0
+        self._each(self._space, self._iterate, self._data)
+        return ffi.unpack(arr.arr, arr.num)  # type: ignore[no-any-return]
 
 
 @dataclass(eq=False)

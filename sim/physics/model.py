@@ -17,20 +17,20 @@ from __future__ import annotations
 
 import math
 
-from pymunk import batch as pmbatch
-
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallEvent, Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics.ball import BallFlight
 from arena.sim.physics.bodies import (
-    _ALL_FIELDS,
     CHALLENGE_DIST,
     HOLD_GAP,
     NO_CATCH_S,
     NO_CHALLENGE_S,
     PIN_TOLERANCE,
     RobotBody,
+    set_angular_velocity,
+    set_velocity,
+    step_space,
 )
 from arena.sim.physics.events import Events
 from arena.sim.physics.placement import Placement
@@ -119,13 +119,11 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
         self._events = events = []
         s = self._snap
         self._apply_commands(s)
-        space, buf, h = self._space, self._buf, self._h
+        space, read, h = self._space_c, self._read, self._h
         robots = self._robots
         for _ in range(self._substeps):
-            space.step(h)
-            buf.clear()
-            pmbatch.get_space_bodies(space, _ALL_FIELDS, buf)
-            new = memoryview(buf.float_buf()).cast("d").tolist()
+            step_space(space, h)
+            new = read()
             for r in robots:
                 o = r.off
                 r.dist += math.hypot(new[o] - s[o], new[o + 1] - s[o + 1])
@@ -154,8 +152,9 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
             else:
                 target = (0.0, 0.0, 0.0)
             if target != r.ctrl_set:
-                r.ctrl.velocity = target[0], target[1]
-                r.ctrl.angular_velocity = target[2]
+                ctrl = r.ctrl._body
+                set_velocity(ctrl, target[:2])
+                set_angular_velocity(ctrl, target[2])
                 r.ctrl_set = target
             if self._holder is r and not r.dribbler:
                 self._release()

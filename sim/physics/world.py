@@ -11,7 +11,7 @@
   GearJoint with max_force = moment * max_alpha does the same for the turn
   rate. Robots collide with each other, the ball, the goals and the fence; a
   robot pushed by another resists with its own drive force.
-* **Snapshot.** One pymunk batch read per substep gives every body's
+* **Snapshot.** One batch read per substep (`BodyReader`) gives every body's
   (x, y, angle, vx, vy, omega) in a flat list; `RobotBody.off` and
   `_ball_off` index it.
 """
@@ -23,7 +23,6 @@ from pymunk import batch as pmbatch
 
 from arena.runtime.config import TEAMS, BallParams, FieldParams, RobotParams
 from arena.sim.physics.bodies import (
-    _ALL_FIELDS,
     _BALL_TYPE,
     _CAT_BALL,
     _CAT_FENCE,
@@ -39,6 +38,7 @@ from arena.sim.physics.bodies import (
     ROBOT_FRICTION,
     SOLVER_ITERATIONS,
     WALL_FRICTION,
+    BodyReader,
     RobotBody,
 )
 
@@ -102,9 +102,11 @@ class WorldBuilding:
                     space.on_collision(_ROBOT_TYPE0 + i, _ROBOT_TYPE0 + j, begin=self._on_impact, data=(i, j))
         self._by_id = {(r.team, r.n): r for r in self._robots}
 
-        self._buf = pmbatch.Buffer()
-        pmbatch.get_space_bodies(space, pmbatch.BodyFields.BODY_ID, self._buf)
-        ids = list(memoryview(self._buf.int_buf()).cast("P"))
+        ids_buf = pmbatch.Buffer()
+        pmbatch.get_space_bodies(space, pmbatch.BodyFields.BODY_ID, ids_buf)
+        ids = list(memoryview(ids_buf.int_buf()).cast("P"))
+        self._read = BodyReader(space)
+        self._space_c = space._space
         self._ball_off = ids.index(self._ball.id) * _STRIDE
         for r in self._robots:
             r.off = ids.index(r.body.id) * _STRIDE
@@ -137,9 +139,7 @@ class WorldBuilding:
 
     def _refresh(self) -> None:
         """Re-read every body (after placements or mid-tick changes)."""
-        self._buf.clear()
-        pmbatch.get_space_bodies(self._space, _ALL_FIELDS, self._buf)
-        self._snap = memoryview(self._buf.float_buf()).cast("d").tolist()
+        self._snap = self._read()
         self._dirty = False
 
     def _fresh(self) -> list[float]:

@@ -549,6 +549,73 @@ def test_two_instances_with_the_same_commands_agree_at_every_tick():
     assert worlds[0].distance == worlds[1].distance
 
 
+def _random_play(cfg: MatchConfig, ticks: int) -> list[tuple[list[BallEvent], object]]:
+    """Events and world frame at every tick of a match of random commands (contacts, kicks, dribbles)."""
+    ph = Physics(cfg)
+    ph.kickoff_positions("a")
+    rnd = random.Random(5)
+    out = []
+    for tick in range(1, ticks + 1):
+        if tick % 4 == 1:
+            for team, n in ph.robot_ids:
+                ph.set_command(
+                    team,
+                    n,
+                    cmd(
+                        vx=rnd.uniform(-5, 5),
+                        vy=rnd.uniform(-5, 5),
+                        omega=rnd.uniform(-6, 6),
+                        dribbler=rnd.random() < 0.5,
+                        kick_speed=rnd.choice([0.0, 0.0, 6.0]),
+                        kick_lob=rnd.random() < 0.3,
+                    ),
+                )
+        out.append((ph.step(), ph.world(tick)))
+    return out
+
+
+def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
+    """`step_space`, `set_velocity`, `set_angular_velocity` and `BodyReader` (sim/physics/bodies.py) bit for bit."""
+    from pymunk import batch as pmbatch
+
+    from arena.sim.physics import bodies, model, world
+
+    cfg = CFG.replace(robots=3)
+    fast = _random_play(cfg, 600)
+
+    # The same world again, every direct call replaced by pymunk's public API.
+    spaces, ctrls = {}, {}  # C pointer -> pymunk object
+    real_build = world.WorldBuilding._build_world
+
+    def build(self, *args):
+        real_build(self, *args)
+        spaces[self._space._space] = self._space
+        ctrls.update((r.ctrl._body, r.ctrl) for r in self._robots)
+
+    def read(space_c):
+        buf = pmbatch.Buffer()
+
+        def snapshot() -> list[float]:
+            buf.clear()
+            pmbatch.get_space_bodies(spaces[space_c], bodies._ALL_FIELDS, buf)
+            return memoryview(buf.float_buf()).cast("d").tolist()
+
+        return snapshot
+
+    monkeypatch.setattr(world.WorldBuilding, "_build_world", build)
+    monkeypatch.setattr(world, "BodyReader", lambda space: read(space._space))
+    monkeypatch.setattr(model, "step_space", lambda space_c, h: spaces[space_c].step(h))
+    monkeypatch.setattr(model, "set_velocity", lambda body_c, v: setattr(ctrls[body_c], "velocity", v))
+    monkeypatch.setattr(model, "set_angular_velocity", lambda body_c, w: setattr(ctrls[body_c], "angular_velocity", w))
+    public = _random_play(cfg, 600)
+
+    assert spaces and ctrls, "the public API was not used"
+    assert sum(len(events) for events, _ in fast) > 0, "nothing happened to the ball"
+    assert len({(w.ball_x, w.ball_y) for _, w in fast}) > 100, "the ball hardly moved"
+    for tick, (a, b) in enumerate(zip(fast, public, strict=True), start=1):
+        assert a == b, f"tick {tick} differs"
+
+
 def test_world_message_is_ground_truth():
     ph = make()
     ph.place_robot("b", 0, 1.0, 2.0, 3.0)
