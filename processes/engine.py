@@ -55,7 +55,7 @@ from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefC
 from arena.schemas.vocabulary import SEND_OFF
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics, StuckWatch
-from arena.sim.sensors import NormalStream, sense
+from arena.sim.sensors import NormalStream, sense_every
 
 
 def check_cmd(cmd: Cmd, wheels: int) -> str | None:
@@ -166,6 +166,7 @@ class EngineNode(Node):
         self.cmd_in = {(team, n): self.inp("cmd", team, n, check=self.check_cmd) for team, n in self.robots}
         self.ref_in = self.inp("referee", check=check_referee)
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
+        self.sense_plan = [(r, self.sensor_rng[r]) for r in self.sense_out]
         for ob in self.sense_out.values():  # L ticks of senses per message (runtime/config.py `frames_per_message`)
             ob.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
         self.world_out = self.out("world", viewers_only=True)
@@ -244,9 +245,8 @@ class EngineNode(Node):
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor
-        states = ph.robot_states()
-        for r, out in self.sense_out.items():
-            out.send(sense(ph, r[0], r[1], k, self.sensor_rng[r], sp, states))
+        for out, z in zip(self.sense_out.values(), sense_every(ph, k, self.sense_plan, sp)):
+            out.send(z)
         if self.world_schedule.due(k):
             self.world_out.send(ph.world(k))
         if self.events_schedule.due(k):

@@ -75,19 +75,45 @@ def sense(
 ) -> Sense:
     """What robot (team, n) senses at `tick`; see the module docstring.
 
-    `states` is `physics.robot_states()`; pass it when sensing for every robot
-    of a tick, so that the snapshot is read once.
+    `states` is `physics.robot_states()`; pass it when sensing for several
+    robots of a tick, so that the snapshot is read once (`sense_every` reads
+    the ball and the holder once too).
     """
     if states is None:
         states = physics.robot_states()
-    n_z = 3 + 2 * len(states)
-    z = rng.take(n_z) if isinstance(rng, NormalStream) else rng.standard_normal(n_z).tolist()
     for me in states:
         if me[1] == n and me[0] == team:
             break
     else:
         raise ValueError(f"no robot {team}/{n} in the states")
-    _, _, x, y, theta, vx, vy, omega = me
+    return _sense(me, states, _normals(rng, 3 + 2 * len(states)), physics.ball_state(), physics.holder(), tick, p)
+
+
+def sense_every(
+    physics: Physics, tick: int, robots: list[tuple[tuple[str, int], NormalStream]], p: SensorParams
+) -> list[Sense]:
+    """`sense()` of each (robot, its noise stream) of `robots`, in that order, the world read once."""
+    states = physics.robot_states()
+    index = {(st[0], st[1]): st for st in states}
+    ball, holder, n_z = physics.ball_state(), physics.holder(), 3 + 2 * len(states)
+    return [_sense(index[r], states, rng.take(n_z), ball, holder, tick, p) for r, rng in robots]
+
+
+def _normals(rng: np.random.Generator | NormalStream, n: int) -> list[float]:
+    return rng.take(n) if isinstance(rng, NormalStream) else rng.standard_normal(n).tolist()
+
+
+def _sense(
+    me: tuple[str, int, float, float, float, float, float, float],
+    states: RobotStates,
+    z: list[float],
+    ball_state: tuple[float, ...],
+    holder: tuple[str, int] | None,
+    tick: int,
+    p: SensorParams,
+) -> Sense:
+    """Robot `me` (one of `states`) at `tick`, with its normals `z` (3 + 2 per robot of `states`)."""
+    team, n, x, y, theta, vx, vy, omega = me
     c, s = math.cos(theta), math.sin(theta)
     pose = Pose(
         x=x + p.pose_sigma * z[0],
@@ -95,7 +121,7 @@ def sense(
         theta=wrap_angle(theta + p.heading_sigma * z[2]),
     )
     hypot, det, per_m = math.hypot, p.det_sigma, p.det_sigma_per_m
-    bx, by = physics.ball_state()[:2]
+    bx, by = ball_state[0], ball_state[1]
     d_ball = hypot(bx - x, by - y)
     if d_ball <= p.ball_range:
         sigma = det + per_m * d_ball
@@ -124,5 +150,5 @@ def sense(
         omega=omega,
         ball=ball,
         robots=[RobotSeen(team=t, x=nx, y=ny) for _, t, nx, ny in near],
-        has_ball=physics.holder() == (team, n),
+        has_ball=holder is not None and holder[1] == n and holder[0] == team,
     )

@@ -150,3 +150,23 @@ def test_sense_is_the_same_with_a_normal_stream():
     stream, gen = NormalStream(np.random.default_rng(9)), np.random.default_rng(9)
     for k in range(50):
         assert sense(ph, "a", 0, k, stream, P) == sense(ph, "a", 0, k, gen, P)
+
+
+def test_sense_every_is_sense_for_each_robot_in_the_order_given():
+    """The engine's per-tick call (the world read once) gives what `sense` gives robot by robot."""
+    from arena.sim.sensors import NormalStream, sense_every
+
+    ph = Physics(CFG.replace(robots=3))
+    ph.kickoff_positions("b")
+    ids = ph.robot_ids[::-1]  # not the physics' own order
+    streams = {r: NormalStream(np.random.default_rng(i)) for i, r in enumerate(ids)}
+    gens = {r: np.random.default_rng(i) for i, r in enumerate(ids)}
+    rnd = random.Random(4)
+    for k in range(200):
+        if k % 10 == 0:
+            for team, n in ids:
+                ph.set_command(team, n, Cmd(tick=k, vx=rnd.uniform(-3, 3), vy=rnd.uniform(-3, 3), dribbler=True))
+        ph.step()
+        got = sense_every(ph, k, [(r, streams[r]) for r in ids], P)
+        assert got == [sense(ph, team, n, k, gens[(team, n)], P) for team, n in ids]
+    assert any(z.has_ball for z in got) or any(z.ball.visible for z in got)
