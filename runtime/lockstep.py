@@ -596,15 +596,21 @@ class Inbound(Generic[M]):
         Jitter can reorder frames, as on a real network; `latest` is the newest
         by send tick, so a late old frame never replaces fresher news.
         """
-        out: list[M] = []
         pending = self._pending
+        if not pending or pending[0][0] > k:
+            return []  # nothing due: the usual case for most links at most ticks
+        out: list[M] = []
         while pending and pending[0][0] <= k:
             out.append(heapq.heappop(pending)[2])
+        latest = self.latest
         for msg in out:
-            if self.latest is None or msg.tick > self.latest.tick:
-                self.latest = msg
+            if latest is None or msg.tick > latest.tick:
+                latest = msg
+        self.latest = latest
         return out
 
     def latest_by(self, k: int) -> M | None:
-        self.take(k)
+        pending = self._pending
+        if pending and pending[0][0] <= k:
+            self.take(k)
         return self.latest
