@@ -158,6 +158,9 @@ class TeamModel:
 
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
     """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
+    if not seen:  # nothing to explain them away: all of them
+        out.extend(entries)
+        return
     for xy in entries:
         x, y = xy
         for a, b in seen:
@@ -192,12 +195,15 @@ class RobotView:
         self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
         self._order_opponents: list[tuple[int, Vec]] = []  # (age, position) of the order's P_B entries
+        self._order_opponent_xy: list[Vec] = []  # their positions ...
+        self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
+        own_ball = self.own_ball
         if sense is not None:
             p = sense.pose
             theta = p.theta
@@ -209,17 +215,17 @@ class RobotView:
             self.has_ball = sense.has_ball
             b = sense.ball
             if b.visible:
-                self.own_ball.observe(tick, b.x, b.y)
+                own_ball.observe(tick, b.x, b.y)
         elif order is not None and self.pose is None:
             for tp in order.own:
                 if tp.robot == self.n:
                     self.pose = (tp.x, tp.y, tp.theta)
-        track = self.own_ball.track
+        track = own_ball.track
         own_age = tick - track.tick if track is not None else 1 << 30
         order_ball = order is not None and order.ball_valid
         order_age = order.ball_age + (tick - order.tick) if order_ball else 1 << 30  # type: ignore[union-attr]
         if own_age <= order_age and track is not None:
-            ball, self.ball_vel, age = (track.x, track.y), self.own_ball.vel, own_age
+            ball, self.ball_vel, age = (track.x, track.y), own_ball.vel, own_age
         elif order_ball:
             ball, self.ball_vel, age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age  # type: ignore[union-attr]
         else:
@@ -235,6 +241,8 @@ class RobotView:
             else:
                 self.mates = {}
                 self._order_opponents = []
+            self._order_opponent_xy = [xy for _, xy in self._order_opponents]
+            self._order_opponent_oldest = max((age for age, _ in self._order_opponents), default=0)
             self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
         seen: list[Vec] = []  # own detections: opponents ...
         near: list[Vec] = []  # ... and teammates
@@ -247,7 +255,11 @@ class RobotView:
         opponents = seen[:]
         if order is not None:
             memory = self._opponent_memory - (tick - order.tick)
-            _add_unexplained(opponents, [xy for age, xy in self._order_opponents if age <= memory], seen, merge2)
+            if self._order_opponent_oldest <= memory:  # none too old (the usual case): all of them
+                entries = self._order_opponent_xy
+            else:
+                entries = [xy for age, xy in self._order_opponents if age <= memory]
+            _add_unexplained(opponents, entries, seen, merge2)
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
