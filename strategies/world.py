@@ -183,7 +183,8 @@ class RobotView:
         self.dt = dt
         self.own_ball = BallFilter(p, dt)
         self.pose: tuple[float, float, float] | None = None
-        self.vel: Vec = (0.0, 0.0)  # [m/s] field frame
+        self._vel: Vec | None = (0.0, 0.0)  # see `vel`
+        self._moving: Sense | None = None  # the latest sense, whose velocity `vel` turns into the field frame
         self.omega = 0.0  # [rad/s] odometry
         self.ball: Vec | None = None
         self.ball_vel: Vec = (0.0, 0.0)
@@ -206,11 +207,8 @@ class RobotView:
         own_ball = self.own_ball
         if sense is not None:
             p = sense.pose
-            theta = p.theta
-            self.pose = (p.x, p.y, theta)
-            c, s = math.cos(theta), math.sin(theta)
-            svx, svy = sense.vx, sense.vy
-            self.vel = (c * svx - s * svy, s * svx + c * svy)
+            self.pose = (p.x, p.y, p.theta)
+            self._moving, self._vel = sense, None  # turned into the field frame when asked for (`vel`)
             self.omega = sense.omega
             self.has_ball = sense.has_ball
             b = sense.ball
@@ -263,6 +261,18 @@ class RobotView:
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
+
+    @property
+    def vel(self) -> Vec:
+        """[m/s] The robot's velocity in the field frame (odometry, sensed in the body frame)."""
+        vel = self._vel
+        if vel is None:  # worked out only when asked for: only the navigator needs it
+            sense = self._moving
+            theta = sense.pose.theta  # type: ignore[union-attr]
+            c, s = math.cos(theta), math.sin(theta)
+            svx, svy = sense.vx, sense.vy  # type: ignore[union-attr]
+            vel = self._vel = (c * svx - s * svy, s * svx + c * svy)
+        return vel
 
     @property
     def mate_obstacles(self) -> list[Vec]:
