@@ -119,19 +119,23 @@ class TeamModel:
         balls: list[tuple[float, float, float]] = []
         seen: list[tuple[float, float, float]] = []
         newest = -1
+        own, other, hypot = self.own, self.other, math.hypot
+        sigma, sigma_per_m = self.sensor.det_sigma, self.sensor.det_sigma_per_m  # detection_sigma, inlined
         for n in sorted(reports):
             rep = reports[n]
-            px, py = rep.pose.x, rep.pose.y
-            if n not in self.own or rep.tick >= self.own[n][3]:
-                self.own[n] = (px, py, rep.pose.theta, rep.tick)
+            pose = rep.pose
+            px, py = pose.x, pose.y
+            if n not in own or rep.tick >= own[n][3]:
+                own[n] = (px, py, pose.theta, rep.tick)
                 self.has_ball[n] = rep.has_ball
-            if rep.ball.visible:
-                s = detection_sigma(self.sensor, math.hypot(rep.ball.x - px, rep.ball.y - py))
-                balls.append((rep.ball.x, rep.ball.y, 1.0 / (s * s)))
+            b = rep.ball
+            if b.visible:
+                s = sigma + sigma_per_m * hypot(b.x - px, b.y - py)
+                balls.append((b.x, b.y, 1.0 / (s * s)))
                 newest = max(newest, rep.tick)
             for r in rep.robots:
-                if r.team == self.other:
-                    s = detection_sigma(self.sensor, math.hypot(r.x - px, r.y - py))
+                if r.team == other:
+                    s = sigma + sigma_per_m * hypot(r.x - px, r.y - py)
                     seen.append((r.x, r.y, 1.0 / (s * s)))
         if balls:
             bx, by, _ = cluster(balls, math.inf)[0]

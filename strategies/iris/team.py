@@ -17,7 +17,6 @@ import math
 from arena.schemas.messages import Order, Referee, Report, TeamPose
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import roles as R
-from arena.strategies import skills as S
 from arena.strategies.base import TeamContext
 from arena.strategies.iris.params import PLAY, IrisParams
 from arena.strategies.world import TeamModel
@@ -41,8 +40,9 @@ class IrisTeam:
         ball = self.model.ball_xy(tick)
         if ball is None:
             return "", None
-        opp = min((S.dist(o.xy, ball) for o in self.model.opponents), default=math.inf)
-        own = min((S.dist((x, y), ball) for x, y, _, _ in self.model.own.values()), default=math.inf)
+        bx, by = ball
+        opp = min((math.hypot(o.x - bx, o.y - by) for o in self.model.opponents), default=math.inf)  # S.dist
+        own = min((math.hypot(x - bx, y - by) for x, y, _, _ in self.model.own.values()), default=math.inf)
         if opp < self.p.possession_radius and opp < own:
             return "opponent", None
         return "", None
@@ -66,20 +66,18 @@ class IrisTeam:
         ]
         opponents = [TeamPose(robot=-1, x=o.x, y=o.y, age=tick - o.tick) for o in self.model.opponents]
         ball = self.model.ball_xy(tick)
-        ball_age = self.model.ball.age(tick) if ball is not None else 0
+        common = dict(  # the fields every robot's order shares
+            tick=tick,
+            **c,
+            own=own_poses,
+            opponents=opponents,
+            ball_valid=ball is not None,
+            ball_x=ball[0] if ball is not None else 0.0,
+            ball_y=ball[1] if ball is not None else 0.0,
+            ball_age=self.model.ball.age(tick) if ball is not None else 0,
+        )
+        state = self.roles.state
         return {
-            n: Order(
-                tick=tick,
-                robot=n,
-                **c,
-                role=role_of.get(n, "defender"),
-                role_state=self.roles.state.get(n, 0),
-                own=own_poses,
-                opponents=opponents,
-                ball_valid=ball is not None,
-                ball_x=ball[0] if ball is not None else 0.0,
-                ball_y=ball[1] if ball is not None else 0.0,
-                ball_age=ball_age,
-            )
+            n: Order(robot=n, role=role_of.get(n, "defender"), role_state=state.get(n, 0), **common)
             for n in range(self.cfg.robots)
         }
