@@ -69,15 +69,18 @@ class BallFilter:
         self.dt = dt
         self.track: Track | None = None
         self.vel: Vec = (0.0, 0.0)
+        self._max_speed = p.max_ball_speed  # [m/s]
+        self._w, self._keep = p.vel_smoothing, 1 - p.vel_smoothing  # weights of the newest sample and the rest
 
     def observe(self, tick: int, x: float, y: float) -> None:
         t = self.track
         if t is not None and tick > t.tick:
-            span = (tick - t.tick) * self.dt
+            gap = tick - t.tick  # [ticks]
+            span = gap * self.dt
             vx, vy = (x - t.x) / span, (y - t.y) / span
-            if math.hypot(vx, vy) <= self.p.max_ball_speed and tick - t.tick <= 10:
-                w = self.p.vel_smoothing
-                self.vel = (w * vx + (1 - w) * self.vel[0], w * vy + (1 - w) * self.vel[1])
+            if math.hypot(vx, vy) <= self._max_speed and gap <= 10:
+                w, keep, vel = self._w, self._keep, self.vel
+                self.vel = (w * vx + keep * vel[0], w * vy + keep * vel[1])
             else:
                 self.vel = (0.0, 0.0)
         self.track = Track(x, y, tick)
