@@ -81,12 +81,12 @@ def sense(
     """
     if states is None:
         states = physics.robot_states()
-    for me in states:
-        if me[1] == n and me[0] == team:
-            break
-    else:
+    me = next((st for st in states if st[1] == n and st[0] == team), None)
+    if me is None:
         raise ValueError(f"no robot {team}/{n} in the states")
-    return _sense(me, states, _normals(rng, 3 + 2 * len(states)), physics.ball_state(), physics.holder(), tick, p)
+    n_z = 3 + 2 * len(states)
+    z = rng.take(n_z) if isinstance(rng, NormalStream) else rng.standard_normal(n_z).tolist()
+    return _sense(me, states, z, physics.ball_state(), physics.holder(), tick, p)
 
 
 def sense_every(
@@ -97,10 +97,6 @@ def sense_every(
     index = {(st[0], st[1]): st for st in states}
     ball, holder, n_z = physics.ball_state(), physics.holder(), 3 + 2 * len(states)
     return [_sense(index[r], states, rng.take(n_z), ball, holder, tick, p) for r, rng in robots]
-
-
-def _normals(rng: np.random.Generator | NormalStream, n: int) -> list[float]:
-    return rng.take(n) if isinstance(rng, NormalStream) else rng.standard_normal(n).tolist()
 
 
 def _sense(
