@@ -34,3 +34,32 @@ def test_bench_throughput_reports_both_start_ups_with_their_definitions():
     assert s["launch_to_first_tick_s"] == 0.6 and s["play_match_to_first_tick_s"] == 0.25
     assert s["launch"] == ["fork"]
     assert set(throughput.LAUNCH_DEFINITIONS) == {"command", "play_match"}
+
+
+def test_a_ctrl_c_inside_the_starters_close_does_not_make_the_next_close_fail(monkeypatch):
+    """The launcher closes its Starter in `finally`; a Ctrl-C that interrupted an earlier close
+    must still end as a KeyboardInterrupt (exit 130), not as EBADF from closing an fd twice (exit 2)."""
+    import os
+
+    import pytest
+
+    from arena.tools import forkstart
+
+    starter = forkstart.Starter.__new__(forkstart.Starter)
+    starter._go_r, starter._go_w = fds = os.pipe()
+    starter._count, starter._frozen, starter._zygote, starter._parked = 0, False, None, []
+    real_close, calls = os.close, []
+
+    def close_then_interrupt(fd: int) -> None:
+        real_close(fd)
+        calls.append(fd)
+        if len(calls) == 1:
+            raise KeyboardInterrupt  # SIGINT between the two closes
+
+    monkeypatch.setattr(forkstart.os, "close", close_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        starter.close()
+    starter.close()  # what the launcher's `finally` does: no EBADF
+    monkeypatch.setattr(forkstart.os, "close", real_close)
+    assert calls == [fds[0]]
+    real_close(fds[1])  # the one the interrupted close left open (the launcher then exits)
