@@ -122,8 +122,7 @@ class TeamModel:
         balls: list[tuple[float, float, float]] = []
         seen: list[tuple[float, float, float]] = []
         newest = -1
-        own, other, hypot = self.own, self.other, math.hypot
-        sigma, sigma_per_m = self.sensor.det_sigma, self.sensor.det_sigma_per_m  # detection_sigma, inlined
+        own, other, hypot, sensor = self.own, self.other, math.hypot, self.sensor
         for n in sorted(reports):
             rep = reports[n]
             pose = rep.pose
@@ -133,12 +132,12 @@ class TeamModel:
                 self.has_ball[n] = rep.has_ball
             b = rep.ball
             if b.visible:
-                s = sigma + sigma_per_m * hypot(b.x - px, b.y - py)
+                s = detection_sigma(sensor, hypot(b.x - px, b.y - py))
                 balls.append((b.x, b.y, 1.0 / (s * s)))
                 newest = max(newest, rep.tick)
             for r in rep.robots:
                 if r.team == other:
-                    s = sigma + sigma_per_m * hypot(r.x - px, r.y - py)
+                    s = detection_sigma(sensor, hypot(r.x - px, r.y - py))
                     seen.append((r.x, r.y, 1.0 / (s * s)))
         if balls:
             bx, by, _ = cluster(balls, math.inf)[0]
