@@ -88,3 +88,16 @@ def test_robot_view_merges_the_order_with_own_detections():
     assert view.opponents == [(1.1, 0.1), (3.0, -2.0)]  # (1, 0) is the own detection; (4, 2) is too old
     assert view.mate_obstacles == [(2.1, 1.0), (-5.5, 0.0)]  # (2, 1) is the own detection
     assert view.others() == view.opponents + view.mate_obstacles
+
+
+def test_segment_room_is_the_least_segment_distance_bit_for_bit():
+    """`best_aim`'s `segment_room` gives what `min(segment_distance(...)[0] ...)` gives."""
+    from arena.strategies.skills import segment_distance, segment_room
+
+    rng = random.Random(11)
+    for _ in range(20000):
+        a = (rng.uniform(-6, 6), rng.uniform(-4, 4))
+        b = a if rng.random() < 0.05 else (rng.uniform(-6, 6), rng.uniform(-4, 4))  # a point-like segment too
+        points = [(rng.uniform(-7, 7), rng.uniform(-5, 5)) for _ in range(rng.randrange(0, 7))]
+        expected = min((segment_distance(q, a, b)[0] for q in points), default=math.inf)
+        assert segment_room(points, a, b) == expected
