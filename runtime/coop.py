@@ -97,11 +97,12 @@ class CoopTransport(MemoryTransport):
 class Task:
     """One node's lockstep loop as the driver sees it."""
 
-    __slots__ = ("name", "steps", "waiting", "done", "busy_s", "resumes")
+    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "resumes")
 
-    def __init__(self, name: str, steps: Waits):
+    def __init__(self, name: str, steps: Waits, flush: Callable[[], None] | None = None):
         self.name = name
         self.steps = steps
+        self.flush = flush  # called as the task parks (`Node.batch_flusher`)
         self.waiting: tuple[Inbound[Any], int] | None = None
         self.done = False
         self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
@@ -130,6 +131,8 @@ def _advance(task: Task) -> None:
                 if not ib.ready(k):
                     task.waiting = w
                     ch.waiter = task  # type: ignore[union-attr]
+                    if task.flush is not None:
+                        task.flush()
                     return
         try:
             w = next(steps)

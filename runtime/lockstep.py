@@ -196,7 +196,12 @@ class Outbound(Generic[M]):
     `batch(n, last)`: put the frames of ticks k..k+n-1 (k a multiple of n) as one
     message, a msgpack array of the frames' bytes (schemas/README.md, "Batches"),
     and whatever is left at tick `last`. A transport detail: the frames, their
-    digest and their order are the same whatever n is.
+    digest and their order are the same whatever n is. A driver `flush`es a
+    node's batches whenever the node is about to wait (`Node.flush_batches`):
+    a frame held back while its sender waits could be what, through other
+    links, the sender waits for, a deadlock (L = 16 with 8 frames a message
+    did: the engine waited for a robot's `cmd` of tick 1, the robot for an
+    `order` of tick 7).
     """
 
     __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last")
@@ -218,8 +223,12 @@ class Outbound(Generic[M]):
         self._size = size
         self._last = last
 
+    @property
+    def batching(self) -> bool:
+        return self._buf is not None
+
     def flush(self) -> None:
-        """Put what the batch holds now (the end of a loop that stopped early)."""
+        """Put what the batch holds now (before a wait, or at the end of a loop that stopped early)."""
         buf = self._buf
         if buf:
             self._put(self._encode(buf))
@@ -264,9 +273,12 @@ class Outbound(Generic[M]):
 Waits = Generator[tuple["Inbound[Any]", int], None, None]
 
 
-def pull(steps: Waits) -> None:
-    """Drive a lockstep loop from this thread, blocking in each link's `sync`."""
+def pull(steps: Waits, before_wait: Callable[[], None] | None = None) -> None:
+    """Drive a lockstep loop from this thread, blocking in each link's `sync`;
+    `before_wait()` first where the link is not ready (`Outbound.flush`)."""
     for ib, k in steps:
+        if before_wait is not None and not ib.ready(k):
+            before_wait()
         ib.sync(k)
 
 
@@ -305,6 +317,7 @@ class Reactor:
         self._waiting: tuple[Inbound[Any], int] | None = None
         self._since = 0.0
         self.error: BaseException | None = None
+        self.before_wait: Callable[[], None] | None = None  # called as the loop starts to wait (`Outbound.flush`)
 
     def on_frame(self, ib: Inbound[Any], raw: bytes) -> None:
         with self.lock:
@@ -330,6 +343,8 @@ class Reactor:
                             ib._give_up("its liveliness token vanished")
                             continue
                         ib.woken = False
+                        if self.before_wait is not None:
+                            self.before_wait()
                         return
                 self._waiting = next(self._steps)  # type: ignore[arg-type]
                 self._since = time.monotonic()  # the start of this wait (failure detection only)

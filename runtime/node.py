@@ -302,11 +302,25 @@ class Node:
     def loop_realtime(self) -> None:
         raise NotImplementedError
 
+    def batch_flusher(self) -> Callable[[], None] | None:
+        """What a driver calls before this node waits: put its held-back batches
+        (`Outbound.batch`); None if it batches nothing."""
+        batched = tuple(o for o in self.outbound if o.batching)
+        if not batched:
+            return None
+
+        def flush() -> None:
+            for o in batched:
+                o.flush()
+
+        return flush
+
     def drive(self, steps: Waits) -> None:
         if self.reactor is not None:
+            self.reactor.before_wait = self.batch_flusher()
             self.reactor.run(steps)
         else:
-            pull(steps)
+            pull(steps, self.batch_flusher())
 
     def summary_extra(self) -> dict[str, object]:
         return {}

@@ -54,7 +54,7 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     settle_heap()
     started = time.time()
     t0 = time.perf_counter()
-    tasks = [Task(name, node.lockstep()) for name, node in nodes.items()]
+    tasks = [Task(name, node.lockstep(), node.batch_flusher()) for name, node in nodes.items()]
     quit_early: set[str] = set()
     try:
         deadlocks = drive(bus, tasks, on_idle=recorder.pump if recorder is not None else None, quit_early=quit_early)

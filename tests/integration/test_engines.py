@@ -56,10 +56,15 @@ def test_inprocess_refuses_what_needs_processes_in_one_line(flag, value):
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
 
 
-def test_a_batched_distributed_match_has_the_digests_of_one_frame_per_message():
-    """Three ticks of sense/cmd frames per zenoh message, against one per message in one process."""
-    base = ("match", "--home", "AD", "--away", "BS", "--half-time", "2", "--seed", "3", "--perception-latency", "3")
-    batched = arena_json(*base)  # --engine processes, --batch 0: 3 frames per message
+@pytest.mark.parametrize("latency", [3, 16])
+def test_a_batched_distributed_match_has_the_digests_of_one_frame_per_message(latency):
+    """L ticks of sense/cmd frames per zenoh message, against one per message in one process.
+
+    16: more than the referee's and the base stations' slack, which deadlocked until
+    a process put its held-back batch whenever it was about to wait."""
+    base = ("match", "--home", "AD", "--away", "BS", "--half-time", "2", "--seed", "3")
+    base = (*base, "--perception-latency", str(latency))
+    batched = arena_json(*base)  # --engine processes, --batch 0: L frames per message
     single = arena_json(*base, "--engine", "inprocess", "--batch", "1")
     assert batched["outcome"] == "completed" and batched["rejected"] == 0
     assert batched["process_digests"] == single["process_digests"]

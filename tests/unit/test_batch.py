@@ -99,8 +99,11 @@ def _digests(latency: int, batch: int) -> dict[str, str]:
     return {name: s.digest for name, s in summaries.items()}
 
 
-@pytest.mark.parametrize("latency", [2, 3])
+@pytest.mark.parametrize("latency", [2, 3, 16])
 def test_the_batch_size_is_a_transport_detail_and_the_latency_is_the_model(latency):
+    # 16: a batch of 16 cmd frames held a robot's cmd of tick 1 back while the robot waited for
+    # an order of tick 7, which waited (referee, engine events) for the engine to pass tick 1:
+    # a deadlock, until a node's batches were put whenever it is about to wait.
     ones = _digests(latency, 1)
     assert _digests(latency, latency) == ones
     assert _digests(0, 1)["engine"] != ones["engine"]  # another latency: robots decide otherwise
