@@ -169,6 +169,8 @@ class EngineNode(Node):
         self.sense_plan = [(r, self.sensor_rng[r]) for r in self.sense_out]
         for ob in self.sense_out.values():  # L ticks of senses per message (runtime/config.py `frames_per_message`)
             ob.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
+        for ib in self.cmd_in.values():
+            ib.paired = True  # the robots batch their cmds on the same grid (runtime/lockstep.py `Outbound`)
         self.world_out = self.out("world", viewers_only=True)
         self.events_out = self.out("events")
         self.field_out = self.out("field")

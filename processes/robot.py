@@ -28,6 +28,7 @@ class RobotNode(Node):
         self.order_in = self.inp("order", team, n)
         self.cmd_out = self.out("cmd", team, n)
         self.cmd_out.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
+        self.sense_in.paired = True  # the engine batches senses on the same grid (runtime/lockstep.py `Outbound`)
         self.report_out = self.out("report", team, n)
         strategy = registry.get(cfg.strategy_of(team))
         self.brain = strategy.make_robot(RobotContext(cfg=cfg, team=team, n=n, rng=self.rng("strategy")))

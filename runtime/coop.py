@@ -102,7 +102,7 @@ class Task:
     def __init__(self, name: str, steps: Waits, flush: Callable[[], None] | None = None):
         self.name = name
         self.steps = steps
-        self.flush = flush  # called as the task parks (`Node.batch_flusher`)
+        self.flush = flush  # called as the task parks on a link not `paired` (`Node.batch_flusher`)
         self.waiting: tuple[Inbound[Any], int] | None = None
         self.done = False
         self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
@@ -131,7 +131,7 @@ def _advance(task: Task) -> None:
                 if not ib.ready(k):
                     task.waiting = w
                     ch.waiter = task  # type: ignore[union-attr]
-                    if task.flush is not None:
+                    if task.flush is not None and not ib.paired:
                         task.flush()
                     return
         try:

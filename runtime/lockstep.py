@@ -197,11 +197,15 @@ class Outbound(Generic[M]):
     message, a msgpack array of the frames' bytes (schemas/README.md, "Batches"),
     and whatever is left at tick `last`. A transport detail: the frames, their
     digest and their order are the same whatever n is. A driver `flush`es a
-    node's batches whenever the node is about to wait (`Node.flush_batches`):
-    a frame held back while its sender waits could be what, through other
-    links, the sender waits for, a deadlock (L = 16 with 8 frames a message
-    did: the engine waited for a robot's `cmd` of tick 1, the robot for an
-    `order` of tick 7).
+    node's batches whenever the node is about to wait on a link that is not
+    `paired` (`Node.batch_flusher`): a frame held back while its sender waits
+    could be what, through other links, the sender waits for, a deadlock (L =
+    16 with 16 frames a message did: the engine waited for a robot's `cmd` of
+    tick 1, the robot for an `order` of tick 7). A `paired` link is the other
+    half of the same aligned grid (the engine's `cmd` from a robot, a robot's
+    `sense`): with n <= L, nothing held on one half is due on the other
+    (runtime/config.py `frames_per_message`), and flushing there too cost
+    ~5 % of a batched distributed match (docs/performance.md, session 10).
     """
 
     __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last")
@@ -275,9 +279,9 @@ Waits = Generator[tuple["Inbound[Any]", int], None, None]
 
 def pull(steps: Waits, before_wait: Callable[[], None] | None = None) -> None:
     """Drive a lockstep loop from this thread, blocking in each link's `sync`;
-    `before_wait()` first where the link is not ready (`Outbound.flush`)."""
+    `before_wait()` first where the link is not ready nor `paired` (`Outbound.flush`)."""
     for ib, k in steps:
-        if before_wait is not None and not ib.ready(k):
+        if before_wait is not None and not ib.paired and not ib.ready(k):
             before_wait()
         ib.sync(k)
 
@@ -343,7 +347,7 @@ class Reactor:
                             ib._give_up("its liveliness token vanished")
                             continue
                         ib.woken = False
-                        if self.before_wait is not None:
+                        if self.before_wait is not None and not ib.paired:
                             self.before_wait()
                         return
                 self._waiting = next(self._steps)  # type: ignore[arg-type]
@@ -437,6 +441,7 @@ class Inbound(Generic[M]):
         self._on_dead = on_dead
         self._check = check
         self.strict = True  # lockstep; False in real-time mode
+        self.paired = False  # its sender batches on our batches' grid: no flush before waiting on it (`Outbound`)
         self.last_seen = -1  # tick of the last accepted frame
         self.dead = False
         self.woken = False  # reactive mode: a WAKE came (a peer's token vanished)

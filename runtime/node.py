@@ -303,8 +303,8 @@ class Node:
         raise NotImplementedError
 
     def batch_flusher(self) -> Callable[[], None] | None:
-        """What a driver calls before this node waits: put its held-back batches
-        (`Outbound.batch`); None if it batches nothing."""
+        """What a driver calls before this node waits on a link not `paired`: put its
+        held-back batches (`Outbound.batch`); None if it batches nothing."""
         batched = tuple(o for o in self.outbound if o.batching)
         if not batched:
             return None

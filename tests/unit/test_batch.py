@@ -107,3 +107,16 @@ def test_the_batch_size_is_a_transport_detail_and_the_latency_is_the_model(laten
     ones = _digests(latency, 1)
     assert _digests(latency, latency) == ones
     assert _digests(0, 1)["engine"] != ones["engine"]  # another latency: robots decide otherwise
+
+
+@pytest.mark.parametrize("latency", [6, 7, 12, 25])
+@pytest.mark.parametrize(("comm", "referee"), [(5, 5), (1, 1), (10, 3)])
+def test_no_latency_batch_or_period_deadlocks(latency, comm, referee):
+    """The old aligned batches deadlocked from L = 6 on (196 of 376 such settings)."""
+    timing = dataclasses.replace(
+        MatchConfig().timing, perception_latency=latency, comm_period=comm, referee_period=referee
+    )
+    cfg = MatchConfig(home="AD", away="BS", half_time=1.0, seed=latency, timing=timing)
+    summaries, _ = play_in_process(cfg, watch=())
+    assert summaries["engine"].tick == cfg.total_ticks
+    assert not any(s.dead for s in summaries.values())
