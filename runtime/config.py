@@ -180,8 +180,9 @@ class TimingParams:
         At most L: the engine's batch for ticks k..k+n-1 needs the commands of up to
         k+n-2, which the robots send once they have the senses of up to k+n-2-L; with
         n <= L those came in an earlier batch. A node's batch is also put early, as it
-        is, whenever the node is about to wait (`Outbound.flush`): through the referee
-        and the base stations a robot's `cmd` can wait on the engine's progress too.
+        is, whenever the node is about to wait on any other link (`Outbound`): through
+        the referee and the base stations a robot's `cmd` can wait on the engine's
+        progress too.
         """
         if realtime:
             return 1

@@ -321,7 +321,7 @@ class Reactor:
         self._waiting: tuple[Inbound[Any], int] | None = None
         self._since = 0.0
         self.error: BaseException | None = None
-        self.before_wait: Callable[[], None] | None = None  # called as the loop starts to wait (`Outbound.flush`)
+        self.before_wait: Callable[[], None] | None = None  # called as the loop starts to wait on a link not `paired`
 
     def on_frame(self, ib: Inbound[Any], raw: bytes) -> None:
         with self.lock:
