@@ -83,10 +83,11 @@ class WireGate:
 
 
 class Pacer:
-    """Duck-types a lockstep `Inbound` (`ready`, `sync`, `woken`, `sender`, `_give_up`)."""
+    """Duck-types a lockstep `Inbound` (`ready`, `sync`, `woken`, `paired`, `sender`, `_give_up`)."""
 
     sender = "viewer"
     key = "control"
+    paired = False  # a held tick is a wait like any other: the engine puts its held `sense` batches first
 
     def __init__(self, dt: float, pace: float, log: logging.Logger | None = None):
         self.dt = dt
