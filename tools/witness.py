@@ -10,17 +10,31 @@ recomputes the digest from the frames as they arrive. zenoh keeps one
 session's puts in order, and the frames come before the Summary, so by the
 time its Summary arrives the witness has seen all of them: a Summary whose
 digest differs is refused (tools/launcher.py `supervise`).
+
+Send order is not quite wire order. In lockstep a robot holds its `cmd`
+frames, and the engine its `sense` frames, for up to L ticks and puts them as
+one batch (runtime/lockstep.py `Outbound.batch`), while every other key's
+frame is put as it is sent: a robot's `report` of tick k reaches the wire
+before the `cmd` of tick k that it sent first. So the witness puts the frames
+back in send order: by tick; within a tick the batched keys first, in the
+order of the key table (the engine's senses robot by robot, as it sends
+them), then the others in the order they came. A frame is added to the
+digest once no batched frame that was sent before it can still arrive.
 """
 
 from __future__ import annotations
 
 import hashlib
+import heapq
 import threading
 
 import msgspec
 
 from arena.runtime.lockstep import BATCH_HEADS, MAX_BATCH, decode_batch
 from arena.schemas.keys import Keys, routes, spec_of
+
+# The keys whose frames a sender may hold back and put as a batch (processes/engine.py, processes/robot.py).
+BATCHED = frozenset({"sense", "cmd"})
 
 
 def digest_update(h: hashlib.blake2b, rel: str, payload: bytes) -> None:
@@ -39,23 +53,32 @@ class Witness:
         self.matched: set[str] = set()
         self.conflicted: set[str] = set()  # someone else put a frame for a tick it had sent
         self._lock = threading.Lock()
-        for rel, sender, _ in routes(robots):
+        # Per sender: accepted frames not yet in the digest, a heap of (tick, 0, rank, seq, rel, payload)
+        # for a batched key or (tick, 1, seq, 0, rel, payload) for another; and, per batched key, the
+        # (tick, 0, rank) of its next frame due, which no frame after it in send order may overtake.
+        self._held: dict[str, list] = {name: [] for name in watched}
+        self._next: dict[str, dict[str, tuple[int, int, int]]] = {name: {} for name in watched}
+        self._seq = 0
+        for rank, (rel, sender, _) in enumerate(routes(robots)):
             if sender in self.digests:
                 spec = spec_of(rel)
                 if spec is not None and spec.timing.period is not None:
-                    transport.subscribe_callback(keys.prefix + rel, self._on(sender, rel, spec, periods))
+                    transport.subscribe_callback(keys.prefix + rel, self._on(sender, rel, spec, periods, rank))
 
-    def _on(self, sender: str, rel: str, spec, periods: dict[str, int]):
+    def _on(self, sender: str, rel: str, spec, periods: dict[str, int], rank: int):
         """Only the in-sequence frame of each scheduled tick counts, as for a receiver.
 
         Anyone can put on an external's keys (outside --secure): garbage, or frames
         for ticks it has not reached, never enter the recomputed digest; a second
         frame for a tick already counted makes the digest unverifiable, not wrong.
         """
-        h = self.digests[sender]
         period, phase = spec.timing.schedule(periods)
         decode = msgspec.msgpack.Decoder(spec.message).decode
         due = [phase]
+        batched = spec.name in BATCHED
+        held, nxt = self._held[sender], self._next[sender]
+        if batched:
+            nxt[rel] = (phase, 0, rank)
 
         def on_frame(payload: bytes) -> None:
             if payload[:1] == b"\xc1":  # a local wake-up, never a message
@@ -77,13 +100,26 @@ class Witness:
                 return
             with self._lock:
                 if tick == due[0]:
-                    digest_update(h, rel, payload)
+                    self._seq += 1
+                    order = (tick, 0, rank, self._seq) if batched else (tick, 1, self._seq, 0)
+                    heapq.heappush(held, (*order, rel, payload))
                     self.frames[sender] += 1
                     due[0] += period
+                    if batched:
+                        nxt[rel] = (due[0], 0, rank)
+                    self._fold(sender, everything=False)
                 elif tick < due[0]:
                     self.conflicted.add(sender)
 
         return on_frame
+
+    def _fold(self, sender: str, everything: bool) -> None:
+        """Add `sender`'s held frames to its digest, in send order, as far as none sent earlier can still come."""
+        held, h = self._held[sender], self.digests[sender]
+        first_missing = min(self._next[sender].values(), default=None)
+        while held and (everything or first_missing is None or held[0][:3] < first_missing):
+            *_, rel, payload = heapq.heappop(held)
+            digest_update(h, rel, payload)
 
     def check(self, name: str, digest: str, dead: list[str]) -> str | None:
         """None if `digest` is what `name` sent; otherwise why not.
@@ -96,6 +132,7 @@ class Witness:
         if name not in self.digests:
             return None
         with self._lock:
+            self._fold(name, everything=True)  # its Summary came after every frame it put
             seen = self.digests[name].hexdigest()
             n = self.frames[name]
         if seen == digest:

@@ -81,3 +81,24 @@ def test_garbage_and_frames_of_future_ticks_from_others_do_not_count_and_a_dupli
     assert w.check("robot/a/1", expected, dead=[]) is None and w.verified() == ["robot/a/1"]
     cmd(msgspec.msgpack.encode(Cmd(tick=2, vx=3.0)))  # a forger's frame for a tick already sent
     assert w.check("robot/a/1", "2" * 32, dead=[]) is None, "unverifiable, not refused"
+
+
+def test_batched_cmds_that_reach_the_wire_after_a_later_report_are_put_back_in_send_order():
+    """With a perception latency a robot holds its `cmd` frames for a batch, while its `report` goes out at once."""
+    digest = hashlib.blake2b(digest_size=16)
+    wire: list[tuple[str, bytes]] = []
+    cmd = Outbound("arena/w/robot/a/1/cmd", "robot/a/1/cmd", lambda p: wire.append(("robot/a/1/cmd", p)), digest)
+    rep = Outbound("arena/w/team/a/report/1", "team/a/report/1", lambda p: wire.append(("team/a/report/1", p)), digest)
+    cmd.batch(3, 11)
+    for k in range(12):
+        cmd.send(Cmd(tick=k, vx=0.1 * k))
+        if k % 5 == 0:
+            rep.send(Report(tick=k, robot=1, pose=Pose(x=1.0, y=2.0, theta=0.5)))
+    assert [rel for rel, _ in wire][:2] == ["team/a/report/1", "robot/a/1/cmd"], "report 0 overtook cmd 0"
+    tr = Callbacks()
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"}, periods=PERIODS)
+    for rel, payload in wire:
+        tr.callbacks[f"arena/w/{rel}"](payload)
+    assert w.frames["robot/a/1"] == 12 + 3
+    assert w.check("robot/a/1", digest.hexdigest(), dead=[]) is None
+    assert w.verified() == ["robot/a/1"]
