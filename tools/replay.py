@@ -39,6 +39,7 @@ from arena.processes import node_class
 from arena.recording.reader import Recording, RecordingError, load
 from arena.runtime.config import ConfigError, ProcessId
 from arena.runtime.coop import CoopBus, CoopTransport, NodeFailed, Task, drive
+from arena.runtime.lockstep import BATCH_HEADS, decode_batch
 from arena.schemas.keys import Keys
 
 
@@ -122,8 +123,8 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
     counts: dict[str, int] = {}
     for rel, channel in outputs:
         got = []
-        while (raw := channel.try_recv()) is not None:
-            got.append(raw)
+        while (raw := channel.try_recv()) is not None:  # a batch (`Outbound.batch`) is its frames, as tapped
+            got.extend(decode_batch(raw) if raw[:1] and raw[0] in BATCH_HEADS else (raw,))
         want = rec.payloads(rel)
         if rec.truncated:
             got = got[: len(want)]  # the recording ends early; compare what it has
