@@ -198,7 +198,7 @@ def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tr
         default=None,
         metavar="TICKS",
         help="a robot at tick k sees the sense of tick k - TICKS (the model; changes digests), e.g. "
-        "--perception-latency 0 for the pre-2026-11-25 model (default: timing.perception_latency)",
+        "--perception-latency 0 for the model before 2026-11-26 (default: timing.perception_latency, 3 = 60 ms)",
     )
     p.add_argument(
         "--batch",
@@ -396,6 +396,14 @@ def build_parser() -> Parser:
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
     t.add_argument(
         "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
+    )
+    t.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
+        "e.g. 0 for the model before 2026-11-26",
     )
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
@@ -819,6 +827,10 @@ def cmd_tournament(args: argparse.Namespace) -> int:
         cls, param, value = parse_override(text)
         overrides.setdefault(cls, {})[param] = value
     resolve(args.link, overrides)
+    if args.perception_latency is not None:  # its range, as arena match checks it
+        from arena.runtime.config import MatchConfig, TimingParams
+
+        MatchConfig(timing=TimingParams(perception_latency=args.perception_latency)).validate()
     if args.ray is not None:
         from arena.tools.cluster import parse_address, parse_runtime_env
 
@@ -833,6 +845,7 @@ def cmd_tournament(args: argparse.Namespace) -> int:
         robots=args.robots,
         link=args.link,
         link_param=tuple(args.link_param),
+        perception_latency=args.perception_latency,
         seed=args.seed,
         jobs=args.jobs,
         out=Path(args.out),

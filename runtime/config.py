@@ -155,6 +155,9 @@ class RulesParams:
     stuck_radius: float = 0.2  # [m] see stuck_s
 
 
+DEFAULT_PERCEPTION_LATENCY = 3  # [ticks] 60 ms at 50 Hz
+
+
 @dataclass(frozen=True)
 class TimingParams:
     dt: float = 0.02  # [s] control tick (50 Hz)
@@ -163,9 +166,10 @@ class TimingParams:
     referee_period: int = DEFAULT_PERIODS["referee"]  # [ticks] engine events -> referee -> everyone (10 Hz)
     world_period: int = DEFAULT_PERIODS["world"]  # [ticks] ground-truth `world` for viewers and the recorder
     # The perception latency L is the model (omni-vision pipelines of MSL robots: 30-60 ms;
-    # docs/architecture.md); the batch is a transport detail: the digests are the same for
-    # every batch. 0 and 0 are allowed (no latency; as many frames as L allows, L or 1).
-    perception_latency: int = 0  # [ticks] a robot acting at tick k sees the `sense` of tick k - L
+    # docs/architecture.md): 3 ticks, 60 ms, since 2026-11-26 (0 before; docs/performance.md,
+    # session 11). The batch is a transport detail: the digests are the same for every batch.
+    # 0 and 0 are allowed (no latency; as many frames as L allows, L or 1).
+    perception_latency: int = DEFAULT_PERCEPTION_LATENCY  # [ticks] a robot at tick k sees the `sense` of k - L
     batch: int = 0  # [frames] `sense`/`cmd` frames per message in lockstep (0: L, or 1)
     startup_timeout: float = 30.0  # [s] wall: wait for every process to come up
     # [s] wall: last-resort bound on one lockstep wait. Dead and hung peers are

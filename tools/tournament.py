@@ -47,7 +47,9 @@ def plural(n: int, word: str, words: str | None = None) -> str:
 
 
 # Settings that decide what a match is: --resume refuses to mix results played with other values.
-BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "seed")
+BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "perception_latency", "seed")
+# What a settings.json written before a binding setting existed was played with.
+LEGACY = {"perception_latency": 0}
 
 
 @dataclass(frozen=True)
@@ -60,6 +62,7 @@ class TournamentOptions:
     robots: int = 3
     link: str = "ideal"
     link_param: tuple[str, ...] = ()  # CLASS.PARAM=V, as given to --link-param
+    perception_latency: int | None = None  # [ticks] None: the default (runtime/config.py TimingParams)
     seed: int = 0
     jobs: int = 0  # 0: one per core
     out: Path = Path("tournament")
@@ -68,6 +71,12 @@ class TournamentOptions:
     engine: str = "processes"
     ray: str | None = None  # None: no Ray; "": a local instance; else auto or HOST:PORT
     ray_runtime_env: str | None = None  # JSON text
+
+    def latency(self) -> int:
+        """The perception latency the matches are played with [ticks]."""
+        from arena.runtime.config import TimingParams
+
+        return TimingParams().perception_latency if self.perception_latency is None else self.perception_latency
 
     def link_overrides(self) -> dict[str, dict[str, float]]:
         from arena.runtime.links import parse_override
@@ -90,6 +99,7 @@ def settings(opts: TournamentOptions) -> dict:
         "robots": opts.robots,
         "link": opts.link,
         "link_overrides": opts.link_overrides(),
+        "perception_latency": opts.latency(),
         "seed": opts.seed,
         "engine": opts.engine,
         "version": package_version(),
@@ -107,11 +117,11 @@ def check_resume(out: Path, now: dict) -> None:
         before = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--resume: cannot read {path}: {exc}") from None
-    flag = {"link_overrides": "link-param", "half_time": "half-time"}
+    flag = {"link_overrides": "link-param", "half_time": "half-time", "perception_latency": "perception-latency"}
     diffs = [
-        f"--{flag.get(k, k)} {_show(before.get(k))} there, {_show(now[k])} now"
+        f"--{flag.get(k, k)} {_show(before.get(k, LEGACY.get(k)))} there, {_show(now[k])} now"
         for k in BINDING
-        if before.get(k) != now[k]
+        if before.get(k, LEGACY.get(k)) != now[k]
     ]
     if diffs:
         raise ConfigError(
@@ -561,7 +571,7 @@ class Runner:
             )
 
     def match_config(self, fx: Fixture):
-        from arena.runtime.config import MatchConfig
+        from arena.runtime.config import MatchConfig, TimingParams
 
         cfg = MatchConfig(
             seed=fx.seed,
@@ -571,6 +581,7 @@ class Runner:
             half_time=self.opts.half_time,
             link=self.opts.link,
             link_overrides=self.opts.link_overrides(),
+            timing=TimingParams(perception_latency=self.opts.latency()),
         )
         cfg.validate()
         return cfg
@@ -628,6 +639,8 @@ class Runner:
             str(fx.seed),
             "--link",
             a.link,
+            "--perception-latency",
+            str(a.latency()),
             "--engine",
             self.engine,
             "--json",

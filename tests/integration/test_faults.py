@@ -301,20 +301,28 @@ def test_an_external_robot_that_never_sends_its_summary_is_named_within_the_boun
 
 def test_two_senders_on_one_key_are_flagged_as_possible_spoofing(reap, tmp_path):
     """Issue 15: a client answers every `sense` of robot b/1 with a forged `cmd` for the same tick."""
+    from arena.runtime.lockstep import BATCH_HEADS
     from arena.schemas.messages import Cmd, Sense, encode
 
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     proc = spawn(*MATCH, "--half-time", "20", "--seed", "4", "--match", "spoof", "--listen", endpoint)
     reap.append(proc)
     decode = msgspec.msgpack.Decoder(Sense).decode
+
+    def ticks(raw: bytes) -> list[int]:
+        """The ticks of a `sense` message: one frame, or a batch of them (schemas/README.md, "Batches")."""
+        frames = msgspec.msgpack.decode(raw) if raw[0] in BATCH_HEADS else [raw]
+        return [decode(f).tick for f in frames]
+
     wait_for(lambda: (tmp_path / "router.sock").exists(), 30, "the router socket")
     with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
         pub = session.declare_publisher("arena/spoof/robot/b/1/cmd", congestion_control=zenoh.CongestionControl.DROP)
         forged = [0]
 
         def answer(sample):
-            pub.put(encode(Cmd(tick=decode(sample.payload.to_bytes()).tick, vx=-5.0, omega=3.0)))
-            forged[0] += 1
+            for tick in ticks(sample.payload.to_bytes()):
+                pub.put(encode(Cmd(tick=tick, vx=-5.0, omega=3.0)))
+                forged[0] += 1
 
         sub = session.declare_subscriber("arena/spoof/robot/b/1/sense", answer)
         code, result, err = finish(proc, 120)

@@ -127,9 +127,11 @@ def test_forged_nan_orders_are_counted_and_the_match_plays_on(reap, tmp_path):
             # The robot's cmd for tick t + 1 proves it has the genuine order of tick t: the forged order
             # for the next comm tick is then the very frame it expects, and the base station cannot send
             # the genuine one before the robot's next report, ticks later.
-            tick = msgpack.unpackb(sample.payload.to_bytes())["tick"]
+            # One frame (a map), or a batch of them (an array of the frames' bytes; schemas/README.md, "Batches").
+            sent = msgpack.unpackb(sample.payload.to_bytes())
+            ticks = [msgpack.unpackb(f)["tick"] for f in sent] if isinstance(sent, list) else [sent["tick"]]
             with lock:
-                if len(genuine) < 2 or len(forged) >= 10 or tick != genuine[-1] + 1 or tick < 200:
+                if len(genuine) < 2 or len(forged) >= 10 or genuine[-1] + 1 not in ticks or genuine[-1] + 1 < 200:
                     return
                 nxt = genuine[-1] + (genuine[-1] - genuine[-2])
                 forged.append(nxt)

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 
-from arena.tools.tournament import Result, report
+import pytest
+
+from arena.runtime.config import ConfigError
+from arena.tools.tournament import Result, TournamentOptions, check_resume, report, settings
 from tests.integration.helpers import ARENA
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--seed", "5", "--jobs", "1")
@@ -19,6 +23,7 @@ def test_settings_are_recorded_and_resume_refuses_a_different_half_time(tmp_path
     assert saved["strategies"] == ["basic-static", "advance-dynamic"]
     assert (saved["legs"], saved["half_time"], saved["robots"], saved["seed"]) == (1, 2.0, 3, 5)
     assert (saved["link"], saved["link_overrides"], saved["engine"]) == ("ideal", {}, "processes")
+    assert saved["perception_latency"] == 3, "the default model"
     assert saved["version"][0].isdigit()
     md = (out / "report.md").read_text()
     assert "1 leg, seed 5" in md and "1 of 1 match played" in md and "half time 2" in md
@@ -31,6 +36,20 @@ def test_settings_are_recorded_and_resume_refuses_a_different_half_time(tmp_path
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "--half-time 2 there, 3 now" in r.stderr
     assert json.loads((out / "tournament.json").read_text())["settings"]["half_time"] == 2.0, "nothing was mixed in"
+
+
+def test_resume_refuses_another_perception_latency_and_an_old_directory_counts_as_0(tmp_path):
+    opts = TournamentOptions(strategies=("basic-static", "advance-dynamic"))
+    now = settings(opts)
+    (tmp_path / "settings.json").write_text(json.dumps(now))
+    check_resume(tmp_path, now)
+    with pytest.raises(ConfigError, match="--perception-latency 3 there, 0 now"):
+        check_resume(tmp_path, settings(dataclasses.replace(opts, perception_latency=0)))
+    # A directory written before the setting was recorded was played with L = 0, the default then.
+    (tmp_path / "settings.json").write_text(json.dumps({k: v for k, v in now.items() if k != "perception_latency"}))
+    check_resume(tmp_path, settings(dataclasses.replace(opts, perception_latency=0)))
+    with pytest.raises(ConfigError, match="--perception-latency 0 there, 3 now"):
+        check_resume(tmp_path, now)
 
 
 def test_a_partial_report_counts_the_whole_schedule(tmp_path):
