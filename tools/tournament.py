@@ -62,7 +62,7 @@ class TournamentOptions:
     robots: int = 3
     link: str = "ideal"
     link_param: tuple[str, ...] = ()  # CLASS.PARAM=V, as given to --link-param
-    perception_latency: int | None = None  # [ticks] None: the default (runtime/config.py TimingParams)
+    perception_latency: int | None = None  # [ticks] None: the default (runtime/config.py DEFAULT_PERCEPTION_LATENCY)
     seed: int = 0
     jobs: int = 0  # 0: one per core
     out: Path = Path("tournament")
@@ -74,9 +74,9 @@ class TournamentOptions:
 
     def latency(self) -> int:
         """The perception latency the matches are played with [ticks]."""
-        from arena.runtime.config import TimingParams
+        from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY
 
-        return TimingParams().perception_latency if self.perception_latency is None else self.perception_latency
+        return DEFAULT_PERCEPTION_LATENCY if self.perception_latency is None else self.perception_latency
 
     def link_overrides(self) -> dict[str, dict[str, float]]:
         from arena.runtime.links import parse_override
