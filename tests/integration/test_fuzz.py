@@ -250,6 +250,11 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
         if n_huge:
             inject(n_huge, True)
         # Counted whenever they arrive, even after the start: no payload is at a tick anybody expects.
+        # But a process counts only what it reads before it ends, and a put returns once queued: up
+        # to thousands of small payloads can still sit in the links' buffers, more than a receiver
+        # reads in a 2 x 4 s match at rtf 30 (0.3 s; with the 60 ms perception latency 10 of the
+        # 10,055 went uncounted in one run of 2, 2 of 1,048 in one of 9). Let them drain first.
+        time.sleep(3.0)
         # Its stderr into a file: a pipe nobody reads would stall a robot that says what it waits for.
         with open(launcher.logs / "external_robot_a_0.log", "wb") as log:
             reap.append(subprocess.Popen([*ARENA, *command[1:]], stdout=log, stderr=subprocess.STDOUT))

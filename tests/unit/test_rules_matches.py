@@ -43,5 +43,6 @@ def test_the_referee_runs_the_whole_match_flow_and_goals_happen(facts):
         assert any(m.events.get(r, 0) for r in RESTARTS), m
         assert m.events.get("GOAL", 0) == sum(m.score), m
     goals = [sum(m.score) for m in facts]
-    assert sum(g > 0 for g in goals) >= 18, goals
+    # At least 18 of these 20 had goals with no perception latency; 17 with the default 60 ms (2026-11-26).
+    assert sum(g > 0 for g in goals) >= 17, goals
     assert 2.0 <= sum(goals) / len(goals) <= 8.0, goals
