@@ -43,6 +43,7 @@ def test_the_referee_runs_the_whole_match_flow_and_goals_happen(facts):
         assert any(m.events.get(r, 0) for r in RESTARTS), m
         assert m.events.get("GOAL", 0) == sum(m.score), m
     goals = [sum(m.score) for m in facts]
-    # At least 18 of these 20 had goals with no perception latency; 17 with the default 60 ms (2026-11-26).
+    # With no perception latency at least 18 of these 20 had goals, at least 2.0 a match; with the
+    # default 60 ms (2026-11-26) the chasers score less: 17 of 20, 1.7 a match (34 goals).
     assert sum(g > 0 for g in goals) >= 17, goals
-    assert 2.0 <= sum(goals) / len(goals) <= 8.0, goals
+    assert 1.5 <= sum(goals) / len(goals) <= 8.0, goals
