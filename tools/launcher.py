@@ -172,6 +172,8 @@ class Child:
         return "\n".join("    " + line for line in text[-lines:])
 
 
+# The packages mapped to a directory of their own (pyproject.toml `package-dir`);
+# their subpackages (arena.sim.physics, arena.strategies.iris, ...) live below them.
 _PACKAGES = (
     "arena",
     "arena.runtime",
@@ -180,6 +182,9 @@ _PACKAGES = (
     "arena.strategies",
     "arena.navigation",
     "arena.tools",
+    "arena.sim",
+    "arena.rules",
+    "arena.recording",
 )
 
 
@@ -200,7 +205,7 @@ def compile_sources() -> None:
         spec = importlib.util.find_spec(name)
         for root in (spec.submodule_search_locations or []) if spec else []:
             try:
-                compileall.compile_dir(root, maxlevels=0, quiet=2)
+                compileall.compile_dir(root, quiet=2)  # subpackages too: each root holds only arena's code
             except OSError:
                 pass  # a read-only install: the processes compile in memory, as before
 
