@@ -94,7 +94,8 @@ EXAMPLES = {
     "facts": """examples:
   arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
   arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
-  arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio""",
+  arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio
+  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present (the model before 2026-11-26)""",
     "replay": """examples:
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
   arena replay match.mcap --process basestation/b --json
@@ -464,6 +465,14 @@ def build_parser() -> Parser:
     fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
     fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
     fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
+    fa.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
+        "e.g. 0 for the model before 2026-11-26",
+    )
 
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
     v.add_argument("file", help="an MCAP file written by arena match --record")
@@ -920,6 +929,7 @@ def cmd_facts(args: argparse.Namespace) -> int:
         round_robin_of=[s for s in (args.round_robin or "").split(",") if s] or None,
         legs=args.legs,
         seed=args.seed,
+        perception_latency=args.perception_latency,
     )
 
 

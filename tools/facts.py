@@ -24,7 +24,7 @@ from itertools import combinations
 import msgspec
 
 from arena.recording.analysis.facts import MatchFacts, measure
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, TimingParams
 from arena.schemas.messages import Referee, World
 from arena.tools.facts_table import line, summary
 from arena.tools.inprocess import play_in_process
@@ -46,7 +46,7 @@ def many(cfgs: list[MatchConfig], workers: int | None = None) -> list[MatchFacts
 
 
 def round_robin(
-    strategies: list[str], legs: int, half_time: float, seed: int, workers: int
+    strategies: list[str], legs: int, half_time: float, seed: int, workers: int, timing: TimingParams | None = None
 ) -> tuple[list, list[MatchFacts]]:
     """Every pairing `legs` times, home and away alternating, in-process; returns (Results, facts)."""
     from arena.runtime import seeds
@@ -58,7 +58,8 @@ def round_robin(
             home, away = (first, second) if leg % 2 == 1 else (second, first)
             s = seeds.derive(seed, "tournament", first, second, leg) % (2**31)
             fixtures.append((first, second, leg, home, away, s))
-    cfgs = [MatchConfig(seed=s, home=h, away=a, half_time=half_time) for _, _, _, h, a, s in fixtures]
+    timing = timing or TimingParams()
+    cfgs = [MatchConfig(seed=s, home=h, away=a, half_time=half_time, timing=timing) for _, _, _, h, a, s in fixtures]
     facts = many(cfgs, workers)
     results = [
         Result(
@@ -88,6 +89,7 @@ def main(
     round_robin_of: list[str] | None = None,
     legs: int = 4,
     seed: int = 0,
+    perception_latency: int | None = None,
 ) -> int:
     """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2."""
     workers = workers or min(2, os.cpu_count() or 1)
@@ -95,13 +97,17 @@ def main(
         raise ConfigError(f"--seeds, --legs and --workers must be at least 1 (got {seeds}, {legs}, {workers})")
     if not half_time > 0:
         raise ConfigError(f"--half-time must be > 0, got {half_time}")
+    latency = DEFAULT_PERCEPTION_LATENCY if perception_latency is None else perception_latency
+    timing = TimingParams(perception_latency=latency)
+    MatchConfig(timing=timing).validate()  # its range, as arena match checks it
+    print(f"perception latency {latency} ticks ({latency * timing.dt * 1000:g} ms)")
     t0 = time.monotonic()
     if round_robin_of:
         from arena.strategies import registry
         from arena.tools.tournament import coverage, short, standings
 
         names = [registry.resolve_name(s) for s in round_robin_of]
-        results, facts = round_robin(names, legs, half_time, seed, workers)
+        results, facts = round_robin(names, legs, half_time, seed, workers, timing)
         for r, m in zip(results, facts):
             print(f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}")
         for row in summary(facts):
@@ -117,7 +123,8 @@ def main(
         print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s")
         return 0
     cfgs = [
-        MatchConfig(seed=s, half_time=half_time, home=home, away=away) for s in range(first_seed, first_seed + seeds)
+        MatchConfig(seed=s, half_time=half_time, home=home, away=away, timing=timing)
+        for s in range(first_seed, first_seed + seeds)
     ]
     facts = many(cfgs, workers)
     for m in facts:

@@ -88,6 +88,7 @@ BAD = [
     (["facts", "--seeds", "0"], "must be at least 1"),
     (["facts", "--round-robin", "AD"], "needs at least two different strategies"),
     (["facts", "--home", "nope"], "unknown strategy 'nope'"),
+    (["facts", "--perception-latency", "99"], "--perception-latency must be 0..25 ticks, got 99"),
     # arena review
     (["review", "/nonexistent.mcap"], "cannot read"),
     (["review", "{file}"], "not an MCAP file"),
