@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from itertools import combinations
 
 import msgspec
@@ -38,11 +39,25 @@ def match_facts(cfg: MatchConfig) -> MatchFacts:
     return measure(cfg, worlds, referee, extra, summaries["engine"].extra.get("distance_m", {}))
 
 
-def many(cfgs: list[MatchConfig], workers: int | None = None) -> list[MatchFacts]:
-    """`match_facts` of every configuration, in worker processes (spawned: no fork of threads)."""
-    workers = workers or min(len(cfgs), os.cpu_count() or 1)
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        return list(pool.map(match_facts, cfgs))
+def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = False) -> list[MatchFacts]:
+    """`match_facts` of every configuration, in worker processes (spawned: no fork of threads),
+    in the order given; `progress`: say on stderr as each match ends (a bar on a terminal)."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    console, bar_shown = Console(stderr=True), progress and sys.stderr.isatty()
+    columns = (TextColumn("[bold]facts[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context) as pool:
+        futures = {pool.submit(match_facts, cfg): cfg for cfg in cfgs}
+        with Progress(*columns, console=console, disable=not bar_shown) as bar:
+            task = bar.add_task("m", total=len(cfgs))
+            for done, future in enumerate(as_completed(futures), 1):
+                bar.update(task, advance=1)
+                if progress and not bar_shown:
+                    c, (h, a) = futures[future], future.result().score
+                    console.print(f"[{done}/{len(cfgs)}] seed {c.seed}: {c.home} {h}:{a} {c.away}", highlight=False)
+        return [f.result() for f in futures]
 
 
 def round_robin(
@@ -60,7 +75,7 @@ def round_robin(
             fixtures.append((first, second, leg, home, away, s))
     timing = timing or TimingParams()
     cfgs = [MatchConfig(seed=s, home=h, away=a, half_time=half_time, timing=timing) for _, _, _, h, a, s in fixtures]
-    facts = many(cfgs, workers)
+    facts = many(cfgs, workers, progress=True)
     results = [
         Result(
             id=f"{i:03d}",
@@ -126,7 +141,7 @@ def main(
         MatchConfig(seed=s, half_time=half_time, home=home, away=away, timing=timing)
         for s in range(first_seed, first_seed + seeds)
     ]
-    facts = many(cfgs, workers)
+    facts = many(cfgs, workers, progress=True)
     for m in facts:
         print(line(m))
     for row in summary(facts):
