@@ -211,6 +211,18 @@ def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tr
     )
 
 
+def every_match_latency(p: argparse.ArgumentParser) -> None:
+    """`--perception-latency` of a command that plays many matches (tournament, facts)."""
+    p.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
+        "e.g. 0 for the model before 2026-11-26",
+    )
+
+
 _PARSER: list[Parser] = []
 
 
@@ -398,14 +410,7 @@ def build_parser() -> Parser:
     t.add_argument(
         "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
     )
-    t.add_argument(
-        "--perception-latency",
-        type=int,
-        default=None,
-        metavar="TICKS",
-        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
-        "e.g. 0 for the model before 2026-11-26",
-    )
+    every_match_latency(t)
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
@@ -465,14 +470,7 @@ def build_parser() -> Parser:
     fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
     fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
     fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
-    fa.add_argument(
-        "--perception-latency",
-        type=int,
-        default=None,
-        metavar="TICKS",
-        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
-        "e.g. 0 for the model before 2026-11-26",
-    )
+    every_match_latency(fa)
 
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
     v.add_argument("file", help="an MCAP file written by arena match --record")
