@@ -746,6 +746,16 @@ def record_path(text: str) -> str:
         raise ConfigError(f"--record {text}: directory {path.parent} does not exist")
     if path.is_dir():
         raise ConfigError(f"--record {text} is a directory")
+    # Tried now, not by the recorder after the match has started: a recorder that
+    # cannot write holds every process at the start barrier until it times out.
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"--record {text}: cannot write it ({exc.strerror or exc})") from None
+    if not existed:
+        path.unlink()
     return str(path)
 
 
