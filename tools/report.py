@@ -56,7 +56,9 @@ def print_match(result: dict, console: Console | None = None) -> None:
             f"({errors.get('a', 0)} bad), b {c.get('worldstates_b', 0)} ({errors.get('b', 0)} bad)"
         )
     rec = result.get("recording")
-    if rec:
+    if rec and "error" in rec:  # no recorder Summary (tools/launcher.py)
+        console.print(f"[red]not recorded[/]: {rec['error']} ({rec['path']})")
+    elif rec:
         state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"
         console.print(
             f"recorded {sum(rec['messages'].values())} messages to {rec['path']} ({state}): arena review {rec['path']}"

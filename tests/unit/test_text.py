@@ -15,9 +15,9 @@ def arena(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "arena", *args], capture_output=True, text=True, timeout=120)
 
 
-def test_units_in_table_headers_survive_rich():
-    console = Console(record=True, width=120)
-    result = {
+def match_result() -> dict:
+    """The least of `arena match --json` that `report.print_match` reads."""
+    return {
         "home": "basic-static",
         "away": "chase",
         "score": [1, 0],
@@ -35,10 +35,21 @@ def test_units_in_table_headers_survive_rich():
         "rejected": 0,
         "dead": [],
     }
-    report.print_match(result, console)
+
+
+def test_units_in_table_headers_survive_rich():
+    console = Console(record=True, width=120)
+    report.print_match(match_result(), console)
     text = console.export_text()
     assert "robot [m]" in text and "┃  [m] ┃" in text, text  # the title and the unit column
     assert "delay mean [ms]" in text and "dropped [%]" in text
+
+
+def test_a_recorder_that_failed_is_reported_not_a_crash():
+    console = Console(record=True, width=200)
+    why = "the recorder failed: exited with code 2"
+    report.print_match({**match_result(), "recording": {"path": "/x/m.mcap", "complete": False, "error": why}}, console)
+    assert f"not recorded: {why} (/x/m.mcap)" in console.export_text()
 
 
 def test_version_matches_the_package():
