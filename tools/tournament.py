@@ -614,9 +614,10 @@ class Runner:
 
     def close(self) -> None:
         if self.pool is not None:
+            workers = list((getattr(self.pool, "_processes", None) or {}).values())  # shutdown sets it to None
             self.pool.shutdown(wait=not self.stopping, cancel_futures=True)
             if self.stopping:
-                for p in list(getattr(self.pool, "_processes", {}).values()):
+                for p in workers:
                     if p.is_alive():
                         p.kill()
 

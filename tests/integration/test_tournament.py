@@ -11,12 +11,19 @@ import pytest
 from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "3", "--half-time", "2", "--seed", "5", "--jobs", "1")
+# One process plays a match of 2 x 2 s in a blink: long enough to be interrupted in the middle.
+INPROCESS = ("--engine", "inprocess", "--half-time", "60")
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
-def test_interrupt_then_resume(tmp_path, reap, sig):
+@pytest.mark.parametrize(
+    ("sig", "engine"),
+    [(signal.SIGINT, ()), (signal.SIGTERM, ()), (signal.SIGINT, INPROCESS)],
+    ids=["ctrl-c", "sigterm", "ctrl-c-inprocess"],
+)
+def test_interrupt_then_resume(tmp_path, reap, sig, engine):
     out = tmp_path / "t"
-    proc = spawn(*ARGS, "--out", str(out))
+    args = (*ARGS, *engine)
+    proc = spawn(*args, "--out", str(out))
     reap.append(proc)
     matches = out / "matches"
     wait_for(lambda: matches.is_dir() and any(matches.glob("*.json")), 120, "the first finished match")
@@ -34,7 +41,7 @@ def test_interrupt_then_resume(tmp_path, reap, sig):
     assert 1 <= len(kept) < 3
     assert not list(matches.glob("*.tmp")), "results are written atomically"
 
-    summary = arena_json(*ARGS, "--out", str(out), "--resume")
+    summary = arena_json(*args, "--out", str(out), "--resume")
     assert summary["skipped"] == len(kept)
     assert len(summary["matches"]) == 3 and summary["failed"] == []
     table = {row["team"]: row for row in summary["table"]}
