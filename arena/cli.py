@@ -1006,7 +1006,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"arena {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"arena {args.command}: interrupted; every process of the match was stopped", file=sys.stderr)
+        stopped = "; every process of the match was stopped" if args.command in ("match", "facts", "bench") else ""
+        print(f"arena {args.command}: interrupted{stopped}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # `arena ... | head`: the reader left; nothing to say
         import os

@@ -162,6 +162,25 @@ def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, c
     assert log.parent == tmp_path and "Traceback" in log.read_text() and "the bug" in log.read_text()
 
 
+@pytest.mark.parametrize(
+    ("command", "said"),
+    [
+        ("cmd_review", "arena review: interrupted"),
+        ("cmd_match", "arena match: interrupted; every process of the match was stopped"),
+    ],
+)
+def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
+    from arena import cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, command, interrupted)
+    argv = ["review", "m.mcap"] if command == "cmd_review" else M
+    assert cli.main(argv) == 130
+    assert capsys.readouterr().err.strip() == said
+
+
 def test_version():
     r = subprocess.run([sys.executable, "-m", "arena", "--version"], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and r.stdout.startswith("arena ") and r.stdout.split()[1][0].isdigit()
