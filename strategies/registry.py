@@ -100,7 +100,10 @@ def resolve_name(name: str) -> str:
         return found
     table = all_strategies()
     names = ", ".join(f"{s.name} ({'/'.join(s.aliases)})" if s.aliases else s.name for s in table.values())
-    raise ConfigError(f"unknown strategy {name!r}; known: {names}")
+    raise ConfigError(
+        f"unknown strategy {name!r}; known: {names} (a plugin is known once its package is installed:"
+        " entry point soccer_arena.strategies, docs/strategies.md)"
+    )
 
 
 def get(name: str) -> Strategy:

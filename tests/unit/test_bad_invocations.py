@@ -104,7 +104,7 @@ BAD = [
     (["config", "--check", "{file}"], "not valid TOML"),
     (["match", "--config", "{file}"], "not valid TOML"),
     # arena strategies
-    (["strategies", "tiki-taka"], "unknown strategy 'tiki-taka'"),
+    (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
     # arena schemas, and the top level
     (["schemas", "--check", "--write"], "not allowed with argument"),
