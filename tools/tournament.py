@@ -779,6 +779,8 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
     # Resume keeps finished matches; failed ones get another chance.
     todo = [fx for fx in fixtures if not (fx.id in have and have[fx.id].status == "ok")]
     results: dict[str, Result] = {fx.id: have[fx.id] for fx in fixtures if fx.id in have and have[fx.id].status == "ok"}
+    if opts.resume:  # a mistyped --out would otherwise start again from nothing without a word
+        print(f"arena tournament: --resume: {len(results)} of {len(fixtures)} matches kept from {out}", file=sys.stderr)
     t0 = time.monotonic()
     interrupted = False
     console = Console(stderr=True)

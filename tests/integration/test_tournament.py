@@ -5,10 +5,11 @@ from __future__ import annotations
 import json
 import os
 import signal
+import subprocess
 
 import pytest
 
-from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
+from tests.integration.helpers import ARENA, arena_json, cmdline, descendants, spawn, wait_for
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "3", "--half-time", "2", "--seed", "5", "--jobs", "1")
 # One process plays a match of 2 x 2 s in a blink: long enough to be interrupted in the middle.
@@ -61,3 +62,19 @@ def test_interrupt_then_resume(tmp_path, reap, sig, engine):
         "coverage.png",
     ):
         assert (out / name).stat().st_size > 0, name
+
+
+def test_resume_says_how_many_matches_it_kept(tmp_path):
+    """A mistyped --out with --resume must not start again from nothing without a word."""
+    args = ("tournament", "--strategies", "BS,AD", "--legs", "2", "--half-time", "1", "--jobs", "1", *INPROCESS[:2])
+    out = str(tmp_path / "nothing-here-yet")
+    first = subprocess.run(
+        [*ARENA, *args, "--out", out, "--resume", "--json"], capture_output=True, text=True, timeout=120
+    )
+    assert first.returncode == 0, first.stderr
+    assert f"--resume: 0 of 2 matches kept from {out}" in first.stderr
+    again = subprocess.run(
+        [*ARENA, *args, "--out", out, "--resume", "--json"], capture_output=True, text=True, timeout=120
+    )
+    assert f"--resume: 2 of 2 matches kept from {out}" in again.stderr
+    assert json.loads(again.stdout)["skipped"] == 2
