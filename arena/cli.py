@@ -76,7 +76,7 @@ EXAMPLES = {
   arena tournament --ray auto --out runs/big        # join the Ray cluster this node belongs to (ray start ...)
   arena tournament --ray 10.0.0.5:6379 --resume     # join the cluster whose head node is there
   arena tournament --ray auto --ray-runtime-env '{"pip": ["soccer-arena==0.1.0"]}'   # workers install it
-  arena tournament --legs 10 --engine inprocess     # one worker process per core, same digests, ~4x faster""",
+  arena tournament --legs 10 --engine inprocess     # one worker process per core, same digests, ~2.5x faster""",
     "bench": """examples:
   arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
   arena bench match --runs 5 --half-time 120 --link wifi
