@@ -29,6 +29,8 @@ from arena.schemas.vocabulary import TEAMS
 
 MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
 MAX_PERCEPTION_LATENCY = 25  # [ticks] 0.5 s at 50 Hz: far beyond any real vision pipeline
+MAX_DT = 0.1  # [s] a control tick of at most 100 ms (10 Hz): slower is no robot's control loop
+MAX_SUBSTEPS = 100  # physics steps per tick
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
@@ -314,11 +316,15 @@ class MatchConfig:
             raise ConfigError(f"--half-time must be positive, got {self.half_time}")
         if not self.half_time <= MAX_HALF_TIME:  # also catches inf and nan
             raise ConfigError(f"--half-time must be at most {MAX_HALF_TIME:g} s, got {self.half_time}")
+        t = self.timing  # before anything divides by dt
+        if not (math.isfinite(t.dt) and 0 < t.dt <= MAX_DT) or not 1 <= t.substeps <= MAX_SUBSTEPS:
+            raise ConfigError(
+                f"timing: dt must be in (0, {MAX_DT:g}] s and substeps in 1..{MAX_SUBSTEPS}, got {t.dt} and {t.substeps}"
+            )
+        if t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
+            raise ConfigError("timing: every period must be >= 1 tick")
         if self.half_ticks < 1:
             raise ConfigError(f"--half-time {self.half_time} is shorter than one tick")
-        t = self.timing
-        if t.dt <= 0 or t.substeps < 1 or t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
-            raise ConfigError("timing: dt must be > 0 and every period >= 1 tick")
         if not 0 <= t.perception_latency <= MAX_PERCEPTION_LATENCY:
             raise ConfigError(
                 f"--perception-latency must be 0..{MAX_PERCEPTION_LATENCY} ticks, got {t.perception_latency}"

@@ -39,6 +39,7 @@ def _comments(cls: type) -> dict[str, str]:
     return dict(re.findall(r"^\s+(\w+): [^=\n]+=[^#\n]*#\s*(.+)$", source, flags=re.M))
 
 
+MAX_FIELD = 100.0  # [m] any length of [field]; an MSL field is 22 x 14 m
 # Numbers of those sections for which 0 means something (MatchConfig.validate checks their range).
 ZERO_ALLOWED = frozenset({"perception_latency", "batch"})
 
@@ -74,6 +75,8 @@ def _check_values(cfg: MatchConfig, where: str) -> None:
                 raise ConfigError(f"{where}: {section}.{f.name} must be a finite number >= 0, got {value}")
             if section in ("field", "ball", "timing") and value == 0 and f.name not in ZERO_ALLOWED:
                 raise ConfigError(f"{where}: {section}.{f.name} must be > 0")
+            if section == "field" and value > MAX_FIELD:  # every field entry is a length
+                raise ConfigError(f"{where}: field.{f.name} must be at most {MAX_FIELD:g} m, got {value}")
     fp = cfg.field
     if fp.goal_width >= fp.width or fp.penalty_area_width >= fp.width or fp.penalty_area_depth * 2 >= fp.length:
         raise ConfigError(f"{where}: field: the goal and the penalty areas must fit inside the field")

@@ -48,6 +48,10 @@ def test_a_custom_field_size_plays_a_match(tmp_path):
         ("[links.wifi]\nwarp = 9\n", "unknown link parameter 'warp'"),
         ("half_time = 1e12\n", "--half-time must be at most 3600 s"),
         ("[timing]\nstartup_timeout = -1\n", "timing.startup_timeout"),
+        ("[timing]\ndt = 0\n", "timing: dt must be in (0, 0.1] s"),  # was a ZeroDivisionError
+        ("[timing]\ndt = nan\n", "timing: dt must be in (0, 0.1] s"),
+        ("[timing]\nsubsteps = 100000\n", "substeps in 1..100"),
+        ("[field]\nwidth = 1e308\n", "field.width must be at most 100 m"),
         ("[field\n", "not valid TOML"),
     ],
 )
