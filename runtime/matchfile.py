@@ -41,7 +41,8 @@ def _comments(cls: type) -> dict[str, str]:
 
 MAX_FIELD = 100.0  # [m] any length of [field]; an MSL field is 22 x 14 m
 # Numbers of those sections for which 0 means something (MatchConfig.validate checks their range).
-ZERO_ALLOWED = frozenset({"perception_latency", "batch"})
+ZERO_ALLOWED = frozenset({"perception_latency", "batch", "kick_max_speed", "lob_angle", "dribble_max_omega"})
+MAX_ROBOT_SIZE = 2.0  # [m] an MSL robot is at most 0.52 m wide
 
 
 def _known(section: str) -> dict[str, Any]:
@@ -64,7 +65,7 @@ def _check_keys(data: dict[str, Any], where: str) -> None:
 
 
 def _check_values(cfg: MatchConfig, where: str) -> None:
-    """Every number finite; sizes, masses and times positive (the engine cannot play a 0 m field)."""
+    """Every number finite; sizes, masses, speeds and times positive (the engine cannot play a 0 m field)."""
     for section in SECTIONS:
         params = getattr(cfg, section)
         for f in dataclasses.fields(params):
@@ -73,10 +74,12 @@ def _check_values(cfg: MatchConfig, where: str) -> None:
                 continue
             if not math.isfinite(value) or value < 0:
                 raise ConfigError(f"{where}: {section}.{f.name} must be a finite number >= 0, got {value}")
-            if section in ("field", "ball", "timing") and value == 0 and f.name not in ZERO_ALLOWED:
+            if section in ("field", "ball", "timing", "robot") and value == 0 and f.name not in ZERO_ALLOWED:
                 raise ConfigError(f"{where}: {section}.{f.name} must be > 0")
             if section == "field" and value > MAX_FIELD:  # every field entry is a length
                 raise ConfigError(f"{where}: field.{f.name} must be at most {MAX_FIELD:g} m, got {value}")
+    if cfg.robot.size > MAX_ROBOT_SIZE:
+        raise ConfigError(f"{where}: robot.size must be at most {MAX_ROBOT_SIZE:g} m, got {cfg.robot.size}")
     fp = cfg.field
     if fp.goal_width >= fp.width or fp.penalty_area_width >= fp.width or fp.penalty_area_depth * 2 >= fp.length:
         raise ConfigError(f"{where}: field: the goal and the penalty areas must fit inside the field")
