@@ -886,6 +886,11 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from arena.tools import bench
 
+    if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
+        from arena.runtime.links import resolve
+
+        resolve(args.link, {})
+        MatchConfig(robots=args.robots, half_time=args.half_time, link=args.link).validate()
     if args.what == "record":
         return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
     if args.what == "robot":
