@@ -75,6 +75,14 @@ def test_acceptance_command_reports_the_contract(seed7):
     assert all(link["dropped"] == 0 for link in r["links"].values()), "ideal drops nothing"
 
 
+def test_the_readme_explains_every_key_of_the_json(seed7):
+    from pathlib import Path
+
+    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    table = readme.split("### What `arena match --json` reports", 1)[1].split("\n\n", 2)[1]
+    assert [k for k in seed7 if f"`{k}`" not in table] == [], "add them to README's table"
+
+
 def test_same_seed_same_digest_other_seed_other_digest(seed7):
     again = arena_json(*BASE, "--seed", "7")
     assert again["digest"] == seed7["digest"]
