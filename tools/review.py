@@ -80,7 +80,7 @@ def print_review(r: dict, console: Console | None = None) -> None:
             f"keeper saves a {a['saves']}, b {b['saves']}; blocks a {a['blocks']}, b {b['blocks']}; "
             f"robot contact {f['contact_s']:.1f} pair-s"
         )
-    d = Table(title="distance per robot", caption=f"from the {r['distance_source']}")
+    d = Table(title="distance per robot", caption=f"from the {r['distance_source']}", min_width=30)
     d.add_column("robot")
     d.add_column(r"\[m]", justify="right")
     for name, m in r["distance_m"].items():
