@@ -888,9 +888,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
         from arena.runtime.links import resolve
+        from arena.strategies import registry
 
         resolve(args.link, {})
         MatchConfig(robots=args.robots, half_time=args.half_time, link=args.link).validate()
+        if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
+            registry.resolve_name(args.strategy)
     if args.what == "record":
         return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
     if args.what == "robot":

@@ -82,6 +82,7 @@ BAD = [
     (["bench", "match", "--half-time", "1e12"], "at most 3600 s"),
     (["bench", "match", "--half-time", "0.001"], "shorter than one tick"),  # before "run 1/3" is printed
     (["bench", "record", "--link", "moon"], "unknown link preset 'moon'"),  # was two empty matches, then no MCAP
+    (["bench", "throughput", "--strategy", "nope"], "unknown strategy 'nope'"),  # was an internal error
     (["bench", "nav", "--trials", "0"], "--trials: '0'"),
     (["bench", "nav", "--scenarios", "/nonexistent.toml"], "nonexistent.toml"),
     (["bench", "nav", "--only", "nosuch"], "nosuch"),
