@@ -117,6 +117,7 @@ class Follower:
         self.box = box  # a RefereeBox: its state, counts and summary stay the match's record
         self.params = box.rules.cfg.refbox
         host, port = rp.parse_endpoint(endpoint or self.params.follow)
+        self.endpoint = f"{host}:{port}"
         self.client = RefboxClient(host, port, log, source=source, name="follow")
         self.ball = (0.0, 0.0)
         self.applied = 0
@@ -147,6 +148,8 @@ class Follower:
 
     def summary(self) -> dict[str, object]:
         return {
+            "endpoint": self.endpoint,
+            "connected": self.client.connected.is_set(),  # ever, during the match
             "applied": self.applied,
             "ignored": dict(sorted(self.ignored.items())),
             "errors": len(self.client.errors),

@@ -355,6 +355,11 @@ class MatchConfig:
                 "--via-refbox needs --realtime: the RefBox protocol carries no tick, so a command read from "
                 "TCP cannot be given the lockstep tick it belongs to (docs/refbox.md)"
             )
+        if rb.follow and not self.realtime:
+            raise ConfigError(
+                "--refbox-follow needs --realtime: a human referee decides in wall-clock time, and the RefBox "
+                "protocol carries no tick to play a command at in lockstep (docs/refbox.md)"
+            )
         if rb.via and rb.listen.rsplit(":", 1)[-1] == "0":
             raise ConfigError("--via-refbox needs a fixed --refbox port (our base stations connect to it), not 0")
         if not -1 <= self.live <= 65535:

@@ -692,6 +692,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "sent_by_key": dict(sorted(sent_by_key.items())),
         "recording": recording,
         "refbox": sums["refbox"].extra if "refbox" in sums else None,
+        "refbox_follow": referee.extra.get("refbox_follow") if referee else None,
         "referee_log": referee.extra.get("log", []) if referee else [],
     }
 

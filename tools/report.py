@@ -55,6 +55,14 @@ def print_match(result: dict, console: Console | None = None) -> None:
             f"{rb['commands_forwarded']} commands forwarded; worldstates a {c.get('worldstates_a', 0)} "
             f"({errors.get('a', 0)} bad), b {c.get('worldstates_b', 0)} ({errors.get('b', 0)} bad)"
         )
+    fo = result.get("refbox_follow")
+    if fo:  # a human referee's RefBox: say whether it was ever there, or the match was a silent 0:0
+        ignored = sum(fo["ignored"].values())
+        state = "connected" if fo["connected"] else "[red]never connected[/]"
+        console.print(
+            f"refbox-follow {fo['endpoint']}: {state}; {fo['applied']} commands applied, "
+            f"{ignored} ignored, {fo['errors']} malformed"
+        )
     rec = result.get("recording")
     if rec and "error" in rec:  # no recorder Summary (tools/launcher.py)
         console.print(f"[red]not recorded[/]: {rec['error']} ({rec['path']})")

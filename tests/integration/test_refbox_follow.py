@@ -63,6 +63,8 @@ def test_refbox_follow_plays_the_scripted_commands(tmp_path):
     )
     assert refbox.peer == "127.0.0.1"
     assert result["score"] == [1, 0]
+    follow = result["refbox_follow"]
+    assert follow["endpoint"] == f"127.0.0.1:{refbox.port}" and follow["connected"] and follow["applied"] > 0
     assert result["events"] == {
         "FIRST_HALF": 1,
         "KICKOFF": 2,

@@ -52,6 +52,13 @@ def test_a_recorder_that_failed_is_reported_not_a_crash():
     assert f"not recorded: {why} (/x/m.mcap)" in console.export_text()
 
 
+def test_a_refbox_that_never_answered_is_said():
+    console = Console(record=True, width=200)
+    follow = {"endpoint": "10.0.0.9:28097", "connected": False, "applied": 0, "ignored": {}, "errors": 0}
+    report.print_match({**match_result(), "refbox_follow": follow}, console)
+    assert "refbox-follow 10.0.0.9:28097: never connected; 0 commands applied" in console.export_text()
+
+
 def test_version_matches_the_package():
     from importlib.metadata import version
 
