@@ -98,7 +98,9 @@ def replay(source: str | Recording, process: str) -> ReplayResult:
     except ConfigError as exc:
         raise ReplayError(str(exc)) from None
     cfg = rec.cfg
-    if pid.kind in ("recorder", "viewer") or pid not in cfg.processes():
+    if pid.kind in ("recorder", "viewer"):
+        raise ReplayError(f"{process}: only the lockstep nodes replay (engine, referee, base stations, robots)")
+    if pid not in cfg.processes():
         raise ReplayError(f"{process}: no such process in this recording ({cfg.robots} robots per team)")
     if pid.kind == "refbox":
         raise ReplayError("refbox: the RefBox bridge replays nothing: its worldstates came from outside the match")

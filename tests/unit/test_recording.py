@@ -331,6 +331,8 @@ def test_replay_refuses_what_it_cannot_do(recorded, tmp_path):
         replay.replay(str(path), "robot/a/7")
     with pytest.raises(replay.ReplayError, match="bad process name"):
         replay.replay(str(path), "goalpost")
+    with pytest.raises(replay.ReplayError, match="only the lockstep nodes replay"):
+        replay.replay(str(path), "recorder")  # it is in the recording, so not "no such process"
     rt, _ = record(tmp_path, "rt.mcap", MatchConfig(seed=1, half_time=0.2, realtime=True))
     with pytest.raises(replay.ReplayError, match="realtime"):
         replay.replay(str(rt), "robot/a/1")
