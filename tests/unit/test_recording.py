@@ -194,6 +194,15 @@ def test_review_reports_the_match(recorded):
     assert not r["truncated"] and r["complete"]
 
 
+def test_docs_explain_every_key_of_review_json(recorded):
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "recording.md").read_text()
+    table = doc.split("`--json` prints one object with these keys", 1)[1].split("\n\n", 2)[1]
+    r = analyse(load(str(recorded[0]), keep=NEEDED))
+    assert [k for k in [*r, "plots", "html"] if f"`{k}`" not in table] == [], "add them to docs/recording.md"
+
+
 def test_review_and_arena_facts_measure_the_same_match_the_same_way(recorded):
     """One analysis: the facts from the recording equal those `arena facts` measures in process."""
     path, _ = recorded
