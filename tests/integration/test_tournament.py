@@ -78,3 +78,14 @@ def test_resume_says_how_many_matches_it_kept(tmp_path):
     )
     assert f"--resume: 2 of 2 matches kept from {out}" in again.stderr
     assert json.loads(again.stdout)["skipped"] == 2
+
+
+def test_docs_explain_every_key_of_the_json(tmp_path):
+    from pathlib import Path
+
+    args = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "1", "--jobs", "1", *INPROCESS[:2])
+    summary = arena_json(*args, "--out", str(tmp_path / "t"))
+    doc = (Path(__file__).parents[2] / "docs" / "tournament.md").read_text()
+    tables = doc.split("### The keys of `tournament.json`", 1)[1].split("\n## ", 1)[0]
+    keys = [*summary, *summary["matches"][0]]
+    assert [k for k in keys if f"`{k}`" not in tables] == [], "add them to docs/tournament.md"
