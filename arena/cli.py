@@ -95,7 +95,8 @@ EXAMPLES = {
   arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
   arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
   arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio
-  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present (the model before 2026-11-26)""",
+  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present (the model before 2026-11-26)
+  arena facts --seeds 10 --home AD --away BS --json  # every match's facts and the totals per strategy, as JSON""",
     "replay": """examples:
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
   arena replay match.mcap --process basestation/b --json
@@ -470,6 +471,7 @@ def build_parser() -> Parser:
     fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
     fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
     fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
+    fa.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
     every_match_latency(fa)
 
     v = add("review", "summarise a match recording: score, goals, restarts, possession, links, timing")
@@ -946,6 +948,7 @@ def cmd_facts(args: argparse.Namespace) -> int:
         legs=args.legs,
         seed=args.seed,
         perception_latency=args.perception_latency,
+        as_json=args.json,
     )
 
 

@@ -15,6 +15,7 @@ with the tournament's own table code (tools/tournament.py).
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import os
 import sys
@@ -27,7 +28,7 @@ import msgspec
 from arena.recording.analysis.facts import MatchFacts, measure
 from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, TimingParams
 from arena.schemas.messages import Referee, World
-from arena.tools.facts_table import line, summary
+from arena.tools import facts_table
 from arena.tools.inprocess import play_in_process
 
 
@@ -105,6 +106,7 @@ def main(
     legs: int = 4,
     seed: int = 0,
     perception_latency: int | None = None,
+    as_json: bool = False,
 ) -> int:
     """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2."""
     workers = workers or min(2, os.cpu_count() or 1)
@@ -115,36 +117,25 @@ def main(
     latency = DEFAULT_PERCEPTION_LATENCY if perception_latency is None else perception_latency
     timing = TimingParams(perception_latency=latency)
     MatchConfig(timing=timing).validate()  # its range, as arena match checks it
-    print(f"perception latency {latency} ticks ({latency * timing.dt * 1000:g} ms)")
+    if not as_json:
+        print(f"perception latency {latency} ticks ({latency * timing.dt * 1000:g} ms)")
     t0 = time.monotonic()
+    results, names = None, [home, away]
     if round_robin_of:
         from arena.strategies import registry
-        from arena.tools.tournament import coverage, short, standings
 
         names = [registry.resolve_name(s) for s in round_robin_of]
         results, facts = round_robin(names, legs, half_time, seed, workers, timing)
-        for r, m in zip(results, facts):
-            print(f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}")
-        for row in summary(facts):
-            print(row)
-        cover = coverage(results, names)
-        print("team              W  D  L  GF  GA  GD   P   robot1 m  robot2 m  ratio")
-        for row in standings(results, names):
-            c = cover[row["team"]]
-            print(
-                f"{short(row['team']):16s} {row['W']:2d} {row['D']:2d} {row['L']:2d} {row['GF']:3d} {row['GA']:3d} "
-                f"{row['GD']:3d} {row['P']:3d}   {c['robot1_m']:7.1f}  {c['robot2_m']:7.1f}  {c['ratio']}"
-            )
-        print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s")
+    else:
+        cfgs = [
+            MatchConfig(seed=s, half_time=half_time, home=home, away=away, timing=timing)
+            for s in range(first_seed, first_seed + seeds)
+        ]
+        facts = many(cfgs, workers, progress=True)
+    if as_json:
+        print(json.dumps(facts_table.as_json(facts, latency, time.monotonic() - t0, results, names)))
         return 0
-    cfgs = [
-        MatchConfig(seed=s, half_time=half_time, home=home, away=away, timing=timing)
-        for s in range(first_seed, first_seed + seeds)
-    ]
-    facts = many(cfgs, workers, progress=True)
-    for m in facts:
-        print(line(m))
-    for row in summary(facts):
-        print(row)
-    print(f"in {time.monotonic() - t0:.0f} s")
+    lines = facts_table.round_robin_lines(results, facts, names) if results else [*map(facts_table.line, facts)]
+    print("\n".join(lines if results else [*lines, *facts_table.summary(facts)]))
+    print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s" if results else f"in {time.monotonic() - t0:.0f} s")
     return 0

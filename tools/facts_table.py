@@ -1,6 +1,9 @@
-"""`arena facts` output: one line per match and the totals per strategy."""
+"""`arena facts` output: one line per match, the totals per strategy, the round robin's
+table, and all of it as one JSON object (`--json`, documented in docs/strategies.md)."""
 
 from __future__ import annotations
+
+import dataclasses
 
 from arena.recording.analysis.facts import GOAL_FAR, GOAL_NEAR, OVERLAP_DEPTH, MatchFacts
 from arena.schemas.vocabulary import RESTARTS
@@ -25,6 +28,43 @@ def line(m: MatchFacts) -> str:
     return out
 
 
+def totals(facts: list[MatchFacts]) -> dict[str, dict[str, float]]:
+    """Totals over matches per strategy (a strategy met on both sides counts both); `summary` prints them."""
+    per: dict[str, dict[str, float]] = {}
+    for m in facts:
+        for k, t in enumerate(m.teams):
+            other = m.teams[1 - k]
+            row = per.setdefault(t.strategy, dict.fromkeys(TOTALS, 0))
+            row["sides"] += 1
+            row["W" if t.goals > other.goals else "D" if t.goals == other.goals else "L"] += 1
+            row["GF"] += t.goals
+            row["GA"] += other.goals
+            row["shots"] += t.shots
+            row["on_target"] += t.on_target
+            row["faced"] += other.on_target
+            row["saves"] += t.saves
+            row["blocks"] += t.blocks
+            row["stuck_s"] += t.stuck_s
+            row["longest_stuck_s"] = max(row["longest_stuck_s"], t.longest_stuck_s)
+            row["corner_s"] += t.corner_s
+            row["conceded_while_stuck"] += t.conceded_while_stuck
+            row["pushing"] += t.pushing
+            row["dribbling"] += t.dribbling
+            for g in t.goal_shots:
+                row["goals_near" if g < GOAL_NEAR else "goals_mid" if g < GOAL_FAR else "goals_far"] += 1
+            if len(t.distance_m) > 2:
+                row["robot1_m"] += t.distance_m[1]
+                row["robot2_m"] += t.distance_m[2]
+    return per
+
+
+# The keys of a `totals` row, in `arena facts --json` ("strategies") and docs/strategies.md.
+TOTALS = (
+    "sides W D L GF GA shots on_target faced saves blocks stuck_s longest_stuck_s corner_s conceded_while_stuck "
+    "pushing dribbling goals_near goals_mid goals_far robot1_m robot2_m"
+).split()
+
+
 def summary(facts: list[MatchFacts]) -> list[str]:
     """Totals over matches, per strategy (a strategy met on both sides counts both)."""
     goals = [sum(m.score) for m in facts]
@@ -35,55 +75,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
     ]
     if not facts[0].teams:
         return out
-    per: dict[str, dict[str, float]] = {}
-    for m in facts:
-        for k, t in enumerate(m.teams):
-            other = m.teams[1 - k]
-            row = per.setdefault(
-                t.strategy,
-                {
-                    "sides": 0,
-                    "W": 0,
-                    "D": 0,
-                    "L": 0,
-                    "GF": 0,
-                    "GA": 0,
-                    "shots": 0,
-                    "on_target": 0,
-                    "faced": 0,
-                    "saves": 0,
-                    "blocks": 0,
-                    "stuck": 0.0,
-                    "longest": 0.0,
-                    "corner": 0.0,
-                    "conceded_stuck": 0,
-                    "pushing": 0,
-                    "d1": 0.0,
-                    "d2": 0.0,
-                    "g_near": 0,
-                    "g_mid": 0,
-                    "g_far": 0,
-                },
-            )
-            row["sides"] += 1
-            row["W" if t.goals > other.goals else "D" if t.goals == other.goals else "L"] += 1
-            row["GF"] += t.goals
-            row["GA"] += other.goals
-            row["shots"] += t.shots
-            row["on_target"] += t.on_target
-            row["faced"] += other.on_target
-            row["saves"] += t.saves
-            row["blocks"] += t.blocks
-            row["stuck"] += t.stuck_s
-            row["longest"] = max(row["longest"], t.longest_stuck_s)
-            row["corner"] += t.corner_s
-            row["conceded_stuck"] += t.conceded_while_stuck
-            row["pushing"] += t.pushing
-            for g in t.goal_shots:
-                row["g_near" if g < GOAL_NEAR else "g_mid" if g < GOAL_FAR else "g_far"] += 1
-            if len(t.distance_m) > 2:
-                row["d1"] += t.distance_m[1]
-                row["d2"] += t.distance_m[2]
+    per = totals(facts)
     out.append(
         "strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
         "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2"
@@ -93,11 +85,12 @@ def summary(facts: list[MatchFacts]) -> list[str]:
     for s, r in sorted(per.items()):
         s = short(s)
         k = r["sides"]
-        ratio = f"{r['d1'] / r['d2']:.2f}" if r["d2"] > 0 else "-"
+        ratio = f"{r['robot1_m'] / r['robot2_m']:.2f}" if r["robot2_m"] > 0 else "-"
         out.append(
             f"{s:8s}  {k:5d} {r['W']:2d} {r['D']:2d} {r['L']:2d} {r['GF']:3d} {r['GA']:3d}  {r['GF'] / k:10.2f}  "
             f"{r['shots']:5d}  {r['on_target']:9d}  {r['faced']:5d}  {r['saves']:5d}  {r['blocks']:6d}  "
-            f"{r['stuck'] / k:12.1f}  {r['longest']:13.1f}  {r['corner'] / k:13.1f}  {r['conceded_stuck']:14d}  "
+            f"{r['stuck_s'] / k:12.1f}  {r['longest_stuck_s']:13.1f}  {r['corner_s'] / k:13.1f}  "
+            f"{r['conceded_while_stuck']:14d}  "
             f"{r['pushing']:7d}  {ratio:>13s}"
         )
     out.append(
@@ -105,7 +98,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         " / not from a detected on-target shot):"
     )
     for s, r in sorted(per.items()):
-        near, mid, far = r["g_near"], r["g_mid"], r["g_far"]
+        near, mid, far = r["goals_near"], r["goals_mid"], r["goals_far"]
         out.append(f"  {short(s):8s} scored {near:3d} / {mid:3d} / {far:3d} / {r['GF'] - near - mid - far:3d}")
     contact = sum(m.contact_s for m in facts) / n
     overlap = sum(m.overlap_s for m in facts) / n
@@ -114,4 +107,44 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         f"robot-robot contact {contact:.1f} pair-s per match; overlap > {OVERLAP_DEPTH * 100:.0f} cm "
         f"{overlap:.2f} pair-s per match; deepest overlap {deepest * 100:.1f} cm"
     )
+    return out
+
+
+def round_robin_lines(results: list, facts: list[MatchFacts], names: list[str]) -> list[str]:
+    """A round robin: one line per match, then the paper's Table 2 with the Fig. 9 coverage."""
+    from arena.tools.tournament import coverage, short, standings
+
+    out = [
+        f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}"
+        for r, m in zip(results, facts)
+    ]
+    out += summary(facts)
+    cover = coverage(results, names)
+    out.append("team              W  D  L  GF  GA  GD   P   robot1 m  robot2 m  ratio")
+    for row in standings(results, names):
+        c = cover[row["team"]]
+        out.append(
+            f"{short(row['team']):16s} {row['W']:2d} {row['D']:2d} {row['L']:2d} {row['GF']:3d} {row['GA']:3d} "
+            f"{row['GD']:3d} {row['P']:3d}   {c['robot1_m']:7.1f}  {c['robot2_m']:7.1f}  {c['ratio']}"
+        )
+    return out
+
+
+def as_json(facts: list[MatchFacts], latency: int, seconds: float, results: list | None, names: list[str]) -> dict:
+    """`arena facts --json`: every match's facts, the totals per strategy, and a round robin's table."""
+    n = len(facts)
+    out = {
+        "perception_latency": latency,
+        "matches": [dataclasses.asdict(m) for m in facts],
+        "strategies": totals(facts),
+        "contact_s_per_match": sum(m.contact_s for m in facts) / n,
+        "overlap_s_per_match": sum(m.overlap_s for m in facts) / n,
+        "deepest_overlap_m": max(m.max_overlap_m for m in facts),
+        "seconds": round(seconds, 1),
+    }
+    if results is not None:
+        from arena.tools.tournament import coverage, standings
+
+        out["standings"] = standings(results, names)
+        out["coverage"] = coverage(results, names)
     return out
