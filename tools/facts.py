@@ -135,7 +135,10 @@ def main(
     if as_json:
         print(json.dumps(facts_table.as_json(facts, latency, time.monotonic() - t0, results, names)))
         return 0
-    lines = facts_table.round_robin_lines(results, facts, names) if results else [*map(facts_table.line, facts)]
-    print("\n".join(lines if results else [*lines, *facts_table.summary(facts)]))
-    print(f"{len(facts)} matches in {time.monotonic() - t0:.0f} s" if results else f"in {time.monotonic() - t0:.0f} s")
+    took = f"in {time.monotonic() - t0:.0f} s"
+    if results:
+        lines = [*facts_table.round_robin_lines(results, facts, names), f"{len(facts)} matches {took}"]
+    else:
+        lines = [*map(facts_table.line, facts), *facts_table.summary(facts), took]
+    print("\n".join(lines))
     return 0
