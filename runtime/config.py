@@ -31,6 +31,7 @@ MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 1
 MAX_PERCEPTION_LATENCY = 25  # [ticks] 0.5 s at 50 Hz: far beyond any real vision pipeline
 MAX_DT = 0.1  # [s] a control tick of at most 100 ms (10 Hz): slower is no robot's control loop
 MAX_SUBSTEPS = 100  # physics steps per tick
+MAX_PERIOD_S = 1.0  # [s] the Wi-Fi, referee and world periods: slower plays no recognisable match
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
@@ -321,8 +322,13 @@ class MatchConfig:
             raise ConfigError(
                 f"timing: dt must be in (0, {MAX_DT:g}] s and substeps in 1..{MAX_SUBSTEPS}, got {t.dt} and {t.substeps}"
             )
-        if t.comm_period < 1 or t.referee_period < 1 or t.world_period < 1:
-            raise ConfigError("timing: every period must be >= 1 tick")
+        longest = max(1, round(MAX_PERIOD_S / t.dt))  # a referee once a day would never start play
+        for name in ("comm_period", "referee_period", "world_period"):
+            if not 1 <= getattr(t, name) <= longest:
+                raise ConfigError(
+                    f"timing.{name} must be 1 tick to {MAX_PERIOD_S:g} s ({longest} ticks of {t.dt:g} s), "
+                    f"got {getattr(t, name)}"
+                )
         if self.half_ticks < 1:
             raise ConfigError(f"--half-time {self.half_time} is shorter than one tick")
         if not 0 <= t.perception_latency <= MAX_PERCEPTION_LATENCY:

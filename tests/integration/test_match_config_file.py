@@ -51,6 +51,8 @@ def test_a_custom_field_size_plays_a_match(tmp_path):
         ("[timing]\ndt = 0\n", "timing: dt must be in (0, 0.1] s"),  # was a ZeroDivisionError
         ("[timing]\ndt = nan\n", "timing: dt must be in (0, 0.1] s"),
         ("[timing]\nsubsteps = 100000\n", "substeps in 1..100"),
+        ("[timing]\ncomm_period = 0\n", "timing.comm_period must be 1 tick to 1 s (50 ticks of 0.02 s), got 0"),
+        ("[timing]\nreferee_period = 100000000\n", "timing.referee_period must be 1 tick to 1 s"),  # no play at all
         ("[field]\nwidth = 1e308\n", "field.width must be at most 100 m"),
         ("[robot]\nwheel_radius = 0\n", "robot.wheel_radius must be > 0"),  # was the engine's LinAlgError
         ("[robot]\nsize = 50\n", "robot.size must be at most 2 m"),
