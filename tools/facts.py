@@ -109,7 +109,10 @@ def main(
     as_json: bool = False,
 ) -> int:
     """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2."""
+    from arena.strategies import registry
+
     workers = workers or min(2, os.cpu_count() or 1)
+    home, away = registry.resolve_name(home), registry.resolve_name(away)  # as arena match: AD is advance-dynamic
     if seeds < 1 or legs < 1 or workers < 1:
         raise ConfigError(f"--seeds, --legs and --workers must be at least 1 (got {seeds}, {legs}, {workers})")
     if not half_time > 0:
@@ -122,8 +125,6 @@ def main(
     t0 = time.monotonic()
     results, names = None, [home, away]
     if round_robin_of:
-        from arena.strategies import registry
-
         names = [registry.resolve_name(s) for s in round_robin_of]
         results, facts = round_robin(names, legs, half_time, seed, workers, timing)
     else:

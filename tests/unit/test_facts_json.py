@@ -28,7 +28,7 @@ def test_seeds_as_json_add_up_and_are_documented():
     out = facts_json("--seeds", "2", "--first-seed", "3", "--home", "AD", "--away", "BS", "--half-time", "4")
     assert [m["seed"] for m in out["matches"]] == [3, 4]
     assert out["perception_latency"] == 3
-    ad = out["strategies"]["AD"]
+    ad = out["strategies"]["advance-dynamic"]  # named in full, as by arena match and tournament.json
     assert ad["sides"] == 2
     assert ad["GF"] == sum(m["teams"][0]["goals"] for m in out["matches"])
     assert ad["GA"] == sum(m["teams"][1]["goals"] for m in out["matches"])
@@ -38,10 +38,15 @@ def test_seeds_as_json_add_up_and_are_documented():
     assert undocumented([*out, *match, *team, *ad]) == []
 
 
+def test_a_strategy_is_one_strategy_by_any_of_its_names():
+    out = facts_json("--seeds", "1", "--home", "AD", "--away", "advance-dynamic", "--half-time", "1")
+    assert list(out["strategies"]) == ["advance-dynamic"] and out["strategies"]["advance-dynamic"]["sides"] == 2
+
+
 def test_round_robin_as_json_has_the_table():
     out = facts_json("--round-robin", "AD,BS", "--legs", "2", "--half-time", "2", "--perception-latency", "0")
     assert out["perception_latency"] == 0
-    names = {"advance-dynamic", "basic-static"}  # the round robin names strategies in full, as tournament.json
+    names = {"advance-dynamic", "basic-static"}
     assert {row["team"] for row in out["standings"]} == names == set(out["coverage"]) == set(out["strategies"])
     assert sum(row["W"] + row["D"] + row["L"] for row in out["standings"]) == 4
     assert undocumented([*out, *out["standings"][0], *out["coverage"]["basic-static"]]) == []
