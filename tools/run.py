@@ -286,9 +286,10 @@ def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
 ROUTER_ROBOTS = 6  # a standalone router's credentials cover every robot a configuration may ask for
 
 
-def secure_router(match: str, net: NetConfig, directory: str) -> NetConfig:
+def secure_router(match: str, net: NetConfig, directory: str, private: Path) -> NetConfig:
     """A secure match's router (`arena run router --credentials DIR`): every principal's credentials
-    file written into DIR, the router's passwords, access control and TLS certificate in its config."""
+    file written into DIR, the router's passwords (a file in `private`, ours alone), access control
+    and TLS certificate in its config."""
     if len(net.listen) != 1:
         raise ConfigError("arena run router --credentials needs one --listen endpoint")
     endpoint, tls = secure_endpoint(net.listen[0])
@@ -298,7 +299,6 @@ def secure_router(match: str, net: NetConfig, directory: str) -> NetConfig:
         secrets.write(Path(directory))
     except OSError as exc:
         raise ConfigError(f"cannot write --credentials {directory}: {exc.strerror}") from None
-    private = Path(tempfile.mkdtemp(prefix="arena-router-"))  # the password dictionary stays ours
     return NetConfig(
         mode="router", listen=(endpoint,), connect=net.connect, extra=(*net.extra, *secrets.router_settings(private))
     )
@@ -306,10 +306,13 @@ def secure_router(match: str, net: NetConfig, directory: str) -> NetConfig:
 
 def run_router(match: str, net: NetConfig, credentials: str | None = None) -> int:
     """A zenoh router for one match; exits when every process of the match has left."""
-    signal.signal(signal.SIGTERM, _sigterm)
+    signal.signal(signal.SIGTERM, _sigterm)  # SystemExit: the password dictionary goes too
+    with tempfile.TemporaryDirectory(prefix="arena-router-") as private:
+        return _route(match, secure_router(match, net, credentials, Path(private)) if credentials else net)
+
+
+def _route(match: str, net: NetConfig) -> int:
     keys = Keys(match)
-    if credentials:
-        net = secure_router(match, net, credentials)
     alive: set[str] = set()
     seen = [False]
 

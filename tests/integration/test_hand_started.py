@@ -97,3 +97,23 @@ def test_a_hand_started_robot_says_whom_it_waits_for_and_the_final_score(tmp_pat
         "b (advance-dynamic)"
     )
     second.communicate(timeout=30)
+
+
+def test_a_secure_router_takes_its_password_dictionary_with_it(tmp_path, reap):
+    """`arena run router --credentials DIR` (arena up) wrote every principal's password into a temp
+    directory of its own and left it behind, after Ctrl-C, SIGTERM or the end of its match alike."""
+    import os
+    import signal
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    port, creds = free_port(), tmp_path / "creds"
+    router = spawn(
+        *("run", "router", "--match", "m", "--listen", f"tls/127.0.0.1:{port}", "--credentials", str(creds)),
+        env={**os.environ, "TMPDIR": str(temp)},
+    )
+    reap.append(router)
+    wait_for(lambda: [*temp.glob("arena-router-*/*")], 30, "the router's password dictionary")
+    router.send_signal(signal.SIGTERM)
+    router.communicate(timeout=30)
+    assert [*temp.iterdir()] == []

@@ -74,6 +74,8 @@ def test_a_standalone_secure_router_serves_the_viewer_it_wrote_credentials_for_w
     from arena.runtime.session import NetConfig
     from arena.tools.run import secure_router
 
-    net = secure_router("m1", NetConfig(mode="router", listen=(f"unixsock-stream/{tmp_path}/r.sock",)), str(tmp_path))
+    net = secure_router(
+        "m1", NetConfig(mode="router", listen=(f"unixsock-stream/{tmp_path}/r.sock",)), str(tmp_path), tmp_path
+    )
     rule = viewer_rule(net.extra)
     assert rule["zids"] == [load_fragment(str(tmp_path / "viewer.json5"))["id"]]
