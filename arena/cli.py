@@ -21,6 +21,8 @@ import dataclasses
 import json
 import logging
 import math
+import os
+import signal
 import sys
 from typing import NoReturn
 
@@ -993,6 +995,22 @@ def cmd_schemas(args: argparse.Namespace) -> int:
     return contract.main(check=args.check, write=args.write)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (`kill`, a service manager): stopped and cleaned up as Ctrl-C is, exit code 143.
+    The processes a match forks set SIGTERM back to its default (tools/forkstart.py)."""
+
+
+_TERMINATED_IN: list[int] = []  # the pid that installed `_terminated`
+
+
+def _terminated(signum, frame):  # noqa: ARG001 - signal handler signature
+    if os.getpid() not in _TERMINATED_IN:  # a child forked before it set SIGTERM back: die as by default
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return
+    raise Terminated
+
+
 def main(argv: list[str] | None = None) -> int:
     try:
         args = parser().parse_args(argv)
@@ -1011,18 +1029,22 @@ def main(argv: list[str] | None = None) -> int:
         "facts": cmd_facts,
         "replay": cmd_replay,
     }
+    if args.command in ("match", "up", "bench", "facts", "review"):  # tournament and run have their own
+        _TERMINATED_IN.append(os.getpid())
+        signal.signal(signal.SIGTERM, _terminated)
     try:
         return handlers[args.command](args)
     except ConfigError as exc:
         print(f"arena {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        stopped = "; every process of the match was stopped" if args.command in ("match", "facts", "bench") else ""
-        print(f"arena {args.command}: interrupted{stopped}", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        stopped = (
+            "; every process of the match was stopped" if args.command in ("match", "up", "facts", "bench") else ""
+        )
+        said, code = ("terminated", 143) if isinstance(exc, Terminated) else ("interrupted", 130)
+        print(f"arena {args.command}: {said}{stopped}", file=sys.stderr)
+        return code
     except BrokenPipeError:  # `arena ... | head`: the reader left; nothing to say
-        import os
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
     except OSError as exc:  # a file or directory the user named: missing, read-only, full disk
@@ -1035,7 +1057,6 @@ def main(argv: list[str] | None = None) -> int:
 
 def internal_error(command: str, exc: BaseException) -> int:
     """A bug, not the user's fault: the traceback goes to a log file, one line names it; exit 1."""
-    import os
     import tempfile
     import traceback
 

@@ -28,7 +28,7 @@ import msgspec
 from arena.recording.analysis.facts import MatchFacts, measure
 from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, TimingParams
 from arena.schemas.messages import Referee, World
-from arena.tools import facts_table
+from arena.tools import facts_table, pools
 from arena.tools.inprocess import play_in_process
 
 
@@ -49,7 +49,8 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
     console, bar_shown = Console(stderr=True), progress and sys.stderr.isatty()
     columns = (TextColumn("[bold]facts[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context) as pool:
+    pool, stopped = ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context), True
+    try:  # Ctrl-C or SIGTERM: the workers are killed, not waited for (tools/pools.py)
         futures = {pool.submit(match_facts, cfg): cfg for cfg in cfgs}
         with Progress(*columns, console=console, disable=not bar_shown) as bar:
             task = bar.add_task("m", total=len(cfgs))
@@ -58,7 +59,10 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
                 if progress and not bar_shown:
                     c, (h, a) = futures[future], future.result().score
                     console.print(f"[{done}/{len(cfgs)}] seed {c.seed}: {c.home} {h}:{a} {c.away}", highlight=False)
+        stopped = False
         return [f.result() for f in futures]
+    finally:
+        pools.stop(pool, now=stopped)
 
 
 def round_robin(

@@ -37,6 +37,7 @@ from itertools import combinations
 from pathlib import Path
 
 from arena.runtime import seeds
+from arena.tools import pools
 
 ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
 
@@ -614,12 +615,7 @@ class Runner:
 
     def close(self) -> None:
         if self.pool is not None:
-            workers = list((getattr(self.pool, "_processes", None) or {}).values())  # shutdown sets it to None
-            self.pool.shutdown(wait=not self.stopping, cancel_futures=True)
-            if self.stopping:
-                for p in workers:
-                    if p.is_alive():
-                        p.kill()
+            pools.stop(self.pool, now=self.stopping)
 
     def command(self, fx: Fixture) -> list[str]:
         a = self.opts

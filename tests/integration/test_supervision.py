@@ -9,6 +9,8 @@ import signal
 import tempfile
 from pathlib import Path
 
+import pytest
+
 from tests.integration.helpers import alive, cmdline, descendants, spawn, wait_for, wait_until_playing
 
 MATCH = ("match", "--home", "BS", "--away", "BS", "--seed", "3", "--json")
@@ -42,15 +44,23 @@ def match_dirs() -> set[Path]:
     return set(Path(tempfile.gettempdir()).glob("arena-*"))
 
 
-def test_ctrl_c_stops_every_process(reap):
+@pytest.mark.parametrize(
+    ("sig", "code", "said"),
+    [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")],
+    ids=["ctrl-c", "sigterm"],
+)
+def test_ctrl_c_or_sigterm_stops_every_process(reap, sig, code, said):
+    """SIGTERM (kill, a service manager) stops as Ctrl-C does; it used to leave the match's temp
+    dir behind, its credentials included, and say nothing."""
     before = match_dirs()
     proc = spawn(*MATCH, "--half-time", "300")
     reap.append(proc)
     kids = all_ten(proc.pid)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
-    assert proc.returncode == 130
-    assert "interrupted" in err and "Traceback" not in err
+    assert proc.returncode == code, err
+    assert err.strip().splitlines()[-1] == f"arena match: {said}; every process of the match was stopped"
+    assert "Traceback" not in err
     survivors = [p for p in kids if alive(p)]
     assert survivors == [], f"orphans: {survivors}"
     assert match_dirs() - before == set(), "an interrupted match leaves no temp dir behind"
@@ -98,3 +108,20 @@ def test_a_hung_robot_is_declared_dead_after_a_bounded_wait(reap, tmp_path):
     # said when it happened, not only in the result
     assert "robot/b/2 stopped responding: its liveliness token vanished" in err and "the match plays on" in err, err
     wait_for(lambda: not alive(victim), 10, "the hung robot to be stopped")
+
+
+def test_sigterm_stops_arena_facts_and_its_workers_now(reap):
+    """SIGTERM reaches only the parent: its pool waited for every running match to end (a 2 x 3600 s
+    match here), where Ctrl-C on a terminal reaches the workers too."""
+    proc = spawn("facts", "--seeds", "2", "--half-time", "3600", "--home", "AD", "--away", "BS")
+    reap.append(proc)
+    workers = wait_for(
+        lambda: w if len(w := {p for p in descendants(proc.pid) if "spawn_main" in cmdline(p)}) == 2 else None,
+        60,
+        "two workers playing",
+    )
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert err.strip().splitlines()[-1] == "arena facts: terminated; every process of the match was stopped"
+    wait_for(lambda: not [p for p in workers if alive(p)], 10, "the workers to be gone")
