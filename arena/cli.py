@@ -109,7 +109,7 @@ EXAMPLES = {
   arena config --check match.toml             # one line naming the bad key, or the whole file completed""",
     "strategies": """examples:
   arena strategies                 # every strategy, built-in or plugin, and whether it passes the conformance suite
-  arena strategies AD my-plugin    # only these
+  arena strategies AD chase        # only these (a plugin by its name too)
   arena strategies --no-check --json""",
     "schemas": """examples:
   arena schemas --check            # is schemas/README.md up to date with schemas/messages.py?
