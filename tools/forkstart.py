@@ -292,6 +292,8 @@ def _child(argv: list[str], log_path: Path, go_r: int, go_w: int, parent: int) -
         code = main(argv)
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else 1
+    except KeyboardInterrupt:  # Ctrl-C reached it before it had its own session: the launcher says so
+        code = 130
     except BaseException:
         traceback.print_exc()
         code = 1
