@@ -4,13 +4,31 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import socket
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+import pytest
+
 ARENA = [sys.executable, "-m", "arena"]
+
+
+def system_program(*names: str, install: str) -> str:
+    """The path of the first of `names` on PATH.
+
+    An optional system program (README's "Tests" names them) that is absent skips the test with the command
+    that installs it, so a fresh machine passes; with CI set (`.ci/run` installs them) absence fails instead.
+    """
+    for name in names:
+        if exe := shutil.which(name):
+            return exe
+    reason = f"{names[0]} is not installed: {install} (.ci/run installs it)"
+    if os.environ.get("CI"):
+        pytest.fail(f"{reason}; CI is set, so this test must run", pytrace=False)
+    pytest.skip(reason)
 
 
 def arena_json(*args: str, timeout: float = 240.0, env: dict | None = None) -> dict:

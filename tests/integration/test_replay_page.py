@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
-from tests.integration.helpers import ARENA, arena_json
+from tests.integration.helpers import ARENA, arena_json, system_program
 
 CHROMIUM_FLAGS = [
     "--headless",
@@ -26,9 +25,7 @@ CHROMIUM_FLAGS = [
 
 
 def chromium() -> str:
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    assert exe, "headless Chromium is needed: apt-get install -y chromium (.ci/run installs it)"
-    return exe
+    return system_program("chromium", "chromium-browser", install="apt-get install -y chromium")
 
 
 @pytest.fixture(scope="module")
