@@ -87,7 +87,7 @@ EXAMPLES = {
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
-  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/navbench/navbench.toml)""",
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)""",
     "review": """examples:
   arena review match.mcap                    # teams, score, goals, restarts, possession, links, timing
   arena review match.mcap --json
@@ -231,7 +231,7 @@ _PARSER: list[Parser] = []
 
 def parser() -> Parser:
     """The parser, built once per process: building it takes ~40 ms, and a forked match
-    process (tools/forkstart.py) gets it ready-made from the launcher."""
+    process (tools/launch/forkstart.py) gets it ready-made from the launcher."""
     if not _PARSER:
         _PARSER.append(build_parser())
     return _PARSER[0]
@@ -456,7 +456,9 @@ def build_parser() -> Parser:
     )
     b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
     b.add_argument(
-        "--scenarios", metavar="FILE", help="nav: scenario file (default: the built-in tools/navbench/navbench.toml)"
+        "--scenarios",
+        metavar="FILE",
+        help="nav: scenario file (default: the built-in tools/experiments/navbench/navbench.toml)",
     )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
@@ -569,9 +571,10 @@ def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
     """Print a match result (arena match, arena up): one JSON object, or the tables.
 
     Faults and keys with two senders are also printed on stderr, one line
-    each. A void match (tools/faults.py) exits 1 with one line naming the cause.
+    each. A void match (tools/launch/faults.py) exits 1 with one line naming the cause.
     """
-    from arena.tools import faults, report
+    from arena.tools.launch import faults
+    from arena.tools.review import report
 
     if as_json:
         result.pop("referee_log", None)
@@ -587,7 +590,7 @@ def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
 
 
 def cmd_match(args: argparse.Namespace) -> int:
-    from arena.tools import launcher
+    from arena.tools.launch import launcher
 
     missing = [f for f, v in (("--home", args.home), ("--away", args.away)) if v is None]
     if missing and not args.config_file:
@@ -690,7 +693,7 @@ def one_line(text: str) -> str:
 
 def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = "") -> int:
     """`arena match --engine inprocess`: flags that need separate processes are refused."""
-    from arena.tools import inprocess
+    from arena.tools.launch import inprocess
 
     for flag, given in (
         ("--realtime", args.realtime),
@@ -765,7 +768,7 @@ def record_path(text: str) -> str:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from arena.runtime.session import NetConfig
-    from arena.tools import run as runner
+    from arena.tools.launch import run as runner
 
     logging.basicConfig(
         level=args.log_level, format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr
@@ -819,7 +822,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_up(args: argparse.Namespace) -> int:
-    from arena.tools import compose
+    from arena.tools.launch import compose
 
     try:
         result = compose.up(args.file, timeout=args.timeout)
@@ -834,7 +837,7 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
-    from arena.tools import tournament
+    from arena.tools.experiments import tournament
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ConfigError(f"--out {args.out} exists and is not a directory")
@@ -853,7 +856,7 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 
         MatchConfig(timing=TimingParams(perception_latency=args.perception_latency)).validate()
     if args.ray is not None:
-        from arena.tools.cluster import parse_address, parse_runtime_env
+        from arena.tools.experiments.cluster import parse_address, parse_runtime_env
 
         parse_address(args.ray)
         parse_runtime_env(args.ray_runtime_env)
@@ -888,7 +891,7 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from arena.tools import bench
+    from arena.tools.experiments import bench
 
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
         from arena.runtime.links import resolve
@@ -903,11 +906,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.what == "robot":
         return bench.bench_robot(args.strategy, args.json)
     if args.what == "throughput":
-        from arena.tools import throughput
+        from arena.tools.experiments import throughput
 
         return throughput.bench_throughput(args.runs, args.half_time, args.robots, args.link, args.strategy, args.json)
     if args.what == "nav":
-        from arena.tools import navbench
+        from arena.tools.experiments import navbench
 
         return navbench.main(
             scenarios=args.scenarios,
@@ -923,7 +926,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_review(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from arena.tools import review
+    from arena.tools.review import review
 
     if args.plots and Path(args.plots).exists() and not Path(args.plots).is_dir():
         raise ConfigError(f"--plots {args.plots} exists and is not a directory")
@@ -935,7 +938,7 @@ def cmd_review(args: argparse.Namespace) -> int:
 
 
 def cmd_facts(args: argparse.Namespace) -> int:
-    from arena.tools import facts
+    from arena.tools.experiments import facts
 
     if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
         raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")
@@ -955,7 +958,7 @@ def cmd_facts(args: argparse.Namespace) -> int:
 
 
 def cmd_replay(args: argparse.Namespace) -> int:
-    from arena.tools import replay
+    from arena.tools.review import replay
 
     return replay.main(args.file, args.process, as_json=args.json)
 
@@ -997,7 +1000,7 @@ def cmd_schemas(args: argparse.Namespace) -> int:
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM (`kill`, a service manager): stopped and cleaned up as Ctrl-C is, exit code 143.
-    The processes a match forks set SIGTERM back to its default (tools/forkstart.py)."""
+    The processes a match forks set SIGTERM back to its default (tools/launch/forkstart.py)."""
 
 
 _TERMINATED_IN: list[int] = []  # the pid that installed `_terminated`

@@ -287,7 +287,7 @@ class EngineNode(Node):
 
     def lockstep(self) -> Waits:
         # The field frame is part of the loop, not of `loop()`: whoever drives the
-        # generator (Reactor, pull, the cooperative driver of tools/inprocess.py)
+        # generator (Reactor, pull, the cooperative driver of tools/launch/inprocess.py)
         # sends it first, so the engine's digest is the same under every driver.
         self.field_out.send(self.field_spec())
         last = self.cfg.total_ticks

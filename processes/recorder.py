@@ -490,7 +490,7 @@ class RecorderNode(Node):
         if self.interrupted:
             raise SystemExit(128 + signal.Signals[self.interrupted].value)
 
-    # A cooperative match (tools/inprocess.py) calls these two instead of `loop`.
+    # A cooperative match (tools/launch/inprocess.py) calls these two instead of `loop`.
     def pump(self) -> None:
         """Take in the tap batches and summaries that are there; write what every watermark passed."""
         self._drain()

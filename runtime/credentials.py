@@ -115,7 +115,7 @@ class Secrets:
         """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
 
         `more`: zenoh settings added to some principals' fragments (top-level keys),
-        e.g. the launcher's own peers' `qos` (tools/launcher.py, `relay_safe`)."""
+        e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`)."""
         directory.mkdir(parents=True, exist_ok=True)
         out = {}
         for p in principals(self.processes):

@@ -1,3 +1,5 @@
-"""What the `arena` commands do: the launcher and supervision of a match,
-`arena run`/`up`, tournaments, benchmarks, review, replay and the navigation
-benchmark. May import every package below it; only `arena.cli` imports it."""
+"""What the `arena` commands do, in three sub-packages by concern:
+`launch` (start, supervise and collect one match, either engine),
+`experiments` (many matches: tournaments, clusters, facts, benchmarks) and
+`review` (looking back at a recorded match). May import every package below
+it; only `arena.cli` and `arena.commands` import it."""

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from arena.runtime.config import MatchConfig
-from arena.tools.inprocess import play_in_process
+from arena.tools.launch.inprocess import play_in_process
 
 HERE = Path(__file__).resolve().parent
 STRATS = ("basic-static", "basic-dynamic", "advance-static", "advance-dynamic", "chase")

@@ -170,7 +170,7 @@ def test_worker_with_another_version_refuses(cluster):
     c, _ = cluster
     script = f"""
 import json, ray
-from arena.tools import cluster
+from arena.tools.experiments import cluster
 ray.init(address={c.address!r}, logging_level="ERROR", log_to_driver=False)
 task = ray.remote(cluster.play_on_worker).options(num_cpus=1)
 mine = cluster.fingerprint()
@@ -196,7 +196,7 @@ from arena.cli import main
 code = main(["tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "1", "--jobs", "1",
              "--out", {str(tmp_path)!r}, "--json"])
 assert code == 0, code
-assert "ray" not in sys.modules and "arena.tools.cluster" not in sys.modules, "Ray was imported"
+assert "ray" not in sys.modules and "arena.tools.experiments.cluster" not in sys.modules, "Ray was imported"
 """
     r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr[-3000:]

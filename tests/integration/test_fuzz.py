@@ -186,7 +186,7 @@ class Launcher:
         except subprocess.TimeoutExpired:
             pass
         stuck = sorted((pid, cmdline(pid)) for pid in descendants(self.proc.pid) if alive(pid))
-        for pid, _ in stuck:  # each `arena run` writes every thread's stack to its log (tools/run.py)
+        for pid, _ in stuck:  # each `arena run` writes every thread's stack to its log (tools/launch/run.py)
             os.kill(pid, signal.SIGUSR1)
         time.sleep(1.0)
         tails = "".join(

@@ -9,7 +9,7 @@ import pytest
 
 from arena.runtime.config import MatchConfig
 from arena.runtime.links import PRESETS
-from arena.tools.inprocess import play_in_process
+from arena.tools.launch.inprocess import play_in_process
 from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 
 BASE = ("match", "--home", "basic-static", "--away", "basic-static", "--half-time", "30")

@@ -9,7 +9,7 @@ import subprocess
 import pytest
 
 from arena.runtime.config import ConfigError
-from arena.tools.tournament import Result, TournamentOptions, check_resume, report, settings
+from arena.tools.experiments.tournament import Result, TournamentOptions, check_resume, report, settings
 from tests.integration.helpers import ARENA
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--seed", "5", "--jobs", "1")

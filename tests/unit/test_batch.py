@@ -17,7 +17,7 @@ import pytest
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.runtime.lockstep import MAX_BATCH, Outbound
 from arena.schemas.messages import Cmd, encode
-from arena.tools.inprocess import play_in_process
+from arena.tools.launch.inprocess import play_in_process
 from tests.unit.test_lockstep import KEY, Harness
 
 

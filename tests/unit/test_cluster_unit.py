@@ -1,4 +1,4 @@
-"""tools/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
+"""tools/experiments/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
 
 The real cluster is exercised in tests/integration/test_cluster.py.
 """
@@ -13,8 +13,8 @@ from types import SimpleNamespace
 import pytest
 
 from arena.runtime.config import ConfigError
-from arena.tools import cluster
-from arena.tools.tournament import Fixture
+from arena.tools.experiments import cluster
+from arena.tools.experiments.tournament import Fixture
 
 ROOT = Path(__file__).resolve().parents[2]
 

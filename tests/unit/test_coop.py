@@ -9,7 +9,7 @@ import pytest
 from arena.processes import node_class
 from arena.processes.robot import RobotNode
 from arena.runtime.config import MatchConfig
-from arena.tools import inprocess
+from arena.tools.launch import inprocess
 
 
 class QuitsAtTick20(RobotNode):

@@ -4,7 +4,7 @@ the workers finish; the results come back in the order asked for."""
 from __future__ import annotations
 
 from arena.runtime.config import MatchConfig
-from arena.tools.facts import many
+from arena.tools.experiments.facts import many
 
 
 def test_one_line_per_match_and_results_in_order(capfd):

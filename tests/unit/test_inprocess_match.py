@@ -7,7 +7,7 @@ import pytest
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import World
-from arena.tools.inprocess import play_in_process
+from arena.tools.launch.inprocess import play_in_process
 
 decode_world = msgspec.msgpack.Decoder(World).decode
 
@@ -79,7 +79,7 @@ def _noisy_referee():
 
 def test_bad_referee_frames_are_rejected_by_engine_and_base_stations_and_change_nothing(monkeypatch):
     from arena.processes import node_class
-    from arena.tools import inprocess
+    from arena.tools.launch import inprocess
 
     cfg = MatchConfig(seed=3, half_time=2.0)
     clean, _ = play_in_process(cfg, watch=())

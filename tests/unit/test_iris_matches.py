@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from arena.runtime.config import MatchConfig
-from arena.tools.inprocess import play_in_process
+from arena.tools.launch.inprocess import play_in_process
 
 
 @pytest.mark.slow

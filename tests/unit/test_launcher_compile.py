@@ -8,7 +8,7 @@ import os
 import sys
 
 from arena.runtime import seeds
-from arena.tools import launcher
+from arena.tools.launch import launcher
 
 
 def test_writes_arenas_bytecode_when_the_interpreters_would_not(monkeypatch):

@@ -1,4 +1,4 @@
-"""Issue 19 part 5: the trajectory and heatmap pictures' data (tools/plots.py)."""
+"""Issue 19 part 5: the trajectory and heatmap pictures' data (tools/review/plots.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RobotState, World
-from arena.tools import plots
+from arena.tools.review import plots
 
 CFG = MatchConfig(half_time=1.0)  # 50 ticks a half
 

@@ -26,8 +26,9 @@ from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import registry
-from arena.tools import facts, replay, review
-from arena.tools.inprocess import play_in_process
+from arena.tools.experiments import facts
+from arena.tools.launch.inprocess import play_in_process
+from arena.tools.review import replay, review
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
 

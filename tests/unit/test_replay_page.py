@@ -10,7 +10,7 @@ import msgspec
 from arena.recording.reader import Recording
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
-from arena.tools.replay_page import write_page
+from arena.tools.review.replay_page import write_page
 
 
 def test_a_full_match_page_is_under_the_5_mb_budget(tmp_path):

@@ -1,4 +1,4 @@
-"""The review GIF (tools/review.py `_animate`) shows the field: grass, robots, score and marks."""
+"""The review GIF (tools/review/review.py `_animate`) shows the field: grass, robots, score and marks."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from PIL import Image
 from arena.recording.analysis.timeline import last_mark, score_at, timeline
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
-from arena.tools.review import _animate
+from arena.tools.review.review import _animate
 
 
 def _match(cfg: MatchConfig, ticks: int = 60):

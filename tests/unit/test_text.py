@@ -8,7 +8,7 @@ import sys
 
 from rich.console import Console
 
-from arena.tools import report
+from arena.tools.review import report
 
 
 def arena(*args: str) -> subprocess.CompletedProcess:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from arena.tools.tournament import (
+from arena.tools.experiments.tournament import (
     Result,
     bradley_terry,
     coverage,
@@ -150,7 +150,7 @@ def test_table1_lists_each_pairings_score_first_named_team_first():
 
 
 def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_path):
-    from arena.tools.tournament import report, void_reason
+    from arena.tools.experiments.tournament import report, void_reason
 
     assert void_reason({"outcome": "void", "outcome_reasons": ["referee exited with code -9 (SIGKILL)"]}) == (
         "void: referee exited with code -9 (SIGKILL)"

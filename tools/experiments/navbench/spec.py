@@ -14,7 +14,7 @@ import msgspec
 
 from arena.runtime.config import ConfigError, RobotParams
 
-BUILTIN = "navbench.toml"  # package data of arena.tools.navbench
+BUILTIN = "navbench.toml"  # package data of arena.tools.experiments.navbench
 
 
 METHODS = ("apf", "sfm", "f-sfm", "mapf")

@@ -31,8 +31,8 @@ from arena.runtime.credentials import COLLECTOR_PRINCIPAL
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
-from arena.tools import launcher
-from arena.tools.run import load_credentials
+from arena.tools.launch import launcher
+from arena.tools.launch.run import load_credentials
 
 MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
 

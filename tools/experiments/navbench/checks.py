@@ -8,7 +8,7 @@ from typing import Any
 from arena.runtime import config as runtime_config
 from arena.runtime.config import RobotParams
 from arena.sim.drive import Drive
-from arena.tools.navbench.spec import ScenarioError
+from arena.tools.experiments.navbench.spec import ScenarioError
 
 
 def _robot(preset: str, overrides: dict[str, Any], where: str) -> RobotParams:

@@ -11,12 +11,20 @@ import msgspec
 
 from arena.navigation import NAVIGATORS, PARAMS
 from arena.sim.drive import Drive
-from arena.tools.navbench.checks import _check_timing, _on_field, _override, _robot
-from arena.tools.navbench.spec import BUILTIN, BenchFile, BenchSpec, LocalMinimum, Scenario, ScenarioError, Scheme
+from arena.tools.experiments.navbench.checks import _check_timing, _on_field, _override, _robot
+from arena.tools.experiments.navbench.spec import (
+    BUILTIN,
+    BenchFile,
+    BenchSpec,
+    LocalMinimum,
+    Scenario,
+    ScenarioError,
+    Scheme,
+)
 
 
 def builtin_text() -> str:
-    return resources.files("arena.tools.navbench").joinpath(BUILTIN).read_text(encoding="utf-8")
+    return resources.files("arena.tools.experiments.navbench").joinpath(BUILTIN).read_text(encoding="utf-8")
 
 
 def load(path: str | Path | None = None) -> BenchSpec:

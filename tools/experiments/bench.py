@@ -20,7 +20,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from arena.runtime.config import MatchConfig
-from arena.tools import launcher, zygote
+from arena.tools.launch import launcher, zygote
 
 
 def bench_match(
@@ -28,7 +28,7 @@ def bench_match(
 ) -> int:
     console = Console(stderr=True)
     results = []
-    # Before the first router: every match's processes are forked by the zygote (tools/zygote.py),
+    # Before the first router: every match's processes are forked by the zygote (tools/launch/zygote.py),
     # the first match's too (warm: the zygote has imported everything before the first launch).
     zygote.start(ready=len(MatchConfig(robots=robots).processes()))
     for i in range(runs):

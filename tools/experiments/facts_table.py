@@ -80,7 +80,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         "strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
         "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2"
     )
-    from arena.tools.tournament import short
+    from arena.tools.experiments.tournament import short
 
     for s, r in sorted(per.items()):
         s = short(s)
@@ -112,7 +112,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
 
 def round_robin_lines(results: list, facts: list[MatchFacts], names: list[str]) -> list[str]:
     """A round robin: one line per match, then the paper's Table 2 with the Fig. 9 coverage."""
-    from arena.tools.tournament import coverage, short, standings
+    from arena.tools.experiments.tournament import coverage, short, standings
 
     out = [
         f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}"
@@ -143,7 +143,7 @@ def as_json(facts: list[MatchFacts], latency: int, seconds: float, results: list
         "seconds": round(seconds, 1),
     }
     if results is not None:
-        from arena.tools.tournament import coverage, standings
+        from arena.tools.experiments.tournament import coverage, standings
 
         out["standings"] = standings(results, names)
         out["coverage"] = coverage(results, names)

@@ -4,7 +4,7 @@ Longer than 150 lines because it is one protocol on both sides of one socket (th
 launcher's `Zygote`, the server's loop, the parked child) whose rules below must
 hold together.
 
-`tools/forkstart.py` forks a match's processes from the launcher itself, which
+`tools/launch/forkstart.py` forks a match's processes from the launcher itself, which
 works only while the launcher has never opened zenoh: zenoh's runtime threads
 outlive a session and a fork lacks them. A process that plays match after match
 (`arena bench match`, a tournament worker) opens a router for its first one, so
@@ -44,7 +44,7 @@ import socket
 import sys
 from pathlib import Path
 
-from arena.tools import forkstart
+from arena.tools.launch import forkstart
 
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36

@@ -9,13 +9,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from arena.runtime.config import ConfigError
-from arena.tools.navbench.console import print_report
-from arena.tools.navbench.loader import load
-from arena.tools.navbench.minima import run_local_minimum
-from arena.tools.navbench.plots import write_plots
-from arena.tools.navbench.report import Report
-from arena.tools.navbench.spec import BenchSpec, Clock
-from arena.tools.navbench.trials import Trial, run_trial
+from arena.tools.experiments.navbench.console import print_report
+from arena.tools.experiments.navbench.loader import load
+from arena.tools.experiments.navbench.minima import run_local_minimum
+from arena.tools.experiments.navbench.plots import write_plots
+from arena.tools.experiments.navbench.report import Report
+from arena.tools.experiments.navbench.spec import BenchSpec, Clock
+from arena.tools.experiments.navbench.trials import Trial, run_trial
 
 
 def run_bench(

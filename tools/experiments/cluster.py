@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING
 from arena.runtime.config import ConfigError
 
 if TYPE_CHECKING:
-    from arena.tools.tournament import TournamentOptions
+    from arena.tools.experiments.tournament import TournamentOptions
 
 # CPUs a match needs, by engine: the distributed engine runs ~11 processes
 # that keep about two cores busy; the in-process engine is one thread.
@@ -192,7 +192,7 @@ def play_on_worker(job: dict, driver: dict) -> dict:
         }
     t0 = time.monotonic()
     if "config" in job:
-        from arena.tools.inprocess import play_match
+        from arena.tools.launch.inprocess import play_match
 
         try:
             m = play_match(job["config"])
@@ -279,7 +279,7 @@ def _shutdown(ray) -> None:
 
 def _play(opts: TournamentOptions, runner, todo: list, on_result):
     """(ray, interrupted); Ray is shut down here only if this raises."""
-    from arena.tools import tournament as T
+    from arena.tools.experiments import tournament as T
 
     cpus = task_cpus(opts.engine)
     jobs = opts.jobs or T.default_jobs()
@@ -336,7 +336,7 @@ def _play(opts: TournamentOptions, runner, todo: list, on_result):
 
 def finish(runner, fx, attempt: int, got: dict):
     """The Result of one attempt, written to --out; None if the match is to be played again."""
-    from arena.tools.tournament import Result, void_reason, write_atomic
+    from arena.tools.experiments.tournament import Result, void_reason, write_atomic
 
     log = runner.logs_dir / f"{fx.id}.log"
     reason = got.get("reason", "")

@@ -41,10 +41,10 @@ from arena.runtime.stats import percentile
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, routes
 from arena.schemas.messages import Referee, Summary
-from arena.tools import forkstart
-from arena.tools.faults import VOIDING, exit_reason
-from arena.tools.faults import outcome as match_outcome
-from arena.tools.witness import Witness
+from arena.tools.launch import forkstart
+from arena.tools.launch.faults import VOIDING, exit_reason
+from arena.tools.launch.faults import outcome as match_outcome
+from arena.tools.launch.witness import Witness
 
 _PR_SET_PDEATHSIG = 1
 
@@ -461,7 +461,7 @@ def supervise(
 
     `strict`: the first child to fail ends the match (MatchError), as for CI.
     Otherwise a failed team process or recorder is a fault and the match plays
-    on; a failed engine or referee makes it void at once (tools/faults.py).
+    on; a failed engine or referee makes it void at once (tools/launch/faults.py).
     `announce(text)` hears of each failure when it happens (a viewer that
     could not serve, say), with the last line of the process's log.
     """
@@ -669,7 +669,7 @@ def assemble(cfg: MatchConfig, got: Collected, wall_total: float, children: list
         "half_time": cfg.half_time,
         "link": cfg.link,
         "realtime": cfg.realtime,
-        "engine": "processes",  # tools/inprocess.py says "inprocess"
+        "engine": "processes",  # tools/launch/inprocess.py says "inprocess"
         "ticks": ticks,
         "sim_seconds": round(sim_seconds, 3),
         "wall_seconds": round(wall_total, 3),
@@ -753,7 +753,7 @@ def play_match(
     `credentials`: the directory for every principal's credentials file
     (default: the match's private temp dir).
     A failed process is a fault in the result (`outcome`, `faults`: see
-    tools/faults.py); with `strict`, it raises MatchError instead, as does a
+    tools/launch/faults.py); with `strict`, it raises MatchError instead, as does a
     match that cannot start.
     """
     t_start = time.monotonic()
@@ -791,7 +791,7 @@ def play_match(
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     starter = None
     try:
-        # Fork the processes before any zenoh session exists here (tools/forkstart.py);
+        # Fork the processes before any zenoh session exists here (tools/launch/forkstart.py);
         # they open theirs once the router is up.
         local = [p for p in cfg.processes() if p not in external]
         starter = forkstart.starter(len(local), {p.kind for p in local}, {cfg.home, cfg.away})
@@ -803,7 +803,7 @@ def play_match(
         with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
-            # An external's digest is recomputed from the frames it puts (tools/witness.py).
+            # An external's digest is recomputed from the frames it puts (tools/launch/witness.py).
             witness = Witness(transport, keys, cfg.robots, {str(p) for p in external}, cfg.timing.periods())
             if starter is not None:
                 starter.release()

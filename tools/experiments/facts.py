@@ -1,7 +1,7 @@
 """`arena facts`: facts about whole matches played in process, the rules
 acceptance (issue 3) and "play that looks like soccer" (issue 4).
 
-`match_facts(cfg)` plays one match in-process (tools/inprocess.py, the very
+`match_facts(cfg)` plays one match in-process (tools/launch/inprocess.py, the very
 `Node` code of a real match) and measures it with the one analysis of the
 World/Referee streams (`arena.recording.analysis.measure`, which also serves
 `arena review`); the facts are described there.
@@ -10,7 +10,7 @@ World/Referee streams (`arena.recording.analysis.measure`, which also serves
 summary; `--home AD --away BS` picks the strategies. `--round-robin AD,AS,BD,BS
 --legs 4` plays every pairing `legs` times, home and away alternating, and
 prints the paper's Table 2 and the robot 1 / robot 2 coverage ratio (Fig. 9),
-with the tournament's own table code (tools/tournament.py).
+with the tournament's own table code (tools/experiments/tournament.py).
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ import msgspec
 from arena.recording.analysis.facts import MatchFacts, measure
 from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, TimingParams
 from arena.schemas.messages import Referee, World
-from arena.tools import facts_table, pools
-from arena.tools.inprocess import play_in_process
+from arena.tools.experiments import facts_table, pools
+from arena.tools.launch.inprocess import play_in_process
 
 
 def match_facts(cfg: MatchConfig) -> MatchFacts:
@@ -50,7 +50,7 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
     columns = (TextColumn("[bold]facts[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     context = multiprocessing.get_context("spawn")
     pool, stopped = ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context), True
-    try:  # Ctrl-C or SIGTERM: the workers are killed, not waited for (tools/pools.py)
+    try:  # Ctrl-C or SIGTERM: the workers are killed, not waited for (tools/experiments/pools.py)
         futures = {pool.submit(match_facts, cfg): cfg for cfg in cfgs}
         with Progress(*columns, console=console, disable=not bar_shown) as bar:
             task = bar.add_task("m", total=len(cfgs))
@@ -70,7 +70,7 @@ def round_robin(
 ) -> tuple[list, list[MatchFacts]]:
     """Every pairing `legs` times, home and away alternating, in-process; returns (Results, facts)."""
     from arena.runtime import seeds
-    from arena.tools.tournament import Result
+    from arena.tools.experiments.tournament import Result
 
     fixtures = []
     for first, second in combinations(strategies, 2):

@@ -22,7 +22,7 @@ from arena.schemas.messages import Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics
 from arena.sim.sensors import sense
-from arena.tools.navbench.spec import PARK_Y, Clock, Scenario, Scheme
+from arena.tools.experiments.navbench.spec import PARK_Y, Clock, Scenario, Scheme
 
 
 class World:

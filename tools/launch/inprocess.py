@@ -104,7 +104,7 @@ def play_in_process(
 
 def play_match(cfg: MatchConfig, record: str = "") -> dict:
     """Play one match in-process and return the result dict of `arena match --json`; `record`: an MCAP path."""
-    from arena.tools.launcher import Collected, assemble
+    from arena.tools.launch.launcher import Collected, assemble
 
     if cfg.realtime:
         raise InprocessError("--engine inprocess plays in lockstep only (no --realtime)")

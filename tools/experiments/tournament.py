@@ -37,7 +37,7 @@ from itertools import combinations
 from pathlib import Path
 
 from arena.runtime import seeds
-from arena.tools import pools
+from arena.tools.experiments import pools
 
 ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
 
@@ -196,7 +196,9 @@ class Result:
     rtf: float = 0.0
     digest: str = ""
     engine: str = "processes"  # which engine played it (arena match --engine)
-    faults: list[dict] = field(default_factory=list)  # a team's crashed process: the match counts (tools/faults.py)
+    faults: list[dict] = field(
+        default_factory=list
+    )  # a team's crashed process: the match counts (tools/launch/faults.py)
 
     @classmethod
     def played(cls, fx: Fixture, m: dict, attempts: int, wall_seconds: float, engine: str) -> Result:
@@ -538,7 +540,7 @@ def report(
 
 
 def void_reason(m: dict) -> str:
-    """Why a match's JSON is no result ("" if it is one): a void match never counts (tools/faults.py)."""
+    """Why a match's JSON is no result ("" if it is one): a void match never counts (tools/launch/faults.py)."""
     if m.get("outcome") == "void" or m.get("void"):
         return "void: " + "; ".join(m.get("outcome_reasons") or ["no reason given"])
     return ""
@@ -717,11 +719,11 @@ def _worker_init() -> None:
     except OSError:
         pass
     import arena.processes.engine  # noqa: F401 - the heavy imports (pymunk, numpy), once per worker
-    import arena.tools.inprocess  # noqa: F401
+    import arena.tools.launch.inprocess  # noqa: F401
 
 
 def _play_inprocess(cfg) -> dict:
-    from arena.tools.inprocess import play_match
+    from arena.tools.launch.inprocess import play_match
 
     return play_match(cfg)
 
@@ -810,7 +812,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
 
         try:
             if opts.ray is not None:
-                from arena.tools import cluster  # imports Ray; never without --ray
+                from arena.tools.experiments import cluster  # imports Ray; never without --ray
 
                 interrupted = cluster.play(opts, runner, todo, arrived)
             else:
@@ -834,7 +836,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
         )
     finally:
         if opts.ray is not None:
-            from arena.tools import cluster
+            from arena.tools.experiments import cluster
 
             cluster.closed()  # Ray shut down in the background while the report was written
     summary["skipped"] = len(fixtures) - len(todo)

@@ -30,7 +30,7 @@ from arena.recording.analysis import NEEDED, analyse
 from arena.recording.analysis.timeline import last_mark, score_at, timeline
 from arena.recording.reader import Recording, RecordingError, load
 from arena.schemas.messages import Referee, World
-from arena.tools import plots as pictures
+from arena.tools.review import plots as pictures
 
 GIF_FRAMES = 100  # [-] at most this many frames in the animation (Pillow encodes ~30 ms each)
 GIF_FPS = 10  # [1/s]
@@ -194,7 +194,7 @@ def _draw_field(ax, cfg, grass: bool = True) -> None:
 def write_plots(rec: Recording, review: dict, out_dir: str, goalkeepers: bool = False) -> list[str]:
     """PNG charts and an animated GIF of the match; returns the paths written.
 
-    Trajectories and heatmaps are tools/plots.py's; `goalkeepers` puts them in the heatmaps.
+    Trajectories and heatmaps are tools/review/plots.py's; `goalkeepers` puts them in the heatmaps.
     """
     import matplotlib
 
@@ -338,7 +338,7 @@ def main(
     if plots:
         review["plots"] = write_plots(rec, review, plots, goalkeepers)
     if html:
-        from arena.tools.replay_page import write_page
+        from arena.tools.review.replay_page import write_page
 
         try:
             review["html"] = write_page(rec, html)

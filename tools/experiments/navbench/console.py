@@ -4,8 +4,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from arena.tools.navbench.report import Report, method_rows, minima_rows, results_rows, timing
-from arena.tools.navbench.spec import FSFM_BUDGET_US, METHODS, PAPER_FIS_OVERHEAD, PAPER_FSFM_MS, PAPER_SFM_MS
+from arena.tools.experiments.navbench.report import Report, method_rows, minima_rows, results_rows, timing
+from arena.tools.experiments.navbench.spec import (
+    FSFM_BUDGET_US,
+    METHODS,
+    PAPER_FIS_OVERHEAD,
+    PAPER_FSFM_MS,
+    PAPER_SFM_MS,
+)
 
 
 def print_report(r: Report, console: Any = None) -> None:

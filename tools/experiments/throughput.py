@@ -35,7 +35,7 @@ import time
 
 from rich.console import Console
 
-from arena.tools.tournament import default_jobs
+from arena.tools.experiments.tournament import default_jobs
 
 ENGINES = ("processes", "inprocess")
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).

@@ -27,7 +27,7 @@ Rules kept:
 `ARENA_LAUNCH=exec` keeps the former exec start (for comparison runs and as a
 fallback). It is also used off the main thread, and in a process that has
 already opened a zenoh session (a second match played by the same process)
-unless that process started a fork server first (tools/zygote.py, as `arena
+unless that process started a fork server first (tools/launch/zygote.py, as `arena
 bench match` does): zenoh's runtime threads outlive the session, and a fork
 would inherit its state without them (measured: the children of such a fork
 did not play).
@@ -65,7 +65,7 @@ def preload(kinds: set[str], strategies: set[str]) -> None:
     from arena import cli  # noqa: F401
     from arena.processes import node_class
     from arena.strategies import registry
-    from arena.tools import run  # noqa: F401
+    from arena.tools.launch import run  # noqa: F401
 
     for kind in kinds:
         node_class(kind)
@@ -144,8 +144,8 @@ class ForkedProcess:
 
 def starter(count: int, kinds: set[str], strategies: set[str]) -> Starter | None:
     """How to start a match's `count` processes: this process's zygote if it has one
-    (tools/zygote.py), else a fork of this process if it can, else None (exec)."""
-    from arena.tools import zygote
+    (tools/launch/zygote.py), else a fork of this process if it can, else None (exec)."""
+    from arena.tools.launch import zygote
 
     z = zygote.running()
     if z is not None:
@@ -163,7 +163,7 @@ class Starter:
     """Forks the children of one match; `release` lets them open their sessions."""
 
     def __init__(self, zygote=None, count: int = 0) -> None:
-        """Fork here, or with `zygote` (tools/zygote.py) hand `count` jobs to its parked children."""
+        """Fork here, or with `zygote` (tools/launch/zygote.py) hand `count` jobs to its parked children."""
         self._go_r, self._go_w = os.pipe()
         self._count = 0
         self._frozen = False
