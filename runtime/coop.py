@@ -193,3 +193,19 @@ def drive(
                 quit_early.add(ib.sender)
             ib._give_up(f"deadlock: {why} (cooperative driver)")
             runnable.append(t)
+
+
+def run_runnable(bus: CoopBus) -> None:
+    """Resume runnable tasks until none is, then return: one stretch of a driver that
+    pauses the match between stretches (`arena.learn` stops where a learner needs an
+    action; a task parked on something the caller releases is woken by putting it on
+    `bus.runnable`). `drive` runs to the end instead. A task that raises: `NodeFailed`."""
+    runnable = bus.runnable
+    while runnable:
+        task = runnable.popleft()
+        if task.done:
+            continue
+        try:
+            _advance(task)
+        except Exception as exc:
+            raise NodeFailed(task.name, exc) from exc

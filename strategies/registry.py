@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from functools import cache
+from pathlib import Path
 
 from arena.runtime.config import ConfigError
+from arena.strategies import learned
 from arena.strategies.base import Strategy
 
 GROUP = "soccer_arena.strategies"
@@ -94,6 +96,8 @@ def resolve_name(name: str) -> str:
     Built-ins come first, as in `all_strategies`, so the entry points are read
     only for a name that is not built in.
     """
+    if name.startswith(learned.PREFIX):  # a policy file: its absolute path, as every process opens it
+        return learned.policy_strategy(learned.PREFIX + str(Path(name[len(learned.PREFIX) :]).resolve())).name
     wanted = name.strip().lower()
     found = _find(builtin_strategies(), wanted) or _find(all_strategies(), wanted)
     if found is not None:
@@ -107,5 +111,7 @@ def resolve_name(name: str) -> str:
 
 
 def get(name: str) -> Strategy:
+    if name.startswith(learned.PREFIX):
+        return learned.policy_strategy(name)
     canonical = resolve_name(name)
     return builtin_strategies().get(canonical) or all_strategies()[canonical]

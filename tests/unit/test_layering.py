@@ -18,7 +18,8 @@ RANK = {
     "strategies": 3,
     "processes": 4,
     "tools": 5,
-    "arena": 6,  # arena/cli.py and arena/__main__.py
+    "learn": 6,  # arena.learn: the learning environments, over the in-process engine
+    "arena": 7,  # arena/cli.py and arena/__main__.py
 }
 
 

@@ -1,0 +1,160 @@
+"""A match that pauses wherever a learner's robot needs an action.
+
+Longer than 150 lines because the gate, the gated robot loop and the match that opens
+the gates are one mechanism: who waits where holds only across the three.
+
+The in-process engine (runtime/coop.py) runs every node of a match on one
+thread, each node's lockstep generator resumed while the link it waits on is
+ready. `SteppedMatch` builds the very same nodes, gives each learner's robot a
+`LearnerBrain` whose action the caller sets, and puts one more wait into that
+robot's loop: just before it acts at a decision tick k (its `sense` of k - L
+and its latest `order` are in), it waits on a `Gate` that only the caller
+opens. `advance()` runs the match until every learner waits at its gate (or
+has ended), so the engine, the referee, the base stations and every other
+robot play exactly as in `arena match`, and the learner's commands enter the
+match where its strategy's would have. Digests are the distributed match's
+(tests/unit/test_learn.py replays an episode through real processes).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import msgspec
+
+from arena.processes import node_class
+from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.coop import CoopBus, CoopTransport, Task, run_runnable
+from arena.schemas.keys import Keys
+from arena.schemas.messages import Order, Referee, Sense, World
+from arena.strategies.base import RobotContext
+from arena.strategies.learned import LearnerBrain
+
+_referee = msgspec.msgpack.Decoder(Referee).decode
+_world = msgspec.msgpack.Decoder(World).decode
+
+
+class Gate:
+    """Where a learner's robot waits for its action; duck-types the `Inbound` a cooperative task parks on."""
+
+    __slots__ = ("key", "sender", "paired", "released", "waiter", "_channel")
+
+    def __init__(self, name: str):
+        self.key = f"action/{name}"
+        self.sender = "learner"
+        self.paired = False  # the robot puts its held-back `cmd` batch as it parks here
+        self.released = -1  # the last tick whose action is set
+        self.waiter: Task | None = None
+        self._channel = self
+
+    def ready(self, k: int) -> bool:
+        return self.released >= k
+
+    def try_recv(self) -> None:
+        return None
+
+    def _accept(self, raw: bytes, _: Any) -> None:  # pragma: no cover - nothing is ever put here
+        pass
+
+    def release(self, k: int, runnable) -> None:
+        self.released = k
+        if self.waiter is not None:
+            runnable.append(self.waiter)
+            self.waiter = None
+
+
+def _gated(node, gate: Gate, skip: int) -> Iterator[Any]:
+    """The robot's own lockstep loop, with a wait on `gate` before it acts at every `skip`-th tick.
+
+    A robot acts right after its `order` link is ready for that tick (processes/robot.py)."""
+    order_in = node.order_in
+    for w in node.lockstep():
+        yield w
+        if w[0] is order_in and w[1] % skip == 0:
+            yield gate, w[1]
+
+
+class SteppedMatch:
+    """One match, played up to each decision tick of its learners. `learners`: robot ids like "a/1"."""
+
+    def __init__(self, cfg: MatchConfig, learners: list[str], frame_skip: int = 1, discrete: bool = False):
+        self.cfg = cfg
+        self.frame_skip = frame_skip
+        self.bus = bus = CoopBus()
+        keys = Keys("learn")
+        self.referee_ch = bus.subscribe(None, keys.key("referee"))
+        self.world_ch = bus.subscribe(None, keys.key("world"))
+        self.nodes = {str(p): node_class(p.kind)(p, cfg, CoopTransport(bus), keys) for p in cfg.processes()}
+        self.actions: dict[str, Any] = {}
+        self.gates: dict[str, Gate] = {}
+        self.robot_of: dict[str, Any] = {}
+        tasks = []
+        for name, node in self.nodes.items():
+            steps = node.lockstep()
+            agent = ProcessId.parse(name).short if node.pid.kind == "robot" else ""
+            if agent in learners:
+                ctx = RobotContext(cfg=cfg, team=node.pid.team, n=node.pid.robot, rng=node.rng("strategy"))
+                node.brain = LearnerBrain(ctx, self._decider(agent), frame_skip, discrete)
+                self.gates[agent] = gate = Gate(agent)
+                self.robot_of[agent] = node
+                steps = _gated(node, gate, frame_skip)
+            tasks.append(Task(name, steps, node.batch_flusher()))
+        self.tasks = tasks
+        self.learner_tasks = {a: next(t for t in tasks if t.name == f"robot/{a}") for a in learners}
+        self.tick = 0  # the decision tick the learners wait at
+        self.score = (0, 0)
+        self.attack_dir_a = 1
+        self.ball: tuple[float, float] | None = None
+        self.referee: Referee | None = None
+        self.new_commands: list = []
+        self.bus.runnable.extend(tasks)
+
+    def _decider(self, agent: str):
+        return lambda _k, _sense, _order: self.actions[agent]
+
+    @property
+    def over(self) -> bool:
+        return all(t.done for t in self.learner_tasks.values())
+
+    def advance(self) -> None:
+        """Play until every learner waits at its gate or has ended; then read the referee and the ball."""
+        run_runnable(self.bus)
+        waiting = [t for t in self.learner_tasks.values() if not t.done]
+        for t in waiting:
+            if t.waiting is None or not isinstance(t.waiting[0], Gate):
+                stuck = ", ".join(f"{x.name} on {x.waiting[0].key}" for x in self.tasks if x.waiting and not x.done)
+                raise RuntimeError(f"the match stopped with no learner waiting for an action: {stuck}")
+        if waiting:
+            self.tick = waiting[0].waiting[1]  # type: ignore[index]
+        self.new_commands = []
+        while (raw := self.referee_ch.try_recv()) is not None:
+            ref = _referee(raw)
+            self.referee = ref
+            self.score = (ref.score_a, ref.score_b)
+            self.attack_dir_a = ref.attack_dir_a
+            self.new_commands.extend(ref.commands)
+        last = None
+        while (raw := self.world_ch.try_recv()) is not None:
+            last = raw
+        if last is not None:
+            w = _world(last)
+            self.ball = (w.ball_x, w.ball_y)
+
+    def act(self, actions: dict[str, Any]) -> None:
+        """Set the learners' actions for the tick they wait at and let them go on."""
+        runnable = self.bus.runnable
+        for agent, gate in self.gates.items():
+            if agent in actions:
+                self.actions[agent] = actions[agent]
+            gate.release(self.tick, runnable)
+
+    def seen(self, agent: str) -> tuple[Sense | None, Order | None]:
+        """What the learner's robot acts on at the current decision tick."""
+        node = self.robot_of[agent]
+        k = min(self.tick, self.cfg.total_ticks)
+        return node.sense_in.latest_by(k), node.order_in.latest_by(k)
+
+    def digests(self) -> dict[str, str]:
+        """Every process's digest of what it has sent so far."""
+        return {name: node.digest.hexdigest() for name, node in self.nodes.items()}

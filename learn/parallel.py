@@ -1,0 +1,193 @@
+"""`SoccerParallelEnv`: a PettingZoo `ParallelEnv` whose episodes are real matches.
+
+Longer than 150 lines because the PettingZoo API (spaces, reset, step, the episode's
+end and its digests) is one class whose docstring is the spec.
+
+Agents are the robots a learner controls, any subset of either team ("a/1",
+"b/0", ...); every other robot, and both base stations, are played by the
+team's named strategy (a built-in or a plugin), and the referee plays too: set
+pieces happen, and a learner that breaks a rule gets the foul. Learn a/1 and
+a/2 with AD's keeper against BS::
+
+    env = SoccerParallelEnv(agents=["a/1", "a/2"], home="AD", away="BS")
+
+Observation: what that robot receives at the tick it acts, its `sense` of
+tick k - L (the perception latency) and its base station's latest `order`
+(which carries the referee's command), in the robot's attack frame
+(`arena.strategies.learned.obs_fields`, docs/learning.md): a `Box`
+(`obs="flat"`) or a `Dict` of named `Box`es (`obs="dict"`).
+
+Action: `Box(-1, 1, (4,))`, (vx, vy, omega, kick) scaled by the robot's
+limits, or `Discrete(10)` (`actions="discrete"`, `DISCRETE`).
+
+A step is one control tick (20 ms) or `frame_skip` ticks with the action held.
+An episode is one match (`half_time` seconds a half, both halves; `until="half"`
+stops at half time); it is truncated when that ends, and terminated at a goal
+(`end_on_goal`). The reward is `reward(agent, Outcome)` (`arena.learn.rewards`),
+by default +1 a goal scored, -1 a goal conceded.
+
+`reset(seed=s)` plays the match of seed s: the same seed and actions give the
+same match, digest for digest (`digests()`), as `arena match` would with the
+policy's actions (`arena.learn.deploy`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from arena.learn.match import SteppedMatch
+from arena.learn.rewards import GoalReward, Outcome
+from arena.runtime.config import MatchConfig, ProcessId
+from arena.strategies import registry
+from arena.strategies.learned import DISCRETE, RecordedActions, View, obs_fields, observe, save_policy
+
+
+def agent_name(text: str) -> str:
+    """ "a/1", "robot/a/1" -> "a/1"; ValueError for anything else."""
+    pid = ProcessId.parse(text)
+    if pid.kind != "robot":
+        raise ValueError(f"{text!r} is not a robot (agents are robots such as a/1)")
+    return pid.short
+
+
+class SoccerParallelEnv(ParallelEnv):
+    metadata = {"name": "soccer_arena_v0", "render_modes": [], "is_parallelizable": True}
+
+    def __init__(
+        self,
+        agents: list[str] | tuple[str, ...] = ("a/1",),
+        home: str = "advance-dynamic",
+        away: str = "basic-static",
+        *,
+        robots: int = 3,
+        half_time: float = 30.0,
+        frame_skip: int = 1,
+        obs: str = "flat",
+        actions: str = "box",
+        reward=None,
+        end_on_goal: bool = True,
+        until: str = "match",
+        config: MatchConfig | None = None,
+    ):
+        base = config or MatchConfig()
+        self.cfg = base.replace(
+            home=registry.resolve_name(home), away=registry.resolve_name(away), robots=robots, half_time=half_time
+        )
+        names = [agent_name(a) for a in agents]
+        if not names or len(set(names)) != len(names):
+            raise ValueError(f"agents must be distinct robots, got {list(agents)}")
+        for a in names:
+            if int(a.split("/")[1]) >= robots:
+                raise ValueError(f"no robot {a} in a match of {robots} robots a team")
+        if obs not in ("flat", "dict") or actions not in ("box", "discrete") or until not in ("match", "half"):
+            raise ValueError("obs must be flat or dict, actions box or discrete, until match or half")
+        if frame_skip < 1:
+            raise ValueError(f"frame_skip must be at least 1, got {frame_skip}")
+        self.possible_agents = names
+        self.agents: list[str] = []
+        self.frame_skip = frame_skip
+        self.obs_form = obs
+        self.discrete = actions == "discrete"
+        self.reward_fn = reward or GoalReward()
+        self.end_on_goal = end_on_goal
+        self.until = until
+        self._views = {a: View.of(self.cfg, a[0]) for a in names}
+        flat = spaces.Box(self._views[names[0]].low, self._views[names[0]].high, dtype=np.float32)
+        self._flat_space = flat
+        self._parts = []
+        i = 0
+        for name, n, _, _, _ in obs_fields(robots):
+            self._parts.append((name, i, i + n))
+            i += n
+        dict_space = spaces.Dict(
+            {name: spaces.Box(flat.low[a:b], flat.high[a:b], dtype=np.float32) for name, a, b in self._parts}
+        )
+        self._obs_space = flat if obs == "flat" else dict_space
+        self._act_space = spaces.Discrete(len(DISCRETE)) if self.discrete else spaces.Box(-1.0, 1.0, (4,), np.float32)
+        self.match: SteppedMatch | None = None
+        self._seed = self.cfg.seed
+        self.recorded: dict[str, list[Any]] = {}
+
+    # ------------------------------------------------------------- spaces
+    def observation_space(self, agent: str) -> spaces.Space:
+        return self._obs_space
+
+    def action_space(self, agent: str) -> spaces.Space:
+        return self._act_space
+
+    # ---------------------------------------------------------------- API
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        """Start the match of `seed` (the previous seed + 1 when None); `options`: {"scenario": path}."""
+        self._seed = (self._seed + 1) % 2**63 if seed is None else int(seed) % 2**63
+        cfg = self.cfg.replace(seed=self._seed)
+        self.match = SteppedMatch(cfg, self.possible_agents, self.frame_skip, self.discrete)
+        self.agents = list(self.possible_agents)
+        self.recorded = {a: [] for a in self.agents}
+        self.match.advance()
+        self._last_score = self.match.score
+        self._last_ball = self.match.ball
+        return self._observations(), {a: self._info() for a in self.agents}
+
+    def step(self, actions: dict[str, Any]):
+        m = self.match
+        if m is None or not self.agents:
+            raise RuntimeError("step() before reset(), or after the episode ended")
+        for a in self.agents:
+            act = actions[a]
+            self.recorded[a].append(act)
+        m.act(actions)
+        m.advance()
+        ga = m.score[0] - self._last_score[0]
+        gb = m.score[1] - self._last_score[1]
+        progress = 0.0
+        if m.ball is not None and self._last_ball is not None:
+            progress = (m.ball[0] - self._last_ball[0]) * m.attack_dir_a
+        self._last_score, self._last_ball = m.score, m.ball
+        out = {
+            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands),
+            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands),
+        }
+        rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
+        goal = (ga or gb) and self.end_on_goal
+        over = m.over or (self.until == "half" and m.tick >= self.cfg.half_ticks)
+        terms = {a: bool(goal) for a in self.agents}
+        truncs = {a: bool(over and not goal) for a in self.agents}
+        obs = self._observations()
+        infos = {a: self._info() for a in self.agents}
+        if goal or over:
+            self.agents = []
+        return obs, rewards, terms, truncs, infos
+
+    def close(self) -> None:
+        self.match = None
+
+    # -------------------------------------------------------------- extras
+    def digests(self) -> dict[str, str]:
+        """Every process's digest so far: after a whole episode, those of `arena match` (docs/learning.md)."""
+        return self.match.digests() if self.match is not None else {}
+
+    def save_actions(self, team: str, path) -> str:
+        """A policy file that replays this episode's actions of `team`'s learners, the rest of the team
+        by its strategy: `arena match --home policy:PATH` (team a) plays this episode again."""
+        mine = {int(a.split("/")[1]): RecordedActions(self.recorded[a]) for a in self.recorded if a[0] == team}
+        base = self.cfg.strategy_of(team)
+        return str(save_policy(path, mine, base, self.frame_skip, self.discrete))
+
+    def observe(self, agent: str) -> Any:
+        return self._shape(observe(*self.match.seen(agent), self._views[agent]))
+
+    def _observations(self) -> dict[str, Any]:
+        return {a: self.observe(a) for a in self.agents}
+
+    def _shape(self, flat: np.ndarray) -> Any:
+        if self.obs_form == "flat":
+            return flat
+        return {name: flat[a:b] for name, a, b in self._parts}
+
+    def _info(self) -> dict[str, Any]:
+        m = self.match
+        return {"tick": m.tick, "score": m.score, "seed": self._seed}

@@ -1,0 +1,49 @@
+"""`SoccerEnv`: a Gymnasium env for one robot (every other robot by its team's strategy),
+and `make_vector_env`: N of them, each in its own worker process.
+
+`SoccerEnv(robot="a/1", home=..., away=..., **options)` is `SoccerParallelEnv`
+with one agent; the options are the same (docs/learning.md). It is registered
+as `arena/Soccer-v0`, so `gymnasium.make("arena/Soccer-v0", robot="b/2")` works.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Any
+
+import gymnasium
+
+from arena.learn.parallel import SoccerParallelEnv, agent_name
+
+
+class SoccerEnv(gymnasium.Env):
+    metadata = {"render_modes": []}
+
+    def __init__(self, robot: str = "a/1", home: str = "advance-dynamic", away: str = "basic-static", **options: Any):
+        self.agent = agent_name(robot)
+        self.env = SoccerParallelEnv(agents=[self.agent], home=home, away=away, **options)
+        self.observation_space = self.env.observation_space(self.agent)
+        self.action_space = self.env.action_space(self.agent)
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        obs, infos = self.env.reset(seed=seed, options=options)
+        return obs[self.agent], infos[self.agent]
+
+    def step(self, action: Any):
+        a = self.agent
+        obs, rewards, terms, truncs, infos = self.env.step({a: action})
+        return obs[a], rewards[a], terms[a], truncs[a], infos[a]
+
+    def digests(self) -> dict[str, str]:
+        return self.env.digests()
+
+
+def make_vector_env(n: int, asynchronous: bool = True, **options: Any) -> gymnasium.vector.VectorEnv:
+    """`n` `SoccerEnv`s with these options, each in its own worker process (`asynchronous`), or in this one.
+
+    `reset(seed=s)` seeds them s, s + 1, ..., s + n - 1."""
+    fns = [partial(SoccerEnv, **options) for _ in range(n)]
+    if asynchronous:
+        return gymnasium.vector.AsyncVectorEnv(fns, context="fork")
+    return gymnasium.vector.SyncVectorEnv(fns)

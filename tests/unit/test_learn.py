@@ -1,0 +1,127 @@
+"""arena.learn: the PettingZoo and Gymnasium conformance suites, determinism, deployment as a strategy."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium")
+pytest.importorskip("pettingzoo")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
+
+from arena.learn import SoccerEnv, SoccerParallelEnv, make_vector_env  # noqa: E402
+from arena.runtime.config import ConfigError, MatchConfig  # noqa: E402
+from arena.strategies import registry  # noqa: E402
+from arena.tools.launch.inprocess import play_in_process  # noqa: E402
+
+SHORT = dict(home="AD", away="BS", half_time=0.6)  # 61 ticks: fast, and the kick-off is played
+
+
+def test_parallel_api_test_passes_for_both_observation_and_action_forms():
+    parallel_api_test(SoccerParallelEnv(agents=["a/1", "b/2"], **SHORT), num_cycles=70)
+    parallel_api_test(SoccerParallelEnv(agents=["b/0"], obs="dict", actions="discrete", frame_skip=4, **SHORT))
+
+
+def test_parallel_seed_test_passes():
+    parallel_seed_test(lambda: SoccerParallelEnv(agents=["a/1", "a/2"], **SHORT), num_cycles=20)
+
+
+def test_gymnasium_check_env_passes():
+    check_env(SoccerEnv("a/1", **SHORT), skip_render_check=True)
+    check_env(SoccerEnv("b/1", obs="dict", actions="discrete", **SHORT), skip_render_check=True)
+
+
+def play(env, seed: int, actions_seed: int = 0) -> tuple[dict, list]:
+    rng = np.random.default_rng(actions_seed)
+    obs, _ = env.reset(seed=seed)
+    seen = []
+    while env.agents:
+        acts = {a: rng.uniform(-1, 1, 4).astype(np.float32) for a in env.agents}
+        obs, *_ = env.step(acts)
+        seen.append(np.concatenate([obs[a] for a in sorted(obs)]))
+    return env.digests(), seen
+
+
+def test_the_same_seed_and_actions_give_the_same_digests_twice():
+    env = SoccerParallelEnv(agents=["a/1", "b/1"], home="AD", away="BS", half_time=1.0, end_on_goal=False)
+    d1, o1 = play(env, seed=5)
+    d2, o2 = play(env, seed=5)
+    for i, (x, y) in enumerate(zip(o1, o2)):
+        assert np.array_equal(x, y), f"observations differ first at step {i}"
+    assert d1 == d2 and len(d1) == 10
+    d3, _ = play(env, seed=5, actions_seed=1)
+    assert d3["robot/a/1"] != d1["robot/a/1"], "other actions, another match"
+
+
+def test_an_episodes_actions_replayed_as_a_policy_strategy_give_the_envs_digests(tmp_path):
+    """The in-process engine with the recorded actions as the strategy `policy:PATH` (the distributed
+    match: tests/integration/test_learn_deploy.py)."""
+    env = SoccerParallelEnv(agents=["a/1", "a/2"], home="AD", away="BS", half_time=1.0, end_on_goal=False, frame_skip=3)
+    digests, _ = play(env, seed=8)
+    path = env.save_actions("a", tmp_path / "actions.pkl")
+    cfg = MatchConfig(seed=8, home=registry.resolve_name(f"policy:{path}"), away="basic-static", half_time=1.0)
+    summaries, _ = play_in_process(cfg, watch=())
+    assert {name: s.digest for name, s in summaries.items()} == digests
+
+
+def test_a_missing_policy_file_is_one_line():
+    with pytest.raises(ConfigError, match="policy file /nonexistent.pkl not found"):
+        registry.resolve_name("policy:/nonexistent.pkl")
+
+
+def test_frame_skip_holds_the_action_and_the_episode_follows_the_match():
+    env = SoccerParallelEnv(agents=["a/1"], home="BS", away="BS", half_time=0.5, frame_skip=4, end_on_goal=False)
+    env.reset(seed=1)
+    steps = 0
+    while env.agents:
+        _, _, term, trunc, info = env.step({"a/1": np.zeros(4, np.float32)})
+        steps += 1
+    assert steps == -(-(env.cfg.total_ticks + 1) // 4) and trunc["a/1"] and not term["a/1"]
+    half = SoccerParallelEnv(agents=["a/1"], home="BS", away="BS", half_time=0.5, until="half", end_on_goal=False)
+    half.reset(seed=1)
+    n = 0
+    while half.agents:
+        half.step({"a/1": np.zeros(4, np.float32)})
+        n += 1
+    assert n == half.cfg.half_ticks
+
+
+def test_bad_agents_are_refused():
+    for agents in (["a/3"], ["a/1", "robot/a/1"], ["referee"], []):
+        with pytest.raises(ValueError):
+            SoccerParallelEnv(agents=agents)
+
+
+def test_the_vector_env_steps_its_workers_with_their_own_seeds():
+    venv = make_vector_env(2, asynchronous=False, robot="a/1", **SHORT)
+    obs, infos = venv.reset(seed=4)
+    assert obs.shape == (2, 69) and list(infos["seed"]) == [4, 5]
+    obs, rew, term, trunc, _ = venv.step(np.zeros((2, 4), np.float32))
+    assert obs.shape == (2, 69) and rew.shape == (2,)
+    venv.close()
+
+
+def test_without_the_extra_the_import_names_it_in_one_line():
+    code = "import sys; sys.modules['pettingzoo'] = None; import arena.learn"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == (
+        "ImportError: arena.learn needs the learn extra: pip install 'soccer-arena[learn]'"
+    )
+
+
+def test_docs_learning_md_lists_every_observation_part_and_discrete_action():
+    from pathlib import Path
+
+    from arena.strategies.learned import DISCRETE, obs_fields
+
+    doc = (Path(__file__).parents[2] / "docs" / "learning.md").read_text()
+    for name, n, lo, hi, text in obs_fields(3):
+        assert f"| `{name}` | {n} | [{lo:g}, {hi:g}] | {text} |" in doc, name
+    for i, (name, a) in enumerate(DISCRETE):
+        assert f"| {i} | {name} | {', '.join(f'{x:g}' for x in a)} |" in doc, name
