@@ -125,3 +125,10 @@ def test_docs_learning_md_lists_every_observation_part_and_discrete_action():
         assert f"| `{name}` | {n} | [{lo:g}, {hi:g}] | {text} |" in doc, name
     for i, (name, a) in enumerate(DISCRETE):
         assert f"| {i} | {name} | {', '.join(f'{x:g}' for x in a)} |" in doc, name
+
+
+def test_a_tournament_names_a_policy_files_matches_by_its_file_name():
+    from arena.tools.experiments.tournament import Fixture
+
+    fx = Fixture(3, "policy:/runs/x/keeper.pkl", "advance-dynamic", 2, "policy:/runs/x/keeper.pkl", "AD", 1)
+    assert fx.id == "003-policy-keeper.pkl-AD-leg02"
