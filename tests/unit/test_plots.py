@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from matplotlib.colors import to_rgb
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RobotState, World
@@ -22,15 +23,25 @@ def world(tick: int, a0=(-5.0, 0.0), a1=(-1.0, 1.0), b1=(2.0, -1.0), ball=(0.5, 
     return World(tick=tick, t=tick * 0.02, ball_x=ball[0], ball_y=ball[1], robots=robots)
 
 
-def test_every_robot_has_its_own_colour_in_its_teams_hue():
-    colours = {(t, n): plots.robot_colour(t, n, 6) for t in "ab" for n in range(6)}
-    assert len(set(colours.values())) == 12
-    for t in "ab":
-        dark = [sum(colours[(t, n)][:3]) for n in range(6)]
-        assert dark == sorted(dark), "a lower number is a darker shade (the goalkeeper darkest)"
-    blue_a = [c[2] - c[0] for (t, _), c in colours.items() if t == "a"]
-    red_b = [c[0] - c[1] for (t, _), c in colours.items() if t == "b"]
-    assert min(blue_a) > 0 and min(red_b) > 0, "team a blue, team b magenta"
+def test_every_robot_has_its_own_colour_and_marker_in_its_teams_hue():
+    colours = {(t, n): to_rgb(plots.robot_colour(t, n)) for t in "ab" for n in range(6)}
+    others = [to_rgb(c) for c in (plots.BALL, "#2e7d32", "white")]  # ball, grass, lines
+    everything = [*colours.values(), *others]
+    gaps = [math.dist(p, q) for i, p in enumerate(everything) for q in everything[i + 1 :]]
+    assert min(gaps) >= 0.25, "every robot's colour is clearly apart from every other, the grass, lines and ball"
+    for (t, n), (r, _, b) in colours.items():
+        assert (b > r) if t == "a" else (r > b), f"{t}/{n}: team a blue, team b magenta/red"
+    assert len({plots.robot_marker(n) for n in range(6)}) == 6
+
+
+def test_heatmap_shares_one_light_to_dark_scale_and_leaves_empty_cells_transparent():
+    grids = [(np.array([[np.nan, 0.1], [2.0, np.nan]]),), (np.array([[40.0, np.nan]]),)]
+    norm = plots.shared_norm(grids)
+    assert (norm.vmin, norm.vmax) == (0.1, 40.0), "one scale over every panel"
+    cmap = plots.colour_map()
+    assert cmap(np.ma.masked_invalid([np.nan]))[0][3] == 0.0, "a cell nobody visited shows the field"
+    least, most = cmap(norm(0.1)), cmap(norm(40.0))
+    assert sum(least[:3]) > 2.4 and sum(most[:3]) < 1.2, "a moment is light, much time dark: no black holes"
 
 
 def test_tracks_split_by_half_and_break_at_a_placement():

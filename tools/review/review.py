@@ -13,13 +13,12 @@ frames, link statistics and timing from the processes' Summaries.
 
 A truncated recording (the recorder was killed) is reviewed up to where it
 ends, and the report says so. `--plots DIR` adds PNG charts and an animated
-GIF (matplotlib, Agg backend, PillowWriter).
+GIF (tools/review/plots.py and tools/review/animation.py).
 """
 
 from __future__ import annotations
 
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -27,13 +26,11 @@ from rich.console import Console
 from rich.table import Table
 
 from arena.recording.analysis import NEEDED, analyse
-from arena.recording.analysis.timeline import last_mark, score_at, timeline
 from arena.recording.reader import Recording, RecordingError, load
 from arena.schemas.messages import Referee, World
+from arena.tools.review import animation
 from arena.tools.review import plots as pictures
 
-GIF_FRAMES = 100  # [-] at most this many frames in the animation (Pillow encodes ~30 ms each)
-GIF_FPS = 10  # [1/s]
 TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in the Foxglove scene
 
 
@@ -235,7 +232,8 @@ def write_plots(rec: Recording, review: dict, out_dir: str, goalkeepers: bool = 
     written.append(_save(fig, out / "score.png"))
 
     if worlds:
-        written.append(_animate(worlds, cfg, out / "match.gif", rec.decoded("referee", Referee)))
+        refs = rec.decoded("referee", Referee)
+        written.append(animation.animate(worlds, cfg, out / "match.gif", refs, _draw_field))
     return written
 
 
@@ -244,84 +242,6 @@ def _save(fig, path: Path) -> str:
 
     fig.tight_layout()
     fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return str(path)
-
-
-def _animate(worlds: list[World], cfg, path: Path, refs: list[Referee] | None = None) -> str:
-    """The match as a small GIF: grass, lines and goals, robots with their numbers, the
-    ball (larger when in the air), the score and clock, the last goal or restart, and a
-    timeline strip with every goal (red) and restart (white) marked."""
-    import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation, PillowWriter
-    from matplotlib.patches import Rectangle
-
-    step = max(1, math.ceil(len(worlds) / GIF_FRAMES))
-    frames = worlds[::step]
-    tl = timeline(worlds, refs or [], cfg.timing.dt, hz=1.0 / cfg.timing.dt)  # marks and scores only
-    f = cfg.field
-    fig = plt.figure(figsize=(7, 5.2), facecolor="#1b5e20")
-    ax = fig.add_axes((0.01, 0.1, 0.98, 0.82))
-    # The grass is a patch: with the axis off the axes' face (set_facecolor) is not drawn.
-    ax.add_patch(
-        Rectangle(
-            (-f.length / 2 - f.runoff, -f.width / 2 - f.runoff),
-            f.length + 2 * f.runoff,
-            f.width + 2 * f.runoff,
-            fc="#2e7d32",
-            ec="#9e9e9e",
-            lw=2,
-            zorder=0,
-        )
-    )
-    _draw_field(ax, cfg, grass=False)
-    ax.set_axis_off()  # axes and ticks would cost most of the drawing time of every frame
-    names = [f"{r.team}/{r.robot}" for r in frames[0].robots]
-    robots = ax.scatter(
-        [0] * len(names),
-        [0] * len(names),
-        s=260,
-        c=[TEAM_COLOURS[n[0]] for n in names],
-        marker="s",
-        edgecolors="black",
-        zorder=3,
-    )
-    numbers = [
-        ax.text(0, 0, n.split("/")[1], ha="center", va="center", fontsize=10, weight="bold", zorder=4) for n in names
-    ]
-    ball = ax.scatter([0], [0], s=40, c="orange", edgecolors="black", zorder=5)
-    head = fig.text(0.5, 0.955, "", ha="center", va="center", color="white", fontsize=13, weight="bold")
-    mark = fig.text(0.5, 0.8, "", ha="center", va="center", color="#ffeb3b", fontsize=22, weight="bold", alpha=0.9)
-    # the timeline strip: goals red, restarts white, a cursor for now
-    strip = fig.add_axes((0.05, 0.03, 0.9, 0.04), facecolor="#103d13")
-    end = max(1, cfg.total_ticks)
-    for m in tl["marks"]:
-        strip.axvline(
-            m["tick"], color="#ff1744" if m["kind"] == "GOAL" else "#eeeeee", lw=2 if m["kind"] == "GOAL" else 0.6
-        )
-    strip.axvline(cfg.half_ticks, color="#ffeb3b", lw=1, ls=":")
-    strip.set_xlim(0, end)
-    strip.set_xticks([])
-    strip.set_yticks([])
-    cursor = strip.axvline(0, color="#00e5ff", lw=2)
-
-    def draw(w: World):
-        pos = {f"{r.team}/{r.robot}": (r.x, r.y) for r in w.robots}
-        xy = [pos.get(n, (math.nan, math.nan)) for n in names]
-        robots.set_offsets(xy)
-        for t, (x, y) in zip(numbers, xy):
-            t.set_position((x, y))
-        ball.set_offsets([[w.ball_x, w.ball_y]])
-        ball.set_sizes([40 * (1 + 2 * max(0.0, w.ball_z))])  # a lob looks larger
-        a, b = score_at(tl, w.tick)
-        head.set_text(f"{cfg.home} (a)  {a} : {b}  (b) {cfg.away}     {w.t:5.1f} s")
-        m = last_mark(tl, w.tick, within=round(3.0 / cfg.timing.dt))
-        mark.set_text("" if m is None else f"{m['kind'].replace('_', ' ')} {m['team']}".strip())
-        cursor.set_xdata([w.tick, w.tick])
-        return robots, ball, head, mark, cursor, *numbers
-
-    anim = FuncAnimation(fig, draw, frames=frames, blit=False)
-    anim.save(path, writer=PillowWriter(fps=GIF_FPS), dpi=60)
     plt.close(fig)
     return str(path)
 
