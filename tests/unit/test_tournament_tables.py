@@ -7,9 +7,12 @@ import pytest
 from arena.tools.experiments.tournament import (
     Result,
     bradley_terry,
+    charts,
     coverage,
+    print_summary,
     ratings,
     replay_odds,
+    report,
     schedule,
     standings,
     table1_rows,
@@ -165,3 +168,50 @@ def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_pat
     assert (
         f"- {faulty.id}: robot/b/1 at tick 1500: exited with code -9 (SIGKILL)" in (tmp_path / "report.md").read_text()
     )
+
+
+def test_draws_alone_give_no_ratings_and_say_why():
+    """Two draws fitted every team at 1500 with a 1500..1500 interval: certainty from no evidence."""
+    rows, notes = ratings([match(AD, BS, 0, 0), match(BS, AD, 1, 1, leg=2)], [AD, BS], boot=50)
+    assert [r["rating"] for r in rows] == [None, None] and [r["ci95"] for r in rows] == [None, None]
+    assert notes == [
+        "no ratings yet: all 2 played matches were draws, so nothing tells the strategies apart; play more legs."
+    ]
+    rows, notes = ratings([match(AD, BS, 0, 0), match(BS, AD, 1, 0, leg=2)], [AD, BS], boot=50)
+    assert all(r["rating"] is not None and r["ci95"][0] < r["ci95"][1] for r in rows)
+
+
+def test_draws_alone_print_and_write_no_rating(tmp_path, capsys):
+    results = [match(AD, BS, 0, 0), match(BS, AD, 2, 2, leg=2)]
+    summary = report(results, [AD, BS], legs=2, out=tmp_path, wall=1.0, seed=0)
+    print_summary(summary)
+    out = capsys.readouterr().out
+    assert "1500" not in out and "no ratings yet" in out
+    assert "1500" not in (tmp_path / "report.md").read_text() + (tmp_path / "ratings.csv").read_text()
+
+
+def test_goal_difference_chart_of_level_teams_has_whole_goal_axis(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from unittest import mock
+
+    import matplotlib.pyplot as plt
+
+    table = standings([match(AD, BS, 0, 0)], [AD, BS])
+    cover = coverage([match(AD, BS, 0, 0)], [AD, BS])
+    seen = {}
+    real_close = plt.close
+
+    def keep(fig):
+        seen.setdefault("axes", fig.axes[0])
+        real_close(fig)
+
+    with mock.patch.object(plt, "close", keep):
+        charts(tmp_path, table, cover)
+    ax = seen["axes"]
+    lo, hi = ax.get_ylim()
+    assert lo <= -1 and hi >= 1, (lo, hi)
+    assert all(float(t).is_integer() for t in ax.get_yticks())
+    assert "all level" in ax.get_title()
+    assert [t.get_text() for t in ax.texts] == ["0", "0"]

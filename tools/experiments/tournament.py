@@ -145,12 +145,6 @@ def short(name: str) -> str:
     return ABBREV.get(name, name)
 
 
-def file_safe(name: str) -> str:
-    """`short(name)` fit for a file name: a policy file's strategy by its prefix and file name."""
-    kind, _, path = short(name).partition(":")
-    return f"{kind}-{os.path.basename(path)}" if path else kind.replace("/", "-")
-
-
 # ------------------------------------------------------------------ schedule
 @dataclass(frozen=True)
 class Fixture:
@@ -164,8 +158,7 @@ class Fixture:
 
     @property
     def id(self) -> str:
-        """The match's file name stem: a name such as `policy:/runs/p.pkl` as `policy-p.pkl`."""
-        return f"{self.index:03d}-{file_safe(self.first)}-{file_safe(self.second)}-leg{self.leg:02d}"
+        return f"{self.index:03d}-{short(self.first)}-{short(self.second)}-leg{self.leg:02d}"
 
 
 def schedule(strategies: list[str], legs: int, seed: int) -> list[Fixture]:
@@ -349,6 +342,12 @@ def ratings(results: list[Result], teams: list[str], boot: int = 400, seed: int 
     interval then lay above its rating.)
     """
     ok = [r for r in results if r.status == "ok"]
+    if not any(r.score[0] != r.score[1] for r in ok):
+        # Draws alone (or nothing played) fit every team at 1500 with a zero-width interval: that reads as
+        # certainty that they are equal, from what is no evidence at all.
+        rows = [{"team": t, "rating": None, "ci95": None} for t in sorted(teams)]
+        why = "no match was played" if not ok else f"all {plural(len(ok), 'played match', 'played matches')} were draws"
+        return rows, [f"no ratings yet: {why}, so nothing tells the strategies apart; play more legs."]
     point = bradley_terry(ok, teams)
     strength = {t: 10 ** ((v - 1500.0) / 400.0) for t, v in point.items()}
     draw_rate = sum(1 for r in ok if r.score[0] == r.score[1]) / len(ok) if ok else 0.0
@@ -418,15 +417,20 @@ def charts(out: Path, table: list[dict], cover: dict[str, dict]) -> list[Path]:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     written = []
     teams = [r["team"] for r in table]
     fig, ax = plt.subplots(figsize=(6, 3.5))
     gd = [r["GD"] for r in table]
-    ax.bar([short(t) for t in teams], gd, color=["tab:green" if g >= 0 else "tab:red" for g in gd])
+    bars = ax.bar([short(t) for t in teams], gd, color=["tab:green" if g >= 0 else "tab:red" for g in gd])
+    ax.bar_label(bars, labels=[f"{g:+d}" if g else "0" for g in gd], padding=2)  # a 0 is said, not left blank
     ax.axhline(0, color="black", linewidth=0.8)
+    top = max(1, *(abs(g) for g in gd)) * 1.25  # whole goals: never a +-0.04 axis when every GD is 0
+    ax.set_ylim(-top, top)
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("goal difference")
-    ax.set_title("Goal difference per strategy (paper Fig. 8)")
+    ax.set_title("Goal difference per strategy (paper Fig. 8)" + ("" if any(gd) else ": all level"))
     fig.tight_layout()
     fig.savefig(out / "goal_difference.png", dpi=120)
     plt.close(fig)
@@ -482,7 +486,7 @@ def report(
     rows2 = [[short(r["team"])] + [r[c] for c in cols2[1:]] for r in table]
     cols3 = ["team", "robot1_m", "robot2_m", "ratio"]
     rows3 = [[short(t)] + [cover[t][c] for c in cols3[1:]] for t in strategies]
-    rows4 = [[short(r["team"]), r["rating"], r["ci95"][0], r["ci95"][1]] for r in rates]
+    rows4 = [[short(r["team"]), *(["", "", ""] if r["rating"] is None else [r["rating"], *r["ci95"]])] for r in rates]
     cols4 = ["team", "rating", "ci95_low", "ci95_high"]
     for name, head, rows in (
         ("table1", h1, rows1),
@@ -867,7 +871,7 @@ def print_summary(summary: dict) -> None:
         t.add_row(
             short(team),
             *(str(row[k]) for k in ("W", "D", "L", "GF", "GA", "GD", "P")),
-            f"{rr['rating']:.0f} ({rr['ci95'][0]:.0f}..{rr['ci95'][1]:.0f})",
+            "-" if rr["rating"] is None else f"{rr['rating']:.0f} ({rr['ci95'][0]:.0f}..{rr['ci95'][1]:.0f})",
             "-" if ratio is None else f"{ratio:.2f}",
         )
     c.print(t)
