@@ -50,3 +50,20 @@ def test_round_robin_as_json_has_the_table():
     assert {row["team"] for row in out["standings"]} == names == set(out["coverage"]) == set(out["strategies"])
     assert sum(row["W"] + row["D"] + row["L"] for row in out["standings"]) == 4
     assert undocumented([*out, *out["standings"][0], *out["coverage"]["basic-static"]]) == []
+
+
+def test_the_printed_lines_say_what_their_two_numbers_are():
+    """`by-fence stuck 1.1/0.0 robot-s` was printed with nothing saying which team each number is."""
+    run = subprocess.run(
+        [sys.executable, "-m", "arena", "facts", "--seeds", "1", "--home", "AD", "--away", "BS", "--half-time", "1"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    first = next(i for i, s in enumerate(lines) if s.startswith("seed "))
+    explained = "\n".join(lines[:first])
+    assert "x/y = team a (home) / team b (away)" in explained
+    for word in ("outside", "stall", "stuck", "by-fence stuck", "corner", "pushing", "contact", "overlap", "saves"):
+        assert word in lines[first] + lines[first + 1] and word in explained, word

@@ -144,6 +144,7 @@ def main(
     if results:
         lines = [*facts_table.round_robin_lines(results, facts, names), f"{len(facts)} matches {took}"]
     else:
-        lines = [*map(facts_table.line, facts), *facts_table.summary(facts), took]
+        lines = [*facts_table.header(bool(facts[0].teams)), *map(facts_table.line, facts)]
+        lines += [*facts_table.summary(facts), took]
     print("\n".join(lines))
     return 0

@@ -9,6 +9,22 @@ from arena.recording.analysis.facts import GOAL_FAR, GOAL_NEAR, OVERLAP_DEPTH, M
 from arena.schemas.vocabulary import RESTARTS
 
 
+def header(teams: bool) -> list[str]:
+    """What the per-match lines' numbers are; `teams`: the second line of team play is printed."""
+    out = [
+        "per match: outside = ticks with the ball beyond the fence; stall = longest time the ball stood still with "
+        "no referee command; stuck = longest time the ball in play stayed in one spot (what NO_PROGRESS bounds); "
+        "then the restarts given"
+    ]
+    if teams:
+        out.append(
+            "  x/y = team a (home) / team b (away); saves and blocks are made by that team; contact and overlap in "
+            "pair-seconds of two robots; by-fence stuck and corner in robot-seconds of the team's outfield robots; "
+            "pushing = fouls given against the team"
+        )
+    return out
+
+
 def line(m: MatchFacts) -> str:
     """One match; "x/y" is team a / team b (saves and blocks: made by that team's robots)."""
     restarts = " ".join(f"{k} {m.events.get(k, 0)}" for k in RESTARTS if m.events.get(k))
