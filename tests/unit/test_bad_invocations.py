@@ -71,6 +71,11 @@ BAD = [
     (["up", "compose.yaml", "--timeout", "-5"], "--timeout: '-5'"),
     # arena tournament
     ([*T, "--out", "{file}"], "exists and is not a directory"),
+    (
+        [*T, "--out", "{tmp}/typo", "--resume"],
+        "{tmp}/typo does not exist, so there is nothing to resume",
+    ),  # was 0 of N kept
+    ([*T, "--out", "{tmp}", "--resume"], "holds no tournament, so there is nothing to resume"),
     (["tournament", "--strategies", "AD"], "at least two different strategies"),
     (["tournament", "--strategies", "AD,nope"], "unknown strategy 'nope'"),
     ([*T, "--legs", "0"], "--legs: '0'"),
@@ -138,7 +143,7 @@ def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, busy_port, garbag
     r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
     assert "Traceback" not in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
-    assert needle in r.stderr, r.stderr
+    assert needle.format(busy=busy_port, file=garbage, tmp=tmp_path) in r.stderr, r.stderr
     assert r.returncode == 2, r.stderr
 
 

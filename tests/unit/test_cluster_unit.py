@@ -84,3 +84,18 @@ def test_a_failed_attempt_is_played_again_then_recorded(runner):
     assert no_json.status == "failed" and no_json.reason == "the match printed no JSON"
     crashed = cluster.finish(runner, FX, 2, {"rc": 1, "out": "", "err": "boom\nlast line\n", "wall": 1.0})
     assert crashed.reason == "last line"
+
+
+def test_ray_missing_is_refused_before_anything_is_written(tmp_path, monkeypatch):
+    """`--ray` without Ray failed, but only after logs/, matches/ and settings.json were made."""
+    import sys
+
+    from arena.runtime.config import ConfigError
+    from arena.tools.experiments import tournament
+
+    monkeypatch.setitem(sys.modules, "ray", None)  # as if not installed
+    out = tmp_path / "t"
+    opts = tournament.TournamentOptions(strategies=("advance-dynamic", "basic-static"), out=out, ray="")
+    with pytest.raises(ConfigError, match=r"--ray needs Ray: pip install"):
+        tournament.run(opts)
+    assert not out.exists()

@@ -98,6 +98,18 @@ def probe(address: str, timeout: float = 5.0) -> None:
         ) from None
 
 
+def preflight(opts: TournamentOptions) -> None:
+    """A ConfigError now for what `connect` would refuse later: no Ray, a bad address or runtime env."""
+    import importlib.util
+
+    if importlib.util.find_spec("ray") is None:
+        raise ConfigError(INSTALL_HINT)
+    address = parse_address(opts.ray)
+    parse_runtime_env(opts.ray_runtime_env)
+    if address not in (None, "auto"):
+        probe(address)
+
+
 def connect(address: str | None, local_cpus: float, runtime_env: dict | None = None):
     """ray.init for the driver; a one-line ConfigError on any failure."""
     try:

@@ -111,6 +111,10 @@ def check_resume(out: Path, now: dict) -> None:
     """ConfigError naming every setting that differs from the ones `out` was played with."""
     from arena.runtime.config import ConfigError
 
+    if not (out / "settings.json").exists() and not (out / "matches").is_dir():
+        # Starting the whole tournament from nothing is what a mistyped --out would do without a word.
+        what = "does not exist" if not out.exists() else "holds no tournament"
+        raise ConfigError(f"--resume: {out} {what}, so there is nothing to resume (leave out --resume to start one)")
     path = out / "settings.json"
     if not path.exists():
         return  # an older tournament directory: nothing recorded to compare
@@ -780,6 +784,10 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
     setup = settings(opts)
     if opts.resume:
         check_resume(out, setup)
+    if opts.ray is not None:
+        from arena.tools.experiments import cluster
+
+        cluster.preflight(opts)  # before anything is written: a failure leaves no empty tournament behind
     out.mkdir(parents=True, exist_ok=True)
     write_atomic(out / "settings.json", json.dumps(setup, indent=2))
     fixtures = schedule(strategies, opts.legs, opts.seed)
