@@ -280,7 +280,11 @@ def build_parser() -> Parser:
         metavar="S",
         help="wait this long [s] for processes to come up (30; 600 with --external)",
     )
-    m.add_argument("--record", metavar="FILE.mcap", help="record every message, a Foxglove scene and the configuration")
+    m.add_argument(
+        "--record",
+        metavar="FILE.mcap",
+        help="record every message, a Foxglove scene and the configuration to a new file (an existing one is refused)",
+    )
     m.add_argument(
         "--secure",
         action=argparse.BooleanOptionalAction,
@@ -595,7 +599,7 @@ def cmd_match(args: argparse.Namespace) -> int:
     missing = [f for f, v in (("--home", args.home), ("--away", args.away)) if v is None]
     if missing and not args.config_file:
         raise ConfigError(f"the following arguments are required: {', '.join(missing)} (or give them in --config FILE)")
-    record = record_path(args.record) if args.record else ""
+    record = record_path(args.record, fresh=True) if args.record else ""
     cfg = match_config(
         args, realtime=args.realtime, external=args.external, tap=bool(record), refbox=refbox_params(args)
     )
@@ -744,8 +748,11 @@ def live_config(cfg: MatchConfig, live: int | None, pace: float | None, host: st
     return cfg.replace(live=live, pace=pace, timing=timing)
 
 
-def record_path(text: str) -> str:
-    """An absolute path for a new MCAP file whose directory exists (children may run elsewhere)."""
+def record_path(text: str, fresh: bool = False) -> str:
+    """An absolute path for a new MCAP file whose directory exists (children may run elsewhere).
+
+    `fresh`: an existing file is refused, not overwritten (arena match; the recorder
+    it starts gets the path it checked)."""
     from pathlib import Path
 
     path = Path(text).expanduser().resolve()
@@ -753,6 +760,9 @@ def record_path(text: str) -> str:
         raise ConfigError(f"--record {text}: directory {path.parent} does not exist")
     if path.is_dir():
         raise ConfigError(f"--record {text} is a directory")
+    if fresh and path.exists():
+        size = path.stat().st_size / 1e6
+        raise ConfigError(f"--record {text} exists ({size:.1f} MB): give a new file name, or delete it first")
     # Tried now, not by the recorder after the match has started: a recorder that
     # cannot write holds every process at the start barrier until it times out.
     existed = path.exists()

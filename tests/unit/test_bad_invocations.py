@@ -47,6 +47,10 @@ BAD = [
     ([*M, "--match", "m/x"], "bad match id"),
     ([*M, "--record", "/nonexistent/dir/m.mcap"], "does not exist"),
     ([*M, "--record", "{tmp}"], "is a directory"),
+    (
+        [*M, "--record", "{file}"],
+        "garbage.txt exists (0.0 MB): give a new file name, or delete it first",
+    ),  # was overwritten
     ([*M, "--refbox-follow", "127.0.0.1:28097"], "--refbox-follow needs --realtime"),  # was a silent 0:0
     ([*M, "--record", "/proc/m.mcap"], "cannot write it"),  # the directory exists, nobody may create files in it
     ([*M, "--seed", "-1"], "--seed must be in"),
