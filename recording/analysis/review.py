@@ -173,6 +173,7 @@ def analyse(rec: Recording) -> dict:
         "truncated": rec.truncated,
         "truncation": rec.problem,
         "complete": rec.complete,
+        "interrupted": rec.meta.get("recording", {}).get("interrupted", ""),
         "undecodable": dict(sorted(rec.undecodable.items())),
         "home": cfg.home,
         "away": cfg.away,

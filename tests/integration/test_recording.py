@@ -143,6 +143,10 @@ def test_sigterm_of_the_recorder_finishes_the_file(tmp_path, reap):
     rec = load(str(path))
     assert not rec.truncated and not rec.complete
     assert rec.meta["recording"]["interrupted"] == "SIGTERM"
+    human = subprocess.run([*ARENA, "review", str(path)], capture_output=True, text=True, timeout=120)
+    assert human.returncode == 0, human.stderr
+    assert "stopped recording: the recorder was stopped by SIGTERM after" in human.stdout, human.stdout
+    assert "missed" not in human.stdout and "gap:" not in human.stdout, "a stop is not a gap"
 
 
 def test_a_recorder_started_by_hand_fetches_the_configuration(tmp_path, reap):

@@ -62,6 +62,11 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
         if recorder is not None:
             recorder.finish()
         raise InprocessError(str(exc)) from exc.__cause__
+    except KeyboardInterrupt:
+        if recorder is not None:  # a whole file that says it was stopped, as the recorder process writes
+            recorder.interrupted = "SIGINT"
+            recorder.finish()
+        raise
     play = time.perf_counter() - t0
     for line in deadlocks:
         nodes[tasks[0].name].log.error("%s", line)

@@ -46,6 +46,13 @@ def print_review(r: dict, console: Console | None = None) -> None:
     )
     if r["truncated"]:
         console.print(f"[yellow]truncated recording: {r['truncation']}; reviewed up to {r['sim_seconds']:.1f} s[/]")
+    elif r.get("interrupted"):
+        # Ctrl-C or a SIGTERM stopped the recorder (with the match, or alone): what came after is not a gap.
+        how = {"SIGINT": "SIGINT (Ctrl-C)"}.get(r["interrupted"], r["interrupted"])
+        console.print(
+            f"[yellow]stopped recording: the recorder was stopped by {how} after {r['sim_seconds']:.1f} s of "
+            f"{r['planned_sim_seconds']:.1f} s; reviewed up to there[/]"
+        )
     elif not r["complete"]:
         console.print("[yellow]incomplete recording: the recorder missed some process's frames (gaps below)[/]")
     if r.get("undecodable"):
@@ -57,7 +64,7 @@ def print_review(r: dict, console: Console | None = None) -> None:
         )
     else:
         console.print("goals: none")
-    for name, gap in r.get("gaps", {}).items():
+    for name, gap in ({} if r.get("interrupted") else r.get("gaps", {})).items():
         lost = ", ".join(f"{a}-{b}" for a, b in gap.get("lost_batches", []))
         keys = ", ".join(f"{k} {c['recorded']} of {c['sent']}" for k, c in gap.get("keys", {}).items())
         what = "; ".join(x for x in (lost and f"tap batches {lost} lost", keys, gap.get("summary", "")) if x)
