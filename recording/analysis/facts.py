@@ -53,6 +53,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from arena.recording.analysis import workload
 from arena.recording.analysis.geometry import crossing_y, footprint_overlap
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Referee, World
@@ -105,6 +106,11 @@ class MatchFacts:
     overlap_s: float = 0.0  # [pair-s]
     max_overlap_m: float = 0.0  # [m]
     fouls: dict[str, int] = field(default_factory=dict)
+    # workload.py: every outfield robot's metres by team mode, Fig. 5 area and activity ("a/1": {cell: m});
+    # every pushing foul at its impact; every robot sent off
+    metres: dict[str, dict[str, float]] = field(default_factory=dict)
+    pushing_fouls: tuple[dict, ...] = ()
+    send_offs: tuple[dict, ...] = ()
 
 
 def measure(
@@ -298,4 +304,7 @@ def measure(
         overlap_s=round(overlap * dt, 2),
         max_overlap_m=round(max_overlap, 4),
         fouls=fouls,
+        metres=workload.metres(cfg, worlds, referee),
+        pushing_fouls=tuple(workload.fouls(cfg, worlds, referee, extra)),
+        send_offs=tuple(workload.send_offs(extra)),
     )

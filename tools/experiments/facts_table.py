@@ -1,10 +1,16 @@
 """`arena facts` output: one line per match, the totals per strategy, the round robin's
-table, and all of it as one JSON object (`--json`, documented in docs/strategies.md)."""
+table, where the metres go and who was sent off, and all of it as one JSON object (`--json`,
+documented in docs/strategies.md).
+
+Longer than 150 lines because every table `arena facts` prints is formatted here, from the
+same totals its JSON holds.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 
+from arena.recording.analysis import workload
 from arena.recording.analysis.facts import GOAL_FAR, GOAL_NEAR, OVERLAP_DEPTH, MatchFacts
 from arena.schemas.vocabulary import RESTARTS
 
@@ -123,6 +129,65 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         f"robot-robot contact {contact:.1f} pair-s per match; overlap > {OVERLAP_DEPTH * 100:.0f} cm "
         f"{overlap:.2f} pair-s per match; deepest overlap {deepest * 100:.1f} cm"
     )
+    return out + workload_lines(facts)
+
+
+def workloads(facts: list[MatchFacts]) -> dict[str, dict[str, dict[str, float]]]:
+    """Per strategy, per outfield robot ("robot1", ...), its metres per match in each cell of
+    `workload.metres` (team mode / Fig. 5 area / activity) and in total, over every side it played."""
+    sums: dict[str, dict[str, dict[str, float]]] = {}
+    sides: dict[str, int] = {}
+    for m in facts:
+        for t, team in zip("ab", m.teams):
+            sides[team.strategy] = sides.get(team.strategy, 0) + 1
+            per = sums.setdefault(team.strategy, {})
+            for key, row in m.metres.items():
+                if key.startswith(t + "/"):
+                    acc = per.setdefault("robot" + key.split("/")[1], {})
+                    for cell, v in row.items():
+                        acc[cell] = acc.get(cell, 0.0) + v
+    return {
+        s: {r: {c: round(v / sides[s], 1) for c, v in sorted(row.items())} for r, row in sorted(per.items())}
+        for s, per in sorted(sums.items())
+    }
+
+
+def workload_lines(facts: list[MatchFacts]) -> list[str]:
+    """Where each outfield robot's metres go (per match, per strategy), every send-off and the pushing fouls."""
+    from arena.tools.experiments.tournament import short
+
+    out = ["metres per match by team mode | Fig. 5 area | activity (arena.recording.analysis.workload):"]
+    for s, per in workloads(facts).items():
+        for r, row in per.items():
+            parts = []
+            for axis, names in enumerate((workload.MODES, workload.AREAS, workload.ACTIVITIES)):
+                m = workload.marginal(row, axis)
+                parts.append(" ".join(f"{k} {m[k]:.0f}" for k in names if m.get(k, 0.0) >= 0.5))
+            out.append(f"  {short(s):3s} robot {r[5:]}  {row.get('total', 0.0):6.1f} m | " + " | ".join(parts))
+    pushes = [f for m in facts for f in m.pushing_fouls]
+    hit = [f for f in pushes if "unseen_closing_m" in f]
+    if pushes:
+        mean = (lambda k: sum(f[k] for f in hit) / len(hit)) if hit else (lambda k: float("nan"))
+        out.append(
+            f"pushing fouls {len(pushes)}: acted on positions {pushes[0]['latency_ms']} ms old; at the impact "
+            f"(means of {len(hit)}) the gap closed {mean('unseen_closing_m'):.3f} m within that latency, "
+            f"offender {mean('offender_speed'):.2f} m/s and victim {mean('victim_speed'):.2f} m/s towards each other"
+        )
+        doing: dict[str, int] = {}
+        for f in hit:
+            doing[f["activity"]] = doing.get(f["activity"], 0) + 1
+        out.append(
+            "  the offender was " + ", ".join(f"{k} {v}" for k, v in sorted(doing.items(), key=lambda kv: -kv[1]))
+        )
+    offs = [(m, o) for m in facts for o in m.send_offs]
+    out.append(f"send-offs {len(offs)}" + (":" if offs else ""))
+    for m, o in offs:
+        team = m.teams[0 if o["team"] == "a" else 1].strategy if m.teams else ""
+        out.append(
+            f"  seed {m.seed}: {short(team)} robot {o['robot']} ({o['team']}) {o['card']} at tick {o['tick']} "
+            f"at {o['score_then'][0]}:{o['score_then'][1]} (final {m.score[0]}:{m.score[1]}), cause {o['cause']}, its fouls at ticks "
+            + ", ".join(map(str, o["foul_ticks"]))
+        )
     return out
 
 
@@ -156,6 +221,7 @@ def as_json(facts: list[MatchFacts], latency: int, seconds: float, results: list
         "contact_s_per_match": sum(m.contact_s for m in facts) / n,
         "overlap_s_per_match": sum(m.overlap_s for m in facts) / n,
         "deepest_overlap_m": max(m.max_overlap_m for m in facts),
+        "workload": workloads(facts),
         "seconds": round(seconds, 1),
     }
     if results is not None:
