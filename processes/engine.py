@@ -11,7 +11,7 @@ Per tick k (lockstep):
    the ball on its spot and pins it there (KICKOFF also places every robot);
    START first moves every robot that is still too close to the ball spot to
    the nearest legal place (`setpieces.py`, docs/rules.md), then frees the
-   ball;
+   ball; then a scenario's teleports due at k (processes/director.py);
 2. publish every robot's `sense` for tick k, `world` (G_V), and every referee
    period the ball `events` (G_Re) gathered since the previous frame, with
    ROBOT_STUCK for robots driven but in one place (`StuckWatch`);
@@ -44,6 +44,7 @@ import time
 
 import numpy as np
 
+from arena.processes.director import Director, referee_steps
 from arena.rules import setpieces
 from arena.rules.referee_box import check_referee
 from arena.runtime import seeds
@@ -155,10 +156,14 @@ class EngineNode(Node):
         cfg = self.cfg
         self.robots = [(team, n) for team in TEAMS for n in range(cfg.robots)]
         self.physics = Physics(cfg)
-        self.physics.attack_dir_a = 1
+        self.physics.attack_dir_a = cfg.scenario.attack_dir_a
         self.physics.kickoff_positions("a")
         self.physics.stop_play()
         self.restarts = Restarts(cfg, self.physics)
+        # A scenario's steps (processes/director.py); its teleports at tick 0 are its start.
+        self.director = Director(cfg, self.physics) if cfg.scenario.active else None
+        if any(t == 0 and o.command == "START" for t, o in referee_steps(cfg.scenario.steps)):
+            self.physics.start_play()  # the ball is in play from tick 0, before the referee's frame arrives
         self.wheels = Drive(cfg.robot).wheels  # wheel speeds a `cmd` in mode "wheels" must carry
         self.sensor_rng = {
             r: NormalStream(np.random.default_rng(seeds.derive(cfg.seed, self.name, "sensor", *r))) for r in self.robots
@@ -231,10 +236,12 @@ class EngineNode(Node):
             )
 
     # -------------------------------------------------------------- per tick
-    def apply_referee(self, frames: list[Referee]) -> None:
+    def apply_referee(self, frames: list[Referee], k: int) -> None:
         for frame in frames:
             n = len(self.restarts.placed)
             self.restarts.apply_frame(frame)
+            if self.director is not None:
+                self.director.observe(frame)
             for tick, team, robot, x, y in self.restarts.placed[n:]:
                 self.log.info(
                     "tick %d: robot %s/%d too close to the ball at START, placed at (%.2f, %.2f)",
@@ -244,6 +251,8 @@ class EngineNode(Node):
                     x,
                     y,
                 )
+        if self.director is not None:
+            self.director.act(k)
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor
@@ -298,7 +307,7 @@ class EngineNode(Node):
                 yield pacer, k  # type: ignore[misc] - duck-types an Inbound: it only ever waits
             yield self.ref_in, k
             t0 = time.perf_counter()
-            self.apply_referee(self.ref_in.take(k))
+            self.apply_referee(self.ref_in.take(k), k)
             self.publish(k)
             self.last_tick = k
             if k == last:
@@ -329,7 +338,7 @@ class EngineNode(Node):
         for k in range(last + 1):
             t0 = time.perf_counter()
             self.ref_in.poll(k)
-            self.apply_referee(self.ref_in.take(k))
+            self.apply_referee(self.ref_in.take(k), k)
             self.publish(k)
             self.last_tick = k
             if k == last:

@@ -2,13 +2,16 @@
 
 Input: `engine/events`. Output: `referee`, on their schedules (`KeySpec.timing`,
 schemas/README.md): a snapshot of the box's state plus the commands issued since
-the previous frame (Re_G for the engine, and for both base stations).
+the previous frame (Re_G for the engine, and for both base stations). A
+scenario's referee overrides are forced at the first referee tick at or after
+their own (`RefereeBox.step`, `Forced`).
 """
 
 from __future__ import annotations
 
 import time
 
+from arena.processes.director import referee_steps
 from arena.rules.refbox_follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
@@ -25,11 +28,18 @@ class RefereeNode(Node):
         # --refbox-follow: a human at a real MSL RefBox decides (docs/refbox.md); our rules only end the match.
         self.follower = Follower(self.box, self.log) if self.cfg.refbox.follow else None
         self.decide = self.follower.step if self.follower else self.box.step
+        # A scenario's referee overrides (processes/director.py), each forced at the first referee tick >= its own.
+        self.forced = referee_steps(self.cfg.scenario.steps)
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         events = [ev for frame in self.events_in.take(k) for ev in frame.events]
-        self.ref_out.send(self.box.frame(k, self.decide(k, events)))
+        if self.forced and self.forced[0][0] <= k:
+            due = tuple(o for at, o in self.forced if at <= k)
+            self.forced = [(at, o) for at, o in self.forced if at > k]
+            self.ref_out.send(self.box.frame(k, self.box.step(k, events, due)))
+        else:
+            self.ref_out.send(self.box.frame(k, self.decide(k, events)))
         self.last_tick = k
         self.timed(t0)
 

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 from arena.rules import setpieces as sp
 from arena.runtime.config import TEAMS, MatchConfig
-from arena.schemas.messages import BallEvent, RefCommand, Referee
+from arena.schemas.messages import BallEvent, RefCommand, Referee, RefereeOverride
 from arena.schemas.vocabulary import REF_COMMANDS, ROBOT_COMMANDS, SEND_OFF, SET_PIECES, STAGES, other_team
 
 MSL_COMMANDS = REF_COMMANDS  # arena.schemas.vocabulary.RefCommandName: the wire types check them on decode
@@ -120,6 +120,14 @@ class Clock:
 
 
 @dataclass(frozen=True)
+class Forced:
+    """A scenario's step forces `override` at `tick` (processes/director.py; docs/scenarios.md)."""
+
+    tick: int
+    override: RefereeOverride
+
+
+@dataclass(frozen=True)
 class Observed:
     """The engine reported `event`; the referee handles it at its tick `tick`."""
 
@@ -127,7 +135,7 @@ class Observed:
     event: BallEvent
 
 
-Change = Clock | Observed
+Change = Clock | Observed | Forced
 
 
 @dataclass(frozen=True)
@@ -146,7 +154,7 @@ class Rules:
         dt, r = cfg.timing.dt, cfg.rules
         return cls(
             cfg=cfg,
-            half_ticks=cfg.half_ticks,
+            half_ticks=cfg.half_ticks - cfg.scenario.clock,  # a scenario may start with time already played
             total_ticks=cfg.total_ticks,
             kickoff_ticks=int(round(r.kickoff_time / dt)),
             setpiece_ticks=int(round(r.setpiece_time / dt)),
@@ -359,6 +367,44 @@ def on_clock(st: RefereeState, tick: int, rules: Rules) -> Result:
     return st, []
 
 
+# ------------------------------------------------------------------ overrides
+def override_spot(o: RefereeOverride, st: RefereeState, cfg: MatchConfig) -> tuple[float, float]:
+    """The ball spot of a forced command: its own, else the rule's spot that needs no ball position
+    (the centre for a kick-off, the mark for a penalty, the left corner or the goal area's centre
+    of the end the command's team attacks or defends); (0, 0) for the rest."""
+    if o.x is not None and o.y is not None:
+        return o.x, o.y
+    f = cfg.field
+    if o.command == "PENALTY" and o.team in TEAMS:
+        return sp.penalty_spot(other_team(o.team), st.attack_dir_a, cfg)
+    if o.command == "CORNER" and o.team in TEAMS:
+        return sp.corner_spot(sp.attack_dir(o.team, st.attack_dir_a) * f.length / 2, f.width / 2, cfg)
+    if o.command == "GOALKICK" and o.team in TEAMS:
+        return sp.goal_kick_spot(-sp.attack_dir(o.team, st.attack_dir_a) * f.length / 2, 0.0, cfg)
+    return 0.0, 0.0
+
+
+def forced(st: RefereeState, tick: int, o: RefereeOverride, rules: Rules) -> Result:
+    """A scenario's decision, taken as the box takes its own: a set piece is the MSL procedure (STOP,
+    the command, START after the positioning time), GOAL counts and the other team kicks off, a
+    card or REPAIR_OUT books or sends off its robot, HALF_TIME and END_GAME run their rules."""
+    spot = override_spot(o, st, rules.cfg)
+    if o.command in sp.SET_PIECES:
+        return restart(st, tick, Restart(o.command, o.team, spot), rules)
+    if o.command == "GOAL" and o.team in TEAMS:
+        return restart(st, tick, Restart("KICKOFF", other_team(o.team), (0.0, 0.0), goal=o.team), rules)
+    if o.command in ROBOT_COMMANDS:
+        st, cards = send_off(*issue(st, tick, o.command, o.team, spot, o.robot))
+        return st, list(cards)
+    if o.command == "HALF_TIME":
+        now = dataclasses.replace(rules, half_ticks=tick)
+        return half_time(dataclasses.replace(st, stage="FIRST_HALF"), tick, now) or (st, [])
+    if o.command == "END_GAME":
+        return end_game(st, tick, dataclasses.replace(rules, total_ticks=tick)) or (st, [])
+    st, c = issue(st, tick, o.command, o.team, spot)
+    return dataclasses.replace(st, start_at=-1, take_by=-1), [c]
+
+
 def process(state: RefereeState, change: Change, rules: Rules) -> Result:
     """The pure transition: the state after `change`, and the commands it issues."""
     match change:
@@ -366,6 +412,8 @@ def process(state: RefereeState, change: Change, rules: Rules) -> Result:
             return on_clock(state, tick, rules)
         case Observed(tick=tick, event=ev):
             return on_event(state, tick, ev, rules)
+        case Forced(tick=tick, override=o):
+            return forced(state, tick, o, rules)
     raise TypeError(f"not a referee change: {change!r}")
 
 
@@ -385,6 +433,8 @@ class LogEntry:
             case Observed(event=ev):
                 who = f" {ev.team}/{ev.robot}" if ev.robot >= 0 else (f" {ev.team}" if ev.team else "")
                 return f"{ev.kind.lower()}{who}"
+            case Forced():
+                return "scenario"
             case _:
                 return "clock"
 
@@ -394,14 +444,17 @@ class RefereeBox:
 
     def __init__(self, cfg: MatchConfig):
         self.rules = Rules.of(cfg)
-        self.state = RefereeState()
+        sc = cfg.scenario  # a scenario may start in a half, with a score
+        self.state = (
+            RefereeState(stage=sc.stage, score=sc.score, attack_dir_a=sc.attack_dir_a) if sc.stage else RefereeState()
+        )
         self.log: list[LogEntry] = []
         self.counts: Counter[str] = Counter()
 
-    def step(self, tick: int, events: list[BallEvent]) -> list[RefCommand]:
-        """The commands of referee tick `tick`: the engine's events first, then the clock."""
+    def step(self, tick: int, events: list[BallEvent], forced: tuple[RefereeOverride, ...] = ()) -> list[RefCommand]:
+        """The commands of referee tick `tick`: a scenario's forced ones, the engine's events, then the clock."""
         out: list[RefCommand] = []
-        for change in [*(Observed(tick, ev) for ev in events), Clock(tick)]:
+        for change in [*(Forced(tick, o) for o in forced), *(Observed(tick, ev) for ev in events), Clock(tick)]:
             pre = self.state
             state, cmds = process(pre, change, self.rules)
             if state == pre and not cmds:

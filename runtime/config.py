@@ -25,6 +25,7 @@ from typing import Any
 import msgspec
 
 from arena.schemas.keys import DEFAULT_PERIODS
+from arena.schemas.messages import Step
 from arena.schemas.vocabulary import TEAMS
 
 MAX_HALF_TIME = 3600.0  # [s] the longest half a match accepts (an MSL half is 15 min)
@@ -228,6 +229,26 @@ class RefboxParams:
 
 
 @dataclass(frozen=True)
+class ScenarioParams:
+    """A scenario's start and steps (scenarios/, docs/scenarios.md). The defaults are a plain match.
+
+    The engine and the referee read it at construction; `steps` are applied at
+    their ticks inside the lockstep, so a scenario is as deterministic as a match.
+    """
+
+    ticks: int = 0  # [ticks] the run's last tick (END_GAME); 0: the two halves
+    clock: int = 0  # [ticks] of match time already played at tick 0 (half time comes that much earlier)
+    stage: str = ""  # the referee's stage at tick 0: FIRST_HALF or SECOND_HALF; "": PRE_GAME and the usual kick-off
+    score: tuple[int, int] = (0, 0)  # goals of team a, team b at tick 0
+    attack_dir_a: int = 1  # +1: team a attacks the +x goal at tick 0
+    steps: tuple[Step, ...] = ()  # teleports and referee overrides, by tick or condition
+
+    @property
+    def active(self) -> bool:
+        return self != ScenarioParams()
+
+
+@dataclass(frozen=True)
 class MatchConfig:
     seed: int = 0
     home: str = "basic-static"  # strategy of team a
@@ -248,6 +269,7 @@ class MatchConfig:
     timing: TimingParams = TimingParams()
     rules: RulesParams = RulesParams()
     refbox: RefboxParams = RefboxParams()
+    scenario: ScenarioParams = ScenarioParams()
 
     # ----------------------------------------------------------------- derived
     @property
@@ -257,7 +279,8 @@ class MatchConfig:
     @property
     def total_ticks(self) -> int:
         """Ticks 0..total_ticks are played; the last one is END_GAME."""
-        return 2 * self.half_ticks
+        whole = 2 * self.half_ticks - self.scenario.clock
+        return min(self.scenario.ticks, whole) if self.scenario.ticks > 0 else whole
 
     def strategy_of(self, team: str) -> str:
         return self.home if team == "a" else self.away
@@ -331,6 +354,11 @@ class MatchConfig:
                 )
         if self.half_ticks < 1:
             raise ConfigError(f"--half-time {self.half_time} is shorter than one tick")
+        sc = self.scenario
+        if sc.ticks < 0 or not 0 <= sc.clock < 2 * self.half_ticks:
+            raise ConfigError(f"scenario: ticks must be >= 0 and clock within the match, got {sc.ticks}, {sc.clock}")
+        if sc.stage not in ("", "FIRST_HALF", "SECOND_HALF") or sc.attack_dir_a not in (1, -1):
+            raise ConfigError(f"scenario: stage {sc.stage!r} or attack_dir_a {sc.attack_dir_a} is not one to start in")
         if not 0 <= t.perception_latency <= MAX_PERCEPTION_LATENCY:
             raise ConfigError(
                 f"--perception-latency must be 0..{MAX_PERCEPTION_LATENCY} ticks, got {t.perception_latency}"

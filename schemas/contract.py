@@ -128,6 +128,10 @@ def _type_name(t: mi.Type) -> str:
         return f"[{t.cls.__name__}](#{t.cls.__name__.lower()})"
     if isinstance(t, mi.AnyType):
         return "any"
+    if isinstance(t, mi.NoneType):
+        return "null"
+    if isinstance(t, mi.UnionType):
+        return " or ".join(_type_name(x) for x in t.types)
     return type(t).__name__
 
 
@@ -159,6 +163,9 @@ def _nested(t: mi.Type, out: list[type]) -> None:
         _nested(t.item_type, out)
     elif isinstance(t, mi.DictType):
         _nested(t.value_type, out)
+    elif isinstance(t, mi.UnionType):
+        for x in t.types:
+            _nested(x, out)
 
 
 def _rate(k: KeySpec) -> str:
@@ -461,6 +468,9 @@ def render() -> str:
         doc = (cls.__doc__ or "").strip()
         if doc:
             lines.append(doc)
+            lines.append("")
+        if info.tag is not None:
+            lines.append(f'One of a union: the map carries `"{info.tag_field}": "{info.tag}"`.')
             lines.append("")
         lines.append("| field | type | units, frame, meaning | default |")
         lines.append("|---|---|---|---|")

@@ -331,6 +331,96 @@ class Control(Base):
     ] = -1.0
 
 
+# ------------------------------------------------------------- scenario control
+# Control as messages (the SSL simulation protocol's SimulatorControl): each is applied at one
+# tick, by the engine (teleports) or by the referee (overrides), so its effect is in every frame
+# sent after it and in the digest. A scenario (docs/scenarios.md) carries them in its steps.
+OptMeters = Annotated[float | None, Meta(description="[m] field frame; none: keep the current value")]
+OptSpeed = Annotated[float | None, Meta(description="[m/s] field frame; none: keep the current value")]
+
+
+class TeleportBall(Base, tag="teleport_ball"):
+    """Put the ball somewhere (SSL `TeleportBall`); unset fields keep their current value."""
+
+    x: OptMeters = None
+    y: OptMeters = None
+    z: Annotated[float, Meta(ge=0.0, description="[m] height; above 0 the ball flies from there")] = 0.0
+    vx: OptSpeed = None
+    vy: OptSpeed = None
+    vz: Annotated[float, Meta(description="[m/s] vertical speed")] = 0.0
+    by_force: Annotated[
+        bool,
+        Meta(description="no jump: the ball is rolled towards (x, y) so that rolling friction stops it there"),
+    ] = False
+
+
+class TeleportRobot(Base, tag="teleport_robot"):
+    """Put one robot somewhere, or take it off the field (SSL `TeleportRobot`)."""
+
+    team: Team
+    robot: Annotated[int, Meta(ge=0, description="robot number")]
+    x: OptMeters = None
+    y: OptMeters = None
+    orientation: Annotated[float | None, Meta(description="[rad] heading; none: keep it")] = None
+    vx: OptSpeed = None
+    vy: OptSpeed = None
+    omega: Annotated[float | None, Meta(description="[rad/s]; none: keep it")] = None
+    present: Annotated[
+        bool, Meta(description="false: parked beyond the fence for the rest of the match (its process plays on)")
+    ] = True
+    by_force: Annotated[
+        bool, Meta(description="no jump: the robot is pushed towards (x, y) at up to its max speed")
+    ] = False
+
+
+class RefereeOverride(Base, tag="referee"):
+    """A referee decision forced at a tick: the command, with the MSL set-piece procedure for set pieces."""
+
+    command: Annotated[RefCommandName, Meta(description="MSL RefBox command name")]
+    team: Annotated[TeamOrNone, Meta(description="target team, '' = both")] = ""
+    x: Annotated[float | None, Meta(description="[m] ball spot; none: the rule's own spot for the ball")] = None
+    y: Annotated[float | None, Meta(description="[m] ball spot; none: the rule's own spot for the ball")] = None
+    robot: Annotated[int, Meta(description="cards and REPAIR_OUT: the robot's number; else -1")] = -1
+
+
+Action = TeleportBall | TeleportRobot | RefereeOverride
+
+
+class Region(Base):
+    """An axis-aligned rectangle of the field frame."""
+
+    x0: Meters
+    y0: Meters
+    x1: Meters
+    y1: Meters
+
+    def contains(self, x: float, y: float) -> bool:
+        return min(self.x0, self.x1) <= x <= max(self.x0, self.x1) and min(self.y0, self.y1) <= y <= max(
+            self.y0, self.y1
+        )
+
+
+class Condition(Base):
+    """What the engine watches for a step's `when`: every field that is set must hold."""
+
+    ball_in: Annotated[Region | None, Meta(description="the ball's centre is in this region")] = None
+    robot: Annotated[str, Meta(description="robot for `robot_in`, e.g. a/1")] = ""
+    robot_in: Annotated[Region | None, Meta(description="`robot`'s centre is in this region")] = None
+    command: Annotated[str, Meta(description="the engine has applied this referee command")] = ""
+    possession: Annotated[TeamOrNone, Meta(description="a robot of this team holds the ball")] = ""
+
+
+class Step(Base):
+    """A scenario's step, carried in the match configuration (`scenario.steps`, docs/scenarios.md), on no key.
+
+    Do `actions` once: at tick `at`, or at the first tick at which `when` holds.
+    """
+
+    at: Annotated[int, Meta(ge=-1, description="[ticks] when to act; -1: when `when` first holds")] = -1
+    when: Annotated[Condition | None, Meta(description="the condition, if `at` is -1")] = None
+    actions: list[Action] = []
+
+
 MESSAGE_TYPES: tuple[type[Base], ...] = (
     FieldSpec,
     Sense,
@@ -344,6 +434,7 @@ MESSAGE_TYPES: tuple[type[Base], ...] = (
     Summary,
     TapBatch,
     Control,
+    Step,
 )
 
 _ENCODER = msgspec.msgpack.Encoder()

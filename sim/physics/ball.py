@@ -130,3 +130,18 @@ class BallFlight:
         """Place the ball at rest on (x, y) [m] and keep it there until `start_play`."""
         self.place_ball(x, y)
         self._pin = (x, y)
+
+    def teleport_ball(self, x: float, y: float, z: float, vx: float, vy: float, vz: float) -> None:
+        """Scenario control (processes/director.py): the ball at (x, y, z) [m] moving at (vx, vy, vz) [m/s].
+
+        Unlike `place_ball` it also releases a pinned set-piece ball; above the
+        ground it flies from there.
+        """
+        self.place_ball(x, y, vx, vy)
+        self._pin = None
+        if z > 0.0 or vz > 0.0:
+            self._z, self._vz = z, vz
+            self._airborne = True
+            self._prev_ax = abs(x)
+            self._roll.max_force = 0.0
+            self._set_ball_mask()

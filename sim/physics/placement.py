@@ -22,6 +22,18 @@ class Placement:
             return
         self._put(r, x, y, theta)
 
+    def teleport_robot(
+        self, team: str, n: int, pose: tuple[float, float, float], twist: tuple[float, float, float]
+    ) -> None:
+        """Scenario control: robot n at `pose` (x, y [m], theta [rad]) moving at `twist` (field frame,
+        [m/s], [rad/s]); its drive takes over from the next tick. A parked robot stays parked."""
+        r = self._by_id[(team, n)]
+        if r.parked:
+            return
+        self._put(r, *pose)
+        r.body.velocity = twist[0], twist[1]
+        r.body.angular_velocity = twist[2]
+
     def park_robot(self, team: str, n: int) -> tuple[float, float]:
         """Take robot n off the field for good (its process died); returns where it stands [m].
 

@@ -18,8 +18,9 @@ RANK = {
     "strategies": 3,
     "processes": 4,
     "tools": 5,
-    "learn": 6,  # arena.learn: the learning environments, over the in-process engine
-    "arena": 7,  # arena/cli.py and arena/__main__.py
+    "scenarios": 6,  # the scenario file, runner, pytest plugin and library: may use tools
+    "learn": 7,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
+    "arena": 8,  # arena/cli.py and arena/__main__.py
 }
 
 

@@ -1,0 +1,375 @@
+"""The scenario file (docs/scenarios.md): TOML read into typed, validated scenarios.
+
+A file holds one or more `[[scenario]]` tables. Each says what plays (`play`),
+how the match stands at tick 0 (`start`), what happens on the way (`step`:
+teleports, referee commands, parked robots, at a simulated time or when a
+condition first holds) and what must come true (`expect`, each with a name).
+`Scenario.config(seed)` turns one into the `MatchConfig` every engine plays:
+the start becomes steps at tick 0 (`MatchConfig.scenario`), so the engine and
+the referee apply it like any other step (processes/director.py).
+
+Every problem is a `ScenarioError` with one line: the file, the key
+(`scenario[1].expect[0].within`) and what is wrong.
+
+Longer than 150 lines because it is the whole file format: one Struct per table,
+and the validation that turns each into engine steps, read as one tree.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import msgspec
+from msgspec import Struct
+
+from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, ProcessId, ScenarioParams
+from arena.schemas.messages import Condition, RefereeOverride, Region, Step, TeleportBall, TeleportRobot
+from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
+
+SUFFIX = ".scenario.toml"
+
+
+class ScenarioError(ValueError):
+    """A scenario file that cannot be used; the message is one line naming the file and the key."""
+
+
+class Spec(Struct, kw_only=True, forbid_unknown_fields=True):
+    """File tables: an unknown key is an error (a typo must not pass silently)."""
+
+
+class Play(Spec):
+    home: str = "basic-static"
+    away: str = "basic-static"
+    robots: int = 3
+    link: str = "ideal"
+    perception_latency: int = DEFAULT_PERCEPTION_LATENCY
+    half_time: float = 300.0
+    external: list[str] = []
+
+
+class BallSpec(Spec):
+    x: float | None = None
+    y: float | None = None
+    z: float = 0.0
+    vx: float | None = None
+    vy: float | None = None
+    vz: float = 0.0
+    by_force: bool = False
+
+
+class RobotSpec(Spec):
+    robot: str
+    x: float | None = None
+    y: float | None = None
+    theta: float | None = None
+    vx: float | None = None
+    vy: float | None = None
+    omega: float | None = None
+    present: bool = True
+    by_force: bool = False
+
+
+class RefereeSpec(Spec):
+    command: str = "START"
+    team: str = ""
+    x: float | None = None
+    y: float | None = None
+    robot: str = ""
+
+
+class Start(Spec):
+    stage: str = "FIRST_HALF"
+    clock: float = 0.0
+    score: list[int] = msgspec.field(default_factory=lambda: [0, 0])
+    attack_dir_a: int = 1
+    referee: RefereeSpec = msgspec.field(default_factory=RefereeSpec)
+    ball: BallSpec | None = None
+    robots: list[RobotSpec] = []
+
+
+class When(Spec):
+    ball_in: list[float] | None = None
+    robot: str = ""
+    robot_in: list[float] | None = None
+    command: str = ""
+    possession: str = ""
+
+
+class StepSpec(Spec):
+    at: float | None = None
+    when: When | None = None
+    ball: BallSpec | None = None
+    robots: list[RobotSpec] = []
+    referee: RefereeSpec | None = None
+    park: list[str] = []
+
+
+class Expect(Spec):
+    name: str
+    kind: str
+    team: str = ""
+    robot: str = ""
+    robots: list[str] = []
+    region: list[float] | None = None
+    command: str = ""
+    within: float | None = None
+    from_: float = msgspec.field(default=0.0, name="from")
+    until: float | None = None
+    distance: float = 0.0
+    seconds: float = 0.0
+    radius: float = 0.2
+    process: str = ""
+    digest: str = ""
+
+
+class ScenarioSpec(Spec):
+    name: str
+    time_limit: float
+    description: str = ""
+    min_pass: float = 1.0
+    measured: str = ""
+    play: Play = msgspec.field(default_factory=Play)
+    start: Start | None = None
+    step: list[StepSpec] = []
+    expect: list[Expect] = []
+
+
+class FileSpec(Spec):
+    scenario: list[ScenarioSpec]
+
+
+def region(values: list[float] | None, where: str) -> Region | None:
+    if values is None:
+        return None
+    if len(values) != 4 or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{where}: a region is [x0, y0, x1, y1] in metres, got {values}")
+    return Region(x0=values[0], y0=values[1], x1=values[2], y1=values[3])
+
+
+def robot_id(text: str, robots: int, where: str) -> tuple[str, int]:
+    parts = text.split("/")
+    if len(parts) != 2 or parts[0] not in TEAMS or not parts[1].isdigit() or not 0 <= int(parts[1]) < robots:
+        raise ValueError(f"{where}: {text!r} is not a robot of this match (a/0 .. b/{robots - 1})")
+    return parts[0], int(parts[1])
+
+
+def ball_action(b: BallSpec, where: str) -> TeleportBall:
+    if b.z < 0:
+        raise ValueError(f"{where}.z: the ball's height must be >= 0 m, got {b.z}")
+    return TeleportBall(x=b.x, y=b.y, z=b.z, vx=b.vx, vy=b.vy, vz=b.vz, by_force=b.by_force)
+
+
+def robot_action(r: RobotSpec, robots: int, where: str) -> TeleportRobot:
+    team, n = robot_id(r.robot, robots, f"{where}.robot")
+    return TeleportRobot(
+        team=team,
+        robot=n,
+        x=r.x,
+        y=r.y,
+        orientation=r.theta,
+        vx=r.vx,
+        vy=r.vy,
+        omega=r.omega,
+        present=r.present,
+        by_force=r.by_force,
+    )
+
+
+def referee_action(r: RefereeSpec, robots: int, where: str) -> RefereeOverride:
+    if r.command not in REF_COMMANDS:
+        raise ValueError(f"{where}.command: {r.command!r} is not an MSL RefBox command")
+    if r.team not in ("a", "b", ""):
+        raise ValueError(f"{where}.team: {r.team!r} (a, b or empty)")
+    if r.command in ("FREEKICK", "THROWIN", "DROP_BALL") and (r.x is None or r.y is None):
+        raise ValueError(f"{where}: {r.command} needs the ball spot x and y")
+    n = robot_id(r.robot, robots, f"{where}.robot")[1] if r.robot else -1
+    if (r.command in ("YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR_OUT")) != (n >= 0):
+        raise ValueError(f"{where}.robot: cards and REPAIR_OUT need a robot, other commands none")
+    return RefereeOverride(command=r.command, team=r.team, x=r.x, y=r.y, robot=n)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One validated scenario: its file spec, where it came from, and the steps it makes."""
+
+    spec: ScenarioSpec
+    path: str
+    index: int
+    params: ScenarioParams
+    dt: float
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    def config(self, seed: int = 0, base: MatchConfig | None = None) -> MatchConfig:
+        """The match every engine plays for this scenario: `base` (default values if None) with what
+        plays, the time limit, the start and the steps."""
+        p = self.spec.play
+        base = base or MatchConfig()
+        return base.replace(
+            seed=seed,
+            home=p.home,
+            away=p.away,
+            robots=p.robots,
+            link=p.link,
+            half_time=p.half_time,
+            external=tuple(p.external),
+            timing=dataclasses.replace(base.timing, perception_latency=p.perception_latency),
+            scenario=self.params,
+        )
+
+    def ticks(self, seconds: float) -> int:
+        return int(round(seconds / self.dt))
+
+
+def start_steps(st: Start, robots: int, where: str) -> list[Step]:
+    actions: list = []
+    for i, r in enumerate(st.robots):
+        actions.append(robot_action(r, robots, f"{where}.robots[{i}]"))
+    if st.ball is not None:
+        actions.append(ball_action(st.ball, f"{where}.ball"))
+    actions.append(referee_action(st.referee, robots, f"{where}.referee"))
+    return [Step(at=0, actions=actions)]
+
+
+def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
+    if (s.at is None) == (s.when is None):
+        raise ValueError(f"{where}: give exactly one of `at` (seconds) and `when` (a condition)")
+    actions: list = [robot_action(r, robots, f"{where}.robots[{i}]") for i, r in enumerate(s.robots)]
+    for i, name in enumerate(s.park):
+        team, n = robot_id(name, robots, f"{where}.park[{i}]")
+        actions.append(TeleportRobot(team=team, robot=n, present=False))
+    if s.ball is not None:
+        actions.append(ball_action(s.ball, f"{where}.ball"))
+    if s.referee is not None:
+        if s.at is None:
+            raise ValueError(f"{where}.referee: a referee command needs `at`; the referee does not see `when`")
+        actions.append(referee_action(s.referee, robots, f"{where}.referee"))
+    if not actions:
+        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee or park)")
+    if s.at is not None:
+        if not (math.isfinite(s.at) and s.at >= 0):
+            raise ValueError(f"{where}.at: seconds >= 0, got {s.at}")
+        return Step(at=int(round(s.at / dt)), actions=actions)
+    w = s.when
+    assert w is not None
+    if w.robot_in is not None:
+        robot_id(w.robot, robots, f"{where}.when.robot")
+    if w.command and w.command not in REF_COMMANDS:
+        raise ValueError(f"{where}.when.command: {w.command!r} is not an MSL RefBox command")
+    if w.possession not in ("a", "b", ""):
+        raise ValueError(f"{where}.when.possession: {w.possession!r} (a or b)")
+    cond = Condition(
+        ball_in=region(w.ball_in, f"{where}.when.ball_in"),
+        robot=w.robot,
+        robot_in=region(w.robot_in, f"{where}.when.robot_in"),
+        command=w.command,
+        possession=w.possession,
+    )
+    if cond == Condition():
+        raise ValueError(f"{where}.when: an empty condition")
+    return Step(at=-1, when=cond, actions=actions)
+
+
+def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
+    """Validate one scenario table (raises ValueError naming the key below `scenario[i]`)."""
+    from arena.scenarios.expect import check_expect
+
+    where = f"scenario[{index}]"
+    cfg = MatchConfig()
+    dt = cfg.timing.dt
+    p = spec.play
+    if not (math.isfinite(spec.time_limit) and spec.time_limit > 0):
+        raise ValueError(f"{where}.time_limit: a positive number of seconds, got {spec.time_limit}")
+    if not 0.0 <= spec.min_pass <= 1.0:
+        raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
+    steps: list[Step] = []
+    stage, clock, score, attack = "", 0, (0, 0), 1
+    if spec.start is not None:
+        st = spec.start
+        if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
+            raise ValueError(f"{where}.start.stage: FIRST_HALF or SECOND_HALF, got {st.stage!r}")
+        if len(st.score) != 2 or min(st.score) < 0:
+            raise ValueError(f"{where}.start.score: [goals of a, goals of b], got {st.score}")
+        if st.attack_dir_a not in (1, -1):
+            raise ValueError(f"{where}.start.attack_dir_a: 1 or -1, got {st.attack_dir_a}")
+        stage, clock, score, attack = st.stage, int(round(st.clock / dt)), (st.score[0], st.score[1]), st.attack_dir_a
+        steps += start_steps(st, p.robots, f"{where}.start")
+    steps += [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
+    names = set()
+    for i, e in enumerate(spec.expect):
+        check_expect(e, p.robots, f"{where}.expect[{i}]")
+        if e.name in names:
+            raise ValueError(f"{where}.expect[{i}].name: {e.name!r} is used twice")
+        names.add(e.name)
+    params = ScenarioParams(
+        ticks=int(round(spec.time_limit / dt)),
+        clock=clock,
+        stage=stage,
+        score=score,
+        attack_dir_a=attack,
+        steps=tuple(steps),
+    )
+    sc = Scenario(spec=spec, path=path, index=index, params=params, dt=dt)
+    try:
+        sc.config()
+    except ConfigError as exc:
+        raise ValueError(f"{where}.play: {exc}") from None
+    for ext in p.external:
+        ProcessId.parse(ext)
+    return sc
+
+
+def load_all(path: str | Path) -> list[Scenario]:
+    """Every scenario of one file, validated; raises ScenarioError (one line)."""
+    path = str(path)
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read it: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not TOML: {exc}") from None
+    try:
+        spec = msgspec.convert(data, FileSpec)
+    except msgspec.ValidationError as exc:
+        text = str(exc)
+        if " - at `$" in text:
+            msg, _, key = text.rpartition(" - at `$")
+            key = key.rstrip("`").lstrip(".")
+            raise ScenarioError(f"{path}: {key}: {msg[0].lower() + msg[1:]}") from None
+        raise ScenarioError(f"{path}: {text[0].lower() + text[1:]}") from None
+    out = []
+    for i, s in enumerate(spec.scenario):
+        try:
+            out.append(build(s, path, i))
+        except (ValueError, ConfigError) as exc:
+            raise ScenarioError(f"{path}: {exc}") from None
+    return out
+
+
+def load(path: str | Path, name: str = "") -> Scenario:
+    """One scenario: the file's only one, or the one called `name`."""
+    scs = load_all(path)
+    if name:
+        for sc in scs:
+            if sc.name == name:
+                return sc
+        raise ScenarioError(f"{path}: no scenario named {name!r} (it has {', '.join(s.name for s in scs)})")
+    if len(scs) != 1:
+        raise ScenarioError(f"{path}: {len(scs)} scenarios; name the one you want")
+    return scs[0]
+
+
+def discover(target: str | Path) -> list[Path]:
+    """The scenario files of `target`: the file itself, or every *.scenario.toml under a directory."""
+    p = Path(target)
+    if p.is_dir():
+        return sorted(p.rglob(f"*{SUFFIX}"))
+    if not p.exists():
+        raise ScenarioError(f"{p}: no such file or directory")
+    return [p]

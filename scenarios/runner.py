@@ -1,0 +1,187 @@
+"""Running scenarios: one verdict per scenario and seed, a pass rate with its interval.
+
+`run_one` plays a scenario's match (`Scenario.config(seed)`) on either engine
+and judges every expectation on what it left (`Trace`): the same verdict and
+digest bit for bit on every rerun and on both engines, because the run is the
+lockstep match itself. A failing run can be played again with `record`: the
+same run, written to an MCAP file that `arena review` reads.
+
+`Outcome` gathers the verdicts of one scenario over N seeds: the pass rate,
+its 95 % Wilson score interval, and the scenario's verdict (`min_pass`).
+
+Longer than 150 lines because a verdict, an outcome and the two engines' ways of
+playing a run belong together: they are what a rerun must reproduce.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import shlex
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import msgspec
+
+from arena.scenarios.expect import Trace, judge
+from arena.scenarios.model import Scenario
+from arena.schemas.messages import Referee, World
+
+ENGINES = ("inprocess", "processes")
+Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
+
+
+@dataclass(frozen=True)
+class Failure:
+    name: str
+    tick: int
+    detail: str
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One scenario at one seed."""
+
+    scenario: str
+    path: str
+    seed: int
+    engine: str
+    passed: bool
+    failures: tuple[Failure, ...]
+    digest: str
+    score: tuple[int, int]
+    ticks: int
+    record: str = ""  # the MCAP of a failed run, if written
+
+    def replay_command(self) -> str:
+        return (
+            f"arena scenario run {shlex.quote(self.path)} --name {shlex.quote(self.scenario)} "
+            f"--seed {self.seed} --engine {self.engine} --record {shlex.quote(self.record or 'run.mcap')}"
+        )
+
+    def to_json(self) -> dict:
+        return {
+            "scenario": self.scenario,
+            "path": self.path,
+            "seed": self.seed,
+            "engine": self.engine,
+            "passed": self.passed,
+            "failures": [{"name": f.name, "tick": f.tick, "detail": f.detail} for f in self.failures],
+            "digest": self.digest,
+            "score": list(self.score),
+            "ticks": self.ticks,
+            "record": self.record,
+        }
+
+
+def wilson(passed: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """The Wilson score interval of a pass rate `passed / n` (95 % by default)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = passed / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+@dataclass
+class Outcome:
+    """A scenario over its seeds."""
+
+    scenario: Scenario
+    verdicts: list[Verdict] = field(default_factory=list)
+
+    @property
+    def passed_runs(self) -> int:
+        return sum(v.passed for v in self.verdicts)
+
+    @property
+    def rate(self) -> float:
+        return self.passed_runs / len(self.verdicts) if self.verdicts else 0.0
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.verdicts) and self.rate >= self.scenario.spec.min_pass
+
+    def to_json(self) -> dict:
+        lo, hi = wilson(self.passed_runs, len(self.verdicts))
+        return {
+            "scenario": self.scenario.name,
+            "path": self.scenario.path,
+            "passed": self.passed,
+            "pass_rate": round(self.rate, 4),
+            "wilson95": [round(lo, 4), round(hi, 4)],
+            "min_pass": self.scenario.spec.min_pass,
+            "runs": [v.to_json() for v in self.verdicts],
+        }
+
+
+def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: dict[str, str]) -> Trace:
+    cfg = sc.config()
+    f = cfg.field
+    commands = [c for r in referees for c in r.commands]
+    fence = (f.length / 2 + f.runoff, f.width / 2 + f.runoff)
+    return Trace(dt=cfg.timing.dt, worlds=worlds, commands=commands, digests=digests, fence=fence)
+
+
+def combined_digest(cfg, digests: dict[str, str]) -> str:
+    """The match digest of `arena match --json` (tools/launch/launcher.py `assemble`): every process's, in order."""
+    combined = hashlib.blake2b(digest_size=16)
+    for p in cfg.processes():
+        name = str(p)
+        if name in digests and p.kind not in ("recorder", "refbox", "viewer"):
+            combined.update(name.encode() + b"=" + digests[name].encode() + b";")
+    return combined.hexdigest()
+
+
+def _inprocess(sc: Scenario, seed: int, record: str):
+    from arena.tools.launch.inprocess import play_in_process
+
+    summaries, frames = play_in_process(sc.config(seed), watch=("world", "referee"), record=record)
+    wdec = msgspec.msgpack.Decoder(World).decode
+    rdec = msgspec.msgpack.Decoder(Referee).decode
+    worlds = [wdec(p) for p in frames["world"]]
+    referees = [rdec(p) for p in frames["referee"]]
+    digests = {name: s.digest for name, s in summaries.items() if name != "recorder"}
+    return worlds, referees, digests, combined_digest(sc.config(seed), digests)
+
+
+def _processes(sc: Scenario, seed: int, record: str):
+    from arena.recording.reader import load
+    from arena.tools.launch.launcher import play_match
+
+    with tempfile.TemporaryDirectory(prefix="arena-scenario-") as tmp:
+        path = record or str(Path(tmp) / "run.mcap")
+        result = play_match(sc.config(seed), record=path, strict=True)
+        rec = load(path, keep={"world", "referee"})
+        worlds = rec.decoded("world", World)
+        referees = rec.decoded("referee", Referee)
+    digests = {k: v for k, v in result["process_digests"].items() if k != "recorder"}
+    return worlds, referees, digests, result["digest"]
+
+
+def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:
+    """Play `sc` at `seed` on `engine` and judge every expectation. `record`: write the MCAP there."""
+    play = _inprocess if engine == "inprocess" else _processes
+    worlds, referees, digests, total = play(sc, seed, record)
+    trace = _trace(sc, worlds, referees, digests)
+    failures = []
+    for e in sc.spec.expect:
+        ok, tick, detail = judge(e, trace, sc.spec.time_limit)
+        if not ok:
+            failures.append(Failure(e.name, tick, detail))
+    last = referees[-1] if referees else None
+    return Verdict(
+        scenario=sc.name,
+        path=sc.path,
+        seed=seed,
+        engine=engine,
+        passed=not failures,
+        failures=tuple(failures),
+        digest=total,
+        score=(last.score_a, last.score_b) if last else (0, 0),
+        ticks=worlds[-1].tick if worlds else 0,
+        record=record,
+    )

@@ -1,0 +1,137 @@
+"""Control as messages: teleports and referee overrides applied at a tick, inside the digest.
+
+processes/director.py (the engine's share), rules/referee_box.py `Forced` (the
+referee's); played in process, where the digests are those of real processes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import msgspec
+import pytest
+
+from arena.processes.director import referee_steps
+from arena.rules.referee_box import Forced, RefereeState, Rules, process
+from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
+from arena.schemas.messages import (
+    Condition,
+    RefereeOverride,
+    Region,
+    Step,
+    TeleportBall,
+    TeleportRobot,
+    World,
+)
+from arena.tools.launch.inprocess import play_in_process
+
+
+def play(steps, ticks=60, stage="FIRST_HALF", seed=3, **kw):
+    cfg = MatchConfig(
+        seed=seed, home="BS", away="BS", scenario=ScenarioParams(ticks=ticks, stage=stage, steps=steps, **kw)
+    )
+    summaries, frames = play_in_process(cfg, watch=("world", "referee"))
+    dec = msgspec.msgpack.Decoder(World).decode
+    worlds = [dec(p) for p in frames["world"]]
+    refs = [msgspec.msgpack.decode(p) for p in frames["referee"]]
+    return summaries, worlds, refs
+
+
+def robot(w: World, team: str, n: int):
+    return next(r for r in w.robots if r.team == team and r.robot == n)
+
+
+def test_teleports_apply_at_their_tick():
+    steps = (
+        Step(at=0, actions=[RefereeOverride(command="START")]),
+        Step(
+            at=10,
+            actions=[
+                TeleportBall(x=1.0, y=2.0, vx=0.0, vy=0.0),
+                TeleportRobot(team="b", robot=1, x=-2.0, y=-3.0, orientation=1.0),
+            ],
+        ),
+        Step(at=20, actions=[TeleportRobot(team="a", robot=2, present=False)]),
+    )
+    _, worlds, _ = play(steps, ticks=30)
+    at = {w.tick: w for w in worlds}
+    assert (at[9].ball_x, at[9].ball_y) != (1.0, 2.0)
+    assert (at[10].ball_x, at[10].ball_y) == (1.0, 2.0), "the world frame of tick 10 shows the teleport"
+    b1 = robot(at[10], "b", 1)
+    assert (b1.x, b1.y) == (-2.0, -3.0) and math.isclose(b1.theta, 1.0)
+    assert abs(robot(at[19], "a", 2).x) < 7 and abs(robot(at[20], "a", 2).x) > 7, "present = false parks it"
+
+
+def test_by_force_rolls_the_ball_to_its_target():
+    steps = (Step(at=0, actions=[RefereeOverride(command="STOP"), TeleportBall(x=0.0, y=3.0, by_force=True)]),)
+    _, worlds, _ = play(steps, ticks=200)
+    first, last = worlds[0], worlds[-1]
+    assert (first.ball_x, first.ball_y) == (0.0, 0.0) and first.ball_vy > 0, "no jump: it rolls from where it lay"
+    assert math.hypot(last.ball_x, last.ball_y - 3.0) < 0.15 and abs(last.ball_vy) < 1e-6
+
+
+def test_a_condition_fires_once_when_it_first_holds():
+    steps = (
+        Step(at=0, actions=[RefereeOverride(command="STOP"), TeleportBall(x=0.0, y=0.0, vx=2.0, vy=0.0)]),
+        Step(when=Condition(ball_in=Region(x0=1.0, y0=-1.0, x1=2.0, y1=1.0)), actions=[TeleportBall(x=-3.0, y=0.0)]),
+    )
+    _, worlds, _ = play(steps, ticks=100)
+    jump = [w.tick for w in worlds if w.ball_x == -3.0]
+    assert len(jump) == 1 and 20 < jump[0] < 40, jump
+    assert max(w.ball_x for w in worlds if w.tick > jump[0]) < 0, "it fires once"
+
+
+def test_a_forced_corner_is_the_set_piece_procedure():
+    steps = (Step(at=0, actions=[RefereeOverride(command="CORNER", team="a")]),)
+    summaries, worlds, refs = play(steps, ticks=150)
+    log = [(e["tick"], e["command"], e["team"], e["cause"]) for e in summaries["referee"].extra["log"]]
+    assert log[:3] == [(0, "STOP", "", "scenario"), (0, "CORNER", "a", "scenario"), (100, "START", "a", "clock")]
+    corner = next(c for r in refs for c in r["commands"] if c["name"] == "CORNER")
+    cfg = MatchConfig()
+    assert (corner["x"], corner["y"]) == (cfg.field.length / 2 - 0.25, cfg.field.width / 2 - 0.25)
+    w = {w.tick: w for w in worlds}[50]
+    assert (w.ball_x, w.ball_y) == (corner["x"], corner["y"]), "the engine put the ball on the spot"
+
+
+def test_a_forced_goal_counts_and_the_start_score_carries():
+    steps = (Step(at=5, actions=[RefereeOverride(command="GOAL", team="b")]),)
+    summaries, _, refs = play(steps, ticks=20, score=(2, 1), clock=100)
+    assert summaries["referee"].extra["score"] == [2, 2]
+    assert refs[0]["stage"] == "FIRST_HALF" and (refs[0]["score_a"], refs[0]["score_b"]) == (2, 1)
+
+
+def test_half_time_comes_after_the_clock_already_played():
+    cfg = MatchConfig(half_time=10.0, scenario=ScenarioParams(ticks=200, clock=400, stage="FIRST_HALF"))
+    assert Rules.of(cfg).half_ticks == 100 and cfg.total_ticks == 200
+    st, cmds = process(RefereeState(stage="FIRST_HALF"), Forced(7, RefereeOverride(command="HALF_TIME")), Rules.of(cfg))
+    assert [c.name for c in cmds] == ["HALF_TIME", "SECOND_HALF", "KICKOFF"] and st.attack_dir_a == -1
+    assert all(c.tick == 7 for c in cmds)
+
+
+def test_steps_are_in_the_digest_and_reruns_are_identical():
+    steps = (Step(at=0, actions=[RefereeOverride(command="START")]), Step(at=30, actions=[TeleportBall(x=2.0, y=1.0)]))
+    a, _, _ = play(steps, ticks=80)
+    b, _, _ = play(steps, ticks=80)
+    c, _, _ = play(steps[:1], ticks=80)
+    assert {k: s.digest for k, s in a.items()} == {k: s.digest for k, s in b.items()}
+    assert a["engine"].digest != c["engine"].digest
+
+
+def test_referee_steps_are_in_tick_order_and_the_config_round_trips():
+    steps = (
+        Step(at=50, actions=[RefereeOverride(command="STOP")]),
+        Step(at=0, actions=[RefereeOverride(command="START"), TeleportBall(x=1.0)]),
+    )
+    assert [t for t, _ in referee_steps(steps)] == [0, 50]
+    cfg = MatchConfig(scenario=ScenarioParams(ticks=10, stage="SECOND_HALF", steps=steps))
+    assert MatchConfig.from_json(cfg.to_json()) == cfg
+    assert not MatchConfig().scenario.active
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [dict(ticks=-1), dict(clock=30000), dict(stage="HALF_TIME"), dict(attack_dir_a=0)],
+)
+def test_bad_scenario_params_are_refused(bad):
+    with pytest.raises(ConfigError, match="scenario"):
+        MatchConfig(scenario=ScenarioParams(**bad)).validate()
