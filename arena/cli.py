@@ -26,6 +26,7 @@ import signal
 import sys
 from typing import NoReturn
 
+from arena.commands import scenario as scenario_command
 from arena.runtime.config import KINDS, MAX_HALF_TIME, ConfigError, MatchConfig, ProcessId
 
 EXAMPLES = {
@@ -256,6 +257,7 @@ def build_parser() -> Parser:
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
 
+    scenario_command.add_parser(sub)
     m = add("match", "play one match, every process its own OS process, and print the score")
     _add_match_flags(m, required=False)
     m.add_argument(
@@ -1041,6 +1043,7 @@ def main(argv: list[str] | None = None) -> int:
         "review": cmd_review,
         "facts": cmd_facts,
         "replay": cmd_replay,
+        "scenario": scenario_command.run,
     }
     if args.command in ("match", "up", "bench", "facts", "review"):  # tournament and run have their own
         _TERMINATED_IN.append(os.getpid())

@@ -29,6 +29,7 @@ from msgspec import Struct
 from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, ProcessId, ScenarioParams
 from arena.schemas.messages import Condition, RefereeOverride, Region, Step, TeleportBall, TeleportRobot
 from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
+from arena.strategies import registry
 
 SUFFIX = ".scenario.toml"
 
@@ -201,6 +202,8 @@ class Scenario:
     index: int
     params: ScenarioParams
     dt: float
+    home: str  # the strategies' canonical names (strategies/registry.py)
+    away: str
 
     @property
     def name(self) -> str:
@@ -213,8 +216,8 @@ class Scenario:
         base = base or MatchConfig()
         return base.replace(
             seed=seed,
-            home=p.home,
-            away=p.away,
+            home=self.home,
+            away=self.away,
             robots=p.robots,
             link=p.link,
             half_time=p.half_time,
@@ -315,7 +318,13 @@ def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
         attack_dir_a=attack,
         steps=tuple(steps),
     )
-    sc = Scenario(spec=spec, path=path, index=index, params=params, dt=dt)
+    names = []
+    for side in ("home", "away"):
+        try:
+            names.append(registry.resolve_name(getattr(p, side)))
+        except ConfigError as exc:
+            raise ValueError(f"{where}.play.{side}: {exc}") from None
+    sc = Scenario(spec=spec, path=path, index=index, params=params, dt=dt, home=names[0], away=names[1])
     try:
         sc.config()
     except ConfigError as exc:

@@ -105,6 +105,22 @@ class Outcome:
     def passed(self) -> bool:
         return bool(self.verdicts) and self.rate >= self.scenario.spec.min_pass
 
+    def describe(self) -> str:
+        """The verdict line, and per failed expectation its name, tick, seed and the replay command."""
+        n = len(self.verdicts)
+        lo, hi = wilson(self.passed_runs, n)
+        lines = [
+            f"{'PASS' if self.passed else 'FAIL'} {self.scenario.name} ({self.scenario.path}): "
+            f"{self.passed_runs}/{n} runs passed, {self.rate:.0%} (95 % CI {lo:.0%}-{hi:.0%}), "
+            f"min_pass {self.scenario.spec.min_pass:g}"
+        ]
+        for v in self.verdicts:
+            for f in v.failures:
+                lines.append(f"  seed {v.seed}: expectation {f.name!r} failed at tick {f.tick}: {f.detail}")
+            if v.failures:
+                lines.append(f"    replay: {v.replay_command()}")
+        return "\n".join(lines)
+
     def to_json(self) -> dict:
         lo, hi = wilson(self.passed_runs, len(self.verdicts))
         return {

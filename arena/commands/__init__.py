@@ -1,0 +1,1 @@
+"""One small module per `arena` sub-command: it builds its parser and calls a typed function."""

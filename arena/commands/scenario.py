@@ -1,0 +1,144 @@
+"""`arena scenario run FILE|DIR`: every scenario at N seeds, a verdict each, a pass rate with its interval.
+
+The parser is built here and the work is `arena.scenarios` (scenarios/runner.py);
+nothing in the library imports this module.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+from pathlib import Path
+
+EXAMPLES = """\
+examples:
+  arena scenario run corner.scenario.toml                      # each scenario once, seed 0
+  arena scenario run tests/scenarios/ --seeds 10 --jobs 2      # every *.scenario.toml below, 10 seeds each
+  arena scenario run "$(arena scenario library)" --seeds 3 --junit report.xml   # the shipped library
+  arena scenario run corner.scenario.toml --name corner --seed 4 --record run.mcap   # replay one run
+  arena scenario run corner.scenario.toml --engine processes   # every process its own OS process
+
+A run fails when an expectation fails; a scenario fails when its pass rate over the
+seeds is below its min_pass. A failed scenario's failed runs are written as MCAP
+files (--records, default scenario-runs/) for arena review. Exit 0: every scenario
+passed; 1: one failed; 2: a bad file or flag. docs/scenarios.md has the file format."""
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    p = sub.add_parser(
+        "scenario",
+        help="run scenario files: verdicts per seed, pass rates (docs/scenarios.md)",
+        description="Run scenario files (docs/scenarios.md), or print where the shipped library is.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("action", choices=("run", "library"), help="run: play and judge; library: print its directory")
+    p.add_argument("target", nargs="?", metavar="FILE|DIR", help="a scenario file, or a directory of *.scenario.toml")
+    p.add_argument("--seeds", type=_count, default=1, metavar="N", help="seeds 0..N-1 per scenario (1)")
+    p.add_argument("--seed", type=_seed, metavar="S", help="just this seed")
+    p.add_argument("--name", metavar="NAME", help="just the scenario called NAME")
+    p.add_argument("--engine", choices=("inprocess", "processes"), default="inprocess", help="(inprocess)")
+    p.add_argument("--jobs", type=_count, default=1, metavar="J", help="runs at a time (1)")
+    p.add_argument("--json", action="store_true", help="one JSON object: every scenario, run and verdict")
+    p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report, one test case per scenario")
+    p.add_argument("--record", metavar="PATH", help="with one scenario and one seed: write the run's MCAP here")
+    p.add_argument(
+        "--records", metavar="DIR", default="scenario-runs", help="MCAP files of failed runs (scenario-runs)"
+    )
+    return p
+
+
+def _count(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if not 1 <= n <= 100_000:
+        raise argparse.ArgumentTypeError(f"expected a whole number 1..100000, got {text!r}")
+    return n
+
+
+def _seed(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a seed >= 0, got {text!r}") from None
+    if not 0 <= n < 2**63:
+        raise argparse.ArgumentTypeError(f"expected a seed in [0, 2^63), got {text!r}")
+    return n
+
+
+def _job(item):
+    from arena.scenarios import run_one
+
+    sc, seed, engine, record = item
+    return run_one(sc, seed, engine, record)
+
+
+def run(args: argparse.Namespace) -> int:
+    from arena.scenarios import Outcome, ScenarioError, discover, load_all
+    from arena.scenarios.junit import write_junit
+    from arena.scenarios.library import LIBRARY
+
+    prog = "arena scenario"
+    if args.action == "library":
+        print(LIBRARY)
+        return 0
+    if not args.target:
+        print(f"{prog}: error: run needs a FILE or DIR", file=sys.stderr)
+        return 2
+    try:
+        scenarios = [sc for path in discover(args.target) for sc in load_all(path)]
+    except ScenarioError as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
+    if args.name:
+        scenarios = [sc for sc in scenarios if sc.name == args.name]
+        if not scenarios:
+            print(f"{prog}: error: {args.target}: no scenario named {args.name!r}", file=sys.stderr)
+            return 2
+    if not scenarios:
+        print(f"{prog}: error: {args.target}: no *.scenario.toml files", file=sys.stderr)
+        return 2
+    seeds = [args.seed] if args.seed is not None else list(range(args.seeds))
+    if args.record and (len(scenarios) != 1 or len(seeds) != 1):
+        print(f"{prog}: error: --record needs one scenario (--name) and one seed (--seed)", file=sys.stderr)
+        return 2
+    items = [(sc, s, args.engine, args.record or "") for sc in scenarios for s in seeds]
+    if args.jobs > 1 and len(items) > 1:
+        with ProcessPoolExecutor(min(args.jobs, len(items)), mp_context=get_context("fork")) as pool:
+            verdicts = list(pool.map(_job, items))
+    else:
+        verdicts = [_job(item) for item in items]
+    outcomes = [Outcome(sc, [v for v in verdicts if v.scenario == sc.name and v.path == sc.path]) for sc in scenarios]
+    for o in outcomes:
+        if not o.passed and not args.record:
+            record_failures(o, args.records)
+    if args.junit:
+        write_junit(args.junit, outcomes)
+    if args.json:
+        print(json.dumps({"passed": all(o.passed for o in outcomes), "scenarios": [o.to_json() for o in outcomes]}))
+    else:
+        for o in outcomes:
+            print(o.describe())
+    return 0 if all(o.passed for o in outcomes) else 1
+
+
+def record_failures(o, directory: str, most: int = 3) -> None:
+    """Play a failed scenario's first failed runs again, recorded: the same runs, now as MCAP files."""
+    import dataclasses
+
+    from arena.scenarios import run_one
+
+    os.makedirs(directory, exist_ok=True)
+    for i, v in enumerate(o.verdicts):
+        if v.passed or most <= 0:
+            continue
+        most -= 1
+        path = str(Path(directory) / f"{Path(v.path).name.split('.')[0]}-{v.scenario}-seed{v.seed}.mcap")
+        again = run_one(o.scenario, v.seed, v.engine, path)
+        o.verdicts[i] = dataclasses.replace(v, record=path if again.digest == v.digest else "")

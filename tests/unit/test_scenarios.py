@@ -1,0 +1,217 @@
+"""Scenario files, expectations, `arena scenario run` and the pytest plugin (scenarios/, docs/scenarios.md)."""
+
+from __future__ import annotations
+
+import json
+import math
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from arena.cli import main
+from arena.recording.reader import load as load_recording
+from arena.scenarios import ScenarioError, load, load_all, wilson
+from arena.scenarios.expect import Trace, judge
+from arena.scenarios.model import Expect
+from arena.schemas.messages import RefCommand, RobotState, World
+
+pytest_plugins = ["pytester"]
+
+ROLL_IN = """
+[[scenario]]
+name = "roll-in"
+time_limit = 2.0
+[scenario.start]
+ball = { x = 4.0, y = 0.0, vx = 4.0, vy = 0.0 }
+robots = [{ robot = "b/0", present = false }]
+[[scenario.expect]]
+name = "a scores"
+kind = "goal"
+team = "a"
+within = 1.0
+[[scenario.expect]]
+name = "kick-off spot"
+kind = "command"
+command = "KICKOFF"
+team = "b"
+region = [-0.1, -0.1, 0.1, 0.1]
+"""
+
+NEVER = ROLL_IN.replace('name = "roll-in"', 'name = "never"').replace(
+    'kind = "goal"', 'kind = "never_command"\ncommand = "GOAL"'
+)
+
+
+@pytest.fixture
+def files(tmp_path):
+    (tmp_path / "ok.scenario.toml").write_text(ROLL_IN)
+    (tmp_path / "bad.scenario.toml").write_text(NEVER)
+    return tmp_path
+
+
+# ------------------------------------------------------------------ the file
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("within = 1.0", 'within = "soon"'), "scenario[0].expect[0].within: expected `float | null`, got `str`"),
+        (("within = 1.0", "withn = 1.0"), "scenario[0].expect[0]: object contains unknown field `withn`"),
+        (('kind = "goal"', 'kind = "goals"'), "scenario[0].expect[0].kind: 'goals' is not one of goal,"),
+        (('team = "a"', 'team = ""'), "scenario[0].expect[0].team: the kind goal needs it"),
+        (('"b/0"', '"b/7"'), "scenario[0].start.robots[0].robot: 'b/7' is not a robot of this match"),
+        (("time_limit = 2.0", "time_limit = -2.0"), "scenario[0].time_limit: a positive number of seconds"),
+        (("region = [-0.1, -0.1, 0.1, 0.1]", "region = [1, 2]"), "scenario[0].expect[1].region: [x0, y0, x1, y1]"),
+        (
+            (
+                "[scenario.start]",
+                "[[scenario.step]]\nat = 1\nwhen = { possession = 'a' }\npark = ['a/1']\n[scenario.start]",
+            ),
+            "scenario[0].step[0]: give exactly one of `at`",
+        ),
+        (
+            (
+                "[scenario.start]",
+                "[[scenario.step]]\nwhen = { possession = 'a' }\nreferee = { command = 'STOP' }\n[scenario.start]",
+            ),
+            "scenario[0].step[0].referee: a referee command needs `at`",
+        ),
+        (
+            ("[scenario.start]", "[scenario.play]\nhome = 'nobody'\n[scenario.start]"),
+            "scenario[0].play.home: unknown strategy 'nobody'",
+        ),
+    ],
+)
+def test_a_bad_file_is_one_line_naming_the_key(tmp_path, capsys, change, message):
+    path = tmp_path / "x.scenario.toml"
+    path.write_text(ROLL_IN.replace(*change))
+    with pytest.raises(ScenarioError, match="^" + str(path).replace(".", r"\.") + ": ") as err:
+        load_all(path)
+    assert message in str(err.value) and "\n" not in str(err.value)
+    assert main(["scenario", "run", str(path)]) == 2
+    err_line = capsys.readouterr().err
+    assert err_line.count("\n") == 1 and message in err_line
+
+
+def test_the_start_becomes_steps_at_tick_zero(files):
+    sc = load(files / "ok.scenario.toml")
+    cfg = sc.config(seed=5)
+    assert cfg.seed == 5 and cfg.total_ticks == 100 and cfg.scenario.stage == "FIRST_HALF"
+    (step,) = cfg.scenario.steps
+    assert step.at == 0 and [type(a).__name__ for a in step.actions] == [
+        "TeleportRobot",
+        "TeleportBall",
+        "RefereeOverride",
+    ]
+
+
+def test_wilson_interval():
+    assert wilson(0, 1) == (0.0, pytest.approx(0.7935, abs=1e-4))
+    assert wilson(3, 3)[0] == pytest.approx(0.4385, abs=1e-4)
+    lo, hi = wilson(8, 10)
+    assert lo == pytest.approx(0.4902, abs=1e-4) and hi == pytest.approx(0.9433, abs=1e-4)
+
+
+# ------------------------------------------------------------ expectations
+def world(tick, bx, by, robots=(), has=None):
+    rs = [RobotState(team=t, robot=n, x=x, y=y, theta=0.0, has_ball=(t, n) == has) for t, n, x, y in robots]
+    return World(tick=tick, t=tick * 0.02, ball_x=bx, ball_y=by, robots=rs)
+
+
+TRACE = Trace(
+    dt=0.02,
+    worlds=[
+        world(k, 0.1 * k, 0.0, [("a", 1, 0.02 * k, 1.0), ("b", 1, 2.5, 1.0)], ("a", 1) if k > 50 else None)
+        for k in range(101)
+    ],
+    commands=[RefCommand(name="CORNER", team="a", x=5.75, y=3.75, tick=40), RefCommand(name="GOAL", team="b", tick=90)],
+    digests={"engine": "abcdef0123"},
+)
+
+
+@pytest.mark.parametrize(
+    ("fields", "ok", "tick"),
+    [
+        (dict(kind="goal", team="b"), True, 90),
+        (dict(kind="goal", team="b", within=1.0), False, 50),
+        (dict(kind="goal", team="a"), False, 100),
+        (dict(kind="command", command="CORNER", region=[5.5, 3.5, 6.0, 4.0]), True, 40),
+        (dict(kind="command", command="CORNER", region=[-6.0, 3.5, -5.5, 4.0]), False, 100),
+        (dict(kind="never_command", command="GOAL", team="a"), True, 100),
+        (dict(kind="never_command", command="GOAL"), False, 90),
+        (dict(kind="ball_in", region=[5.0, -1.0, 6.0, 1.0]), True, 50),
+        (dict(kind="ball_never_in", region=[5.0, -1.0, 6.0, 1.0], until=0.9), True, 45),
+        (dict(kind="ball_never_in", region=[5.0, -1.0, 6.0, 1.0]), False, 50),
+        (dict(kind="robot_in", robot="a/1", region=[1.0, 0.0, 2.0, 2.0]), True, 50),
+        (dict(kind="robot_never_in", robot="b/1", region=[2.0, 0.0, 4.0, 2.0], **{"from_": 1.0}), False, 50),
+        (dict(kind="possession", team="a"), True, 51),
+        (dict(kind="possession", team="b"), False, 100),
+        (dict(kind="min_distance", distance=1.0), False, 76),
+        (dict(kind="min_distance", distance=1.0, until=1.5), True, 75),
+        (dict(kind="not_stuck", seconds=1.0), False, 51),
+        (dict(kind="not_stuck", seconds=1.0, robots=["a/1"]), True, 100),
+        (dict(kind="digest", process="engine", digest="abcd"), True, 100),
+        (dict(kind="digest", process="engine", digest="abce"), False, 100),
+    ],
+)
+def test_each_kind_judges_its_window(fields, ok, tick):
+    e = Expect(name="x", **fields)
+    got_ok, got_tick, detail = judge(e, TRACE, time_limit=2.0)
+    assert (got_ok, got_tick) == (ok, tick), detail
+
+
+# -------------------------------------------------------- arena scenario run
+def test_run_passes_fails_and_reports(files, tmp_path, capsys):
+    junit = tmp_path / "report.xml"
+    records = tmp_path / "runs"
+    code = main(
+        ["scenario", "run", str(files), "--seeds", "2", "--json", "--junit", str(junit), "--records", str(records)]
+    )
+    assert code == 1
+    out = json.loads(capsys.readouterr().out)
+    by_name = {s["scenario"]: s for s in out["scenarios"]}
+    assert by_name["roll-in"]["passed"] and by_name["roll-in"]["pass_rate"] == 1.0
+    never = by_name["never"]
+    assert not never["passed"] and never["wilson95"] == [0.0, pytest.approx(0.6576, abs=1e-4)]
+    failure = never["runs"][0]["failures"][0]
+    assert failure["name"] == "a scores" and failure["tick"] == 30
+    record = never["runs"][0]["record"]
+    assert record and load_recording(record).complete, "the failed run's MCAP is whole"
+    cases = ET.parse(junit).getroot().findall("testcase")
+    assert sorted(c.get("name") for c in cases) == ["never", "roll-in"]
+    assert [c.get("name") for c in cases if c.find("failure") is not None] == ["never"]
+    # the printed form names the expectation, the tick, the seed and the replay command
+    assert main(["scenario", "run", str(files / "bad.scenario.toml"), "--records", str(records)]) == 1
+    text = capsys.readouterr().out
+    assert "seed 0: expectation 'a scores' failed at tick 30" in text
+    assert "replay: arena scenario run" in text and "--seed 0" in text
+
+
+def test_reruns_give_identical_verdicts(files):
+    from arena.scenarios import run_one
+
+    sc = load(files / "ok.scenario.toml")
+    first, again = run_one(sc, 3), run_one(sc, 3)
+    assert first == again and first.passed and first.score == (1, 0)
+    assert run_one(sc, 4).digest != first.digest
+
+
+def test_min_pass_decides(files, capsys):
+    path = files / "bad.scenario.toml"
+    path.write_text(NEVER.replace("time_limit = 2.0", "time_limit = 2.0\nmin_pass = 0.0"))
+    assert main(["scenario", "run", str(path)]) == 0
+    assert capsys.readouterr().out.startswith("PASS never")
+
+
+# ------------------------------------------------------------ pytest plugin
+def test_the_plugin_collects_one_item_per_scenario(pytester):
+    pytester.makefile(".scenario.toml", two=ROLL_IN + NEVER.replace("[[scenario]]", "\n[[scenario]]", 1))
+    pytester.makepyfile(
+        test_fixture="""
+def test_it(arena_scenario):
+    outcome = arena_scenario("two.scenario.toml", name="roll-in")
+    assert outcome.passed and outcome.rate == 1.0
+"""
+    )
+    result = pytester.runpytest_inprocess("-q", "-p", "no:cacheprovider")
+    result.assert_outcomes(passed=2, failed=1)
+    result.stdout.fnmatch_lines(["*FAIL never*", "*expectation 'a scores' failed at tick 30*"])
+    assert math.isfinite(1.0)
