@@ -86,6 +86,7 @@ EXAMPLES = {
   arena bench record               # median rtf with and without --record, and the ratio
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
+  arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)""",
@@ -444,10 +445,11 @@ def build_parser() -> Parser:
     b = add("bench", "benchmarks: print throughput and ratios (medians of several runs)")
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "throughput"],
+        choices=["match", "record", "robot", "nav", "throughput", "learn"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
-        "side by side",
+        "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
+        "on 2 workers vs. 1 (needs the learn extra)",
     )
     b.add_argument(
         "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
@@ -903,11 +905,11 @@ def cmd_tournament(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    from arena.strategies import registry
     from arena.tools.experiments import bench
 
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
         from arena.runtime.links import resolve
-        from arena.strategies import registry
 
         resolve(args.link, {})
         MatchConfig(robots=args.robots, half_time=args.half_time, link=args.link).validate()
@@ -917,6 +919,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
     if args.what == "robot":
         return bench.bench_robot(args.strategy, args.json)
+    if args.what == "learn":
+        registry.resolve_name(args.strategy)
+        try:
+            from arena.learn.bench import bench_learn
+        except ImportError as exc:
+            raise ConfigError(str(exc)) from None
+        return bench_learn(args.runs, args.half_time, args.strategy, args.json)
     if args.what == "throughput":
         from arena.tools.experiments import throughput
 

@@ -125,3 +125,26 @@ def test_docs_learning_md_lists_every_observation_part_and_discrete_action():
         assert f"| `{name}` | {n} | [{lo:g}, {hi:g}] | {text} |" in doc, name
     for i, (name, a) in enumerate(DISCRETE):
         assert f"| {i} | {name} | {', '.join(f'{x:g}' for x in a)} |" in doc, name
+
+
+def test_a_tournament_names_a_policy_files_matches_by_its_file_name():
+    from arena.tools.experiments.tournament import Fixture
+
+    fx = Fixture(3, "policy:/runs/x/keeper.pkl", "advance-dynamic", 2, "policy:/runs/x/keeper.pkl", "AD", 1)
+    assert fx.id == "003-policy-keeper.pkl-AD-leg02"
+
+
+def test_arena_bench_learn_reports_the_ratios():
+    import json
+
+    r = subprocess.run(
+        [sys.executable, "-m", "arena", "bench", "learn", "--runs", "1", "--half-time", "0.5", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["match_ticks_per_cpu_second"] > 0 and out["env1_steps_per_cpu_second"] > 0
+    assert out["env1_ratio"] == round(out["env1_steps_per_cpu_second"] / out["match_ticks_per_cpu_second"], 3)
+    assert set(out["vector_ratio"]) == {"1", "5"}

@@ -149,6 +149,12 @@ def short(name: str) -> str:
     return ABBREV.get(name, name)
 
 
+def file_safe(name: str) -> str:
+    """`short(name)` fit for a file name: a policy file's strategy by its prefix and file name."""
+    kind, _, path = short(name).partition(":")
+    return f"{kind}-{os.path.basename(path)}" if path else kind.replace("/", "-")
+
+
 # ------------------------------------------------------------------ schedule
 @dataclass(frozen=True)
 class Fixture:
@@ -162,7 +168,8 @@ class Fixture:
 
     @property
     def id(self) -> str:
-        return f"{self.index:03d}-{short(self.first)}-{short(self.second)}-leg{self.leg:02d}"
+        """The match's file name stem: a name such as `policy:/runs/p.pkl` as `policy-p.pkl`."""
+        return f"{self.index:03d}-{file_safe(self.first)}-{file_safe(self.second)}-leg{self.leg:02d}"
 
 
 def schedule(strategies: list[str], legs: int, seed: int) -> list[Fixture]:

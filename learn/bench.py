@@ -1,0 +1,127 @@
+"""`arena bench learn`: env steps per CPU-second against the in-process match's ticks per CPU-second.
+
+Each run plays the same 3v3 match (referee on, both teams by `strategy`) three
+ways, interleaved: as an in-process match (`--engine inprocess`), and as a
+`SoccerParallelEnv` episode with 1 and with 3 controlled robots (team a's,
+fixed pre-drawn actions, one step per tick, reset included). CPU seconds are
+this process's (`time.process_time`), so a loaded host slows both sides alike;
+the ratios are the figures to compare. Then the vector env: `SoccerEnv`s in 1
+and in 2 worker processes (`AsyncVectorEnv`), stepped for the same number of
+steps each; its figure is wall-clock steps per second, since it is about cores.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import time
+
+import numpy as np
+from rich.console import Console
+
+from arena.learn.parallel import SoccerParallelEnv
+from arena.learn.single import make_vector_env
+from arena.runtime.config import MatchConfig
+from arena.tools.launch.inprocess import play_in_process
+
+ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  # cycled: no draw in the loop
+
+
+def match_rate(cfg: MatchConfig) -> float:
+    """In-process match: ticks per CPU-second."""
+    t0 = time.process_time()
+    play_in_process(cfg, watch=())
+    return (cfg.total_ticks + 1) / (time.process_time() - t0)
+
+
+def env_rate(cfg: MatchConfig, agents: list[str]) -> float:
+    """One whole-match episode (reset included): env steps per CPU-second."""
+    env = SoccerParallelEnv(
+        agents=agents,
+        home=cfg.home,
+        away=cfg.away,
+        robots=cfg.robots,
+        half_time=cfg.half_time,
+        end_on_goal=False,
+        config=cfg,
+    )
+    t0 = time.process_time()
+    env.reset(seed=cfg.seed)
+    n = 0
+    while env.agents:
+        a = ACTIONS[n % len(ACTIONS)]
+        env.step({x: a for x in env.agents})
+        n += 1
+    return n / (time.process_time() - t0)
+
+
+def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1) -> float:
+    """`workers` SoccerEnvs in their own processes: wall-clock env steps per second over `steps` vector steps."""
+    venv = make_vector_env(
+        workers, robot="a/1", home=strategy, away=strategy, half_time=half_time, frame_skip=frame_skip
+    )
+    try:
+        venv.reset(seed=0)
+        batch = np.repeat(ACTIONS[:1], workers, axis=0)
+        for _ in range(20):  # warm up: the workers are forked and their first match built
+            venv.step(batch)
+        t0 = time.perf_counter()
+        for i in range(steps):
+            batch[:] = ACTIONS[i % len(ACTIONS)]
+            venv.step(batch)
+        return workers * steps / (time.perf_counter() - t0)
+    finally:
+        venv.close()
+
+
+def bench_learn(
+    runs: int = 3, half_time: float = 30.0, strategy: str = "advance-dynamic", as_json: bool = False
+) -> int:
+    console = Console(stderr=True)
+    rates: dict[str, list[float]] = {"match": [], "env1": [], "env3": []}
+    for i in range(runs):
+        cfg = MatchConfig(seed=500 + i, home=strategy, away=strategy, half_time=half_time)
+        console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, 3v3, referee on ...")
+        rates["match"].append(match_rate(cfg))
+        rates["env1"].append(env_rate(cfg, ["a/1"]))
+        rates["env3"].append(env_rate(cfg, ["a/0", "a/1", "a/2"]))
+        console.print("  " + ", ".join(f"{k} {v[-1]:.0f}/cpu-s" for k, v in rates.items()))
+    med = {k: statistics.median(v) for k, v in rates.items()}
+    steps = int(round(2 * half_time / 0.02))
+    vec = {}
+    for skip in (1, 5):
+        console.print(f"vector env, frame_skip {skip}: 1 worker, then 2, {steps // skip} steps each ...")
+        vec[skip] = [vector_rate(w, steps // skip, half_time, strategy, skip) for w in (1, 2)]
+    out = {
+        "runs": runs,
+        "half_time": half_time,
+        "strategy": strategy,
+        "cpus": os.cpu_count(),
+        "loadavg_1min": round(os.getloadavg()[0], 2),
+        "match_ticks_per_cpu_second": round(med["match"], 1),
+        "env1_steps_per_cpu_second": round(med["env1"], 1),
+        "env3_steps_per_cpu_second": round(med["env3"], 1),
+        "env1_ratio": round(med["env1"] / med["match"], 3),
+        "env3_ratio": round(med["env3"] / med["match"], 3),
+        "all": {k: [round(x, 1) for x in v] for k, v in rates.items()},
+        # frame_skip -> [1 worker, 2 workers] wall-clock env steps per second, and their ratio
+        "vector_steps_per_second": {str(k): [round(x, 1) for x in v] for k, v in vec.items()},
+        "vector_ratio": {str(k): round(v[1] / v[0], 3) for k, v in vec.items()},
+    }
+    if as_json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"in-process match       {out['match_ticks_per_cpu_second']:8.0f} ticks/cpu-s")
+    print(
+        f"env, 1 robot           {out['env1_steps_per_cpu_second']:8.0f} steps/cpu-s  "
+        f"{out['env1_ratio']:.2f} x the match (target >= 0.9)"
+    )
+    print(f"env, 3 robots          {out['env3_steps_per_cpu_second']:8.0f} steps/cpu-s  {out['env3_ratio']:.2f} x")
+    for skip, (v1, v2) in vec.items():
+        print(
+            f"vector env, frame_skip {skip}: 1 worker {v1:6.0f} steps/s, 2 workers {v2:6.0f} steps/s (wall): "
+            f"{v2 / v1:.2f} x (target >= 1.8 on 2 idle cores)"
+        )
+    print(f"host: {out['cpus']} cpus, 1-minute load average {out['loadavg_1min']}")
+    return 0
