@@ -136,6 +136,7 @@ def _advance(task: Task) -> None:
                     return
         try:
             w = next(steps)
+            w[0].waited = w[1]
         except StopIteration:
             task.waiting = None
             task.done = True

@@ -381,11 +381,11 @@ class Node:
         links: dict[str, dict[str, float]] = {}
         delays: dict[str, list[float]] = {}
         for ib in self.inbound:
-            e = ib.emulator
+            frames, dropped, kept = ib.counted()
             agg = links.setdefault(ib.link_class, {"frames": 0.0, "dropped": 0.0})
-            agg["frames"] += e.frames
-            agg["dropped"] += e.dropped
-            delays.setdefault(ib.link_class, []).extend(round(d, 3) for d in e.delays_ms)
+            agg["frames"] += frames
+            agg["dropped"] += dropped
+            delays.setdefault(ib.link_class, []).extend(round(d, 3) for d in kept)
         tick_us: list[float] = []
         if self._work_s:
             w = sorted(self._work_s)

@@ -39,6 +39,8 @@ def test_a_recorded_inprocess_match_has_the_same_records_and_digests(tmp_path):
     assert got["inprocess"]["engine"] == "inprocess"
     assert got["processes"]["process_digests"] == got["inprocess"]["process_digests"]
     assert got["processes"]["recording"]["messages"] == got["inprocess"]["recording"]["messages"]
+    # The link counters too: only the frames the receivers waited for, never those racing the end.
+    assert got["processes"]["links"] == got["inprocess"]["links"]
     assert got["inprocess"]["recording"]["complete"] is True
     records = {e: records_in_file_order(rec[e]) for e in rec}
     assert len(records["processes"]) > 1000

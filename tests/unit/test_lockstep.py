@@ -397,3 +397,29 @@ def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
     with pytest.raises(ValueError, match="boom"):
         Reactor(timeout=1.0).run(broken())
     h.close()
+
+
+def test_the_counters_count_the_frames_waited_for_not_those_racing_the_end():
+    """links.sensor.sent was 72012, 72004, 72006 in runs of one seed: frames that landed after the
+    receiver's last wait were counted or not depending on how fast its summary was taken."""
+    from arena.runtime.lockstep import pull
+
+    harness = Harness(emulator=ScriptedLink([0.0, None, 30.0, 0.0, None, 0.0, 0.0]))
+    try:
+        ib = harness.inbound
+
+        def loop():
+            for k in range(1, 5):  # waits for ticks 0..3 (lag 1)
+                yield ib, k
+
+        for k in range(4):
+            harness.put(encode(Cmd(tick=k)))
+        pull(loop())
+        frames, dropped, delays = ib.counted()
+        assert (frames, dropped) == (4, 1)
+        for k in range(4, 7):  # in flight at the end: taken in by the transport's callback, or not
+            harness.put(encode(Cmd(tick=k)))
+        ib.sync(7)
+        assert ib.emulator.frames == 7 and ib.counted() == (frames, dropped, delays), "the late ones do not count"
+    finally:
+        harness.close()
