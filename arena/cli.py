@@ -67,8 +67,16 @@ EXAMPLES = {
   arena run viewer --match demo --connect tcp/192.168.1.10:7447 --port 8765
   # the RefBox bridge on the laptop the base stations reach (the match was started with --refbox ... --external refbox)
   arena run refbox --match demo --connect tcp/192.168.1.10:7447""",
-    "up": """examples:
-  arena up compose.yaml            # the services of compose.yaml as local processes
+    "up": """The match is compose.yaml's: 2 x 300 s of basic-static vs advance-dynamic, seed 7, link wifi,
+unless the environment says otherwise (the same variables docker compose expands):
+  ARENA_HOME, ARENA_AWAY   strategies of team a and team b
+  ARENA_HALF_TIME          simulated seconds per half (300)
+  ARENA_SEED, ARENA_LINK   master seed (7) and link preset (wifi)
+  ARENA_MATCH              match id, the key prefix arena/<id>/ (a fresh one)
+
+examples:
+  arena up compose.yaml                        # the services of compose.yaml as local processes
+  ARENA_HALF_TIME=30 arena up compose.yaml     # 2 x 30 s instead of 2 x 300 s
   arena up compose.yaml --json""",
     "tournament": """examples:
   arena tournament                                  # the paper's experiment: 4 strategies x 10 legs = 60 matches

@@ -14,7 +14,7 @@ import zenoh
 
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas.messages import RefCommand, Referee, Report, encode
-from tests.integration.helpers import ARENA, arena_json, spawn, wait_for
+from tests.integration.helpers import ARENA, spawn, wait_for
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -191,7 +191,13 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
 
 def test_arena_up_runs_the_compose_file_as_local_processes():
     env = dict(os.environ, ARENA_HALF_TIME="3", ARENA_SEED="2")
-    r = arena_json("up", str(REPO / "compose.yaml"), env=env, timeout=240)
+    run = subprocess.run(
+        [*ARENA, "up", str(REPO / "compose.yaml"), "--json"], capture_output=True, text=True, env=env, timeout=240
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    r = json.loads(run.stdout)
+    # What it plays, and how to change it, is said before it plays (it was 2 x 300 s without a word).
+    assert "2 x 3 s simulated, seed 2, link wifi" in run.stderr and "ARENA_HALF_TIME" in run.stderr
     assert r["services"][0] == "router" and len(r["services"]) == 11
     assert len({p["pid"] for p in r["processes"]}) == 10
     assert r["seed"] == 2 and r["half_time"] == 3.0 and r["link"] == "wifi"

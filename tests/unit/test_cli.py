@@ -69,3 +69,11 @@ def test_help_texts_show_examples():
     for cmd in ("match", "run", "up", "bench", "review", "replay"):
         r = arena(cmd, "--help")
         assert r.returncode == 0 and "examples:" in r.stdout
+
+
+def test_arena_up_help_says_how_long_it_plays_and_which_variables_change_it():
+    """`arena up` played 2 x 300 s, and ARENA_HALF_TIME was documented only in a compose.yaml comment."""
+    out = arena("up", "--help").stdout
+    assert "2 x 300 s" in out
+    for var in ("ARENA_HALF_TIME", "ARENA_HOME", "ARENA_AWAY", "ARENA_SEED", "ARENA_LINK", "ARENA_MATCH"):
+        assert var in out, var

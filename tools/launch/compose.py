@@ -141,6 +141,12 @@ def up(path: str, timeout: float = 600.0) -> dict:
                 if name != router:
                     children.append(launcher.spawn(name, _process_of(argv), _argv(argv), tmp, env=env))
             cfg = _fetch(transport, keys, children)
+            print(
+                f"arena up: {cfg.home} (a) vs {cfg.away} (b), 2 x {cfg.half_time:g} s simulated, seed {cfg.seed}, "
+                f"link {cfg.link} (the environment's ARENA_HOME, ARENA_AWAY, ARENA_HALF_TIME, ARENA_SEED and "
+                "ARENA_LINK change them)",
+                file=sys.stderr,
+            )
             declared = {c.pid for c in children if c.name != "router"}
             missing = [str(p) for p in cfg.processes() if p not in declared]
             if missing:
