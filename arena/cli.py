@@ -1,10 +1,5 @@
 """The `arena` command: one subcommand per job.
 
-Longer than 150 lines because it is the whole command line in one place: the argument
-tables of every subcommand with their examples (`build_parser`, over 150 lines itself,
-one block per subcommand) and one short `cmd_*` per subcommand that turns the flags into
-typed calls.
-
 Bad input never ends in a traceback. Exit codes, the same for every subcommand:
 
 * 0: done;
@@ -247,7 +242,7 @@ def parser() -> Parser:
     return _PARSER[0]
 
 
-def build_parser() -> Parser:
+def build_parser() -> Parser:  # noqa: PLR0915 - the argument tables of every sub-command
     top = Parser(
         prog="arena",
         description="Wheeled-robot soccer (RoboCup MSL / KRSBI-B) as separate processes over zenoh.",
@@ -1035,7 +1030,7 @@ class Terminated(KeyboardInterrupt):
 _TERMINATED_IN: list[int] = []  # the pid that installed `_terminated`
 
 
-def _terminated(signum, frame):  # noqa: ARG001 - signal handler signature
+def _terminated(signum, frame):
     if os.getpid() not in _TERMINATED_IN:  # a child forked before it set SIGTERM back: die as by default
         signal.signal(signum, signal.SIG_DFL)
         os.kill(os.getpid(), signum)
@@ -1084,7 +1079,7 @@ def main(argv: list[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"arena {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
-    except Exception as exc:  # noqa: BLE001 - the last line of defence: one line, the details in a log
+    except Exception as exc:
         return internal_error(args.command, exc)
 
 

@@ -7,7 +7,7 @@ Needs the `learn` extra: pip install 'soccer-arena[learn]'.
 """
 
 try:
-    import gymnasium  # noqa: F401
+    import gymnasium
     import pettingzoo  # noqa: F401
 except ImportError:
     raise ImportError("arena.learn needs the learn extra: pip install 'soccer-arena[learn]'") from None

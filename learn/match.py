@@ -1,8 +1,5 @@
 """A match that pauses wherever a learner's robot needs an action.
 
-Longer than 150 lines because the gate, the gated robot loop and the match that opens
-the gates are one mechanism: who waits where holds only across the three.
-
 The in-process engine (runtime/coop.py) runs every node of a match on one
 thread, each node's lockstep generator resumed while the link it waits on is
 ready. `SteppedMatch` builds the very same nodes, gives each learner's robot a

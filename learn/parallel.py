@@ -1,8 +1,5 @@
 """`SoccerParallelEnv`: a PettingZoo `ParallelEnv` whose episodes are real matches.
 
-Longer than 150 lines because the PettingZoo API (spaces, reset, step, the episode's
-end and its digests) is one class whose docstring is the spec.
-
 Agents are the robots a learner controls, any subset of either team ("a/1",
 "b/0", ...); every other robot, and both base stations, are played by the
 team's named strategy (a built-in or a plugin), and the referee plays too: set

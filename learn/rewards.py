@@ -35,5 +35,5 @@ class GoalReward:
     def __init__(self, progress: float = 0.0):
         self.progress = progress
 
-    def __call__(self, agent: str, o: Outcome) -> float:  # noqa: ARG002
+    def __call__(self, agent: str, o: Outcome) -> float:
         return float(o.goals_for - o.goals_against) + self.progress * o.ball_progress

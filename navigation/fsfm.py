@@ -2,10 +2,6 @@
 "Responsive Motion Control for Robot Soccer Navigation Using Adaptive Social
 Force Framework", 2021), eq. 8-14 and the rule table of its Fig. 4.
 
-Longer than 150 lines because it is one model, the fuzzy inference system (membership
-functions, rules, centre of area) and the force law that uses it, each cited to paper
-1's equations below.
-
 A fuzzy inference system (FIS) maps each obstacle's distance d and relative
 direction gamma to the gain k of that obstacle's force in the SFM (eq. 6-7,
 :mod:`arena.navigation.sfm`); everything else is the SFM. Per obstacle j:

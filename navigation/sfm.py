@@ -3,9 +3,6 @@
 Navigation Using Adaptive Social Force Framework", 2021), eq. 3-7 and 17-20,
 with the parameters of its Table 1.
 
-Longer than 150 lines because of this docstring: every equation of paper 1 used here,
-with its symbols and units, is written out next to the code.
-
 Eq. 3, navigation force:   F^n = F^g + sum_j F^o_j
 Eq. 4, goal force:         F^g = m (v0 e_g - v) / tau
 Eq. 5, obstacle force:     F^o_j = f^o_s + f^o_p

@@ -1,9 +1,5 @@
 """Game rule engine process: the pymunk world, the tick clock, ball events.
 
-Longer than 150 lines because the engine is where the referee's commands meet the
-physics: `Restarts` (set pieces, sending off, parking) and `EngineNode` (over 150 lines
-itself: wiring, checks, both loops) follow the one tick order below.
-
 Per tick k (lockstep):
 
 1. apply the referee frames delivered by k (`apply_command`): the side

@@ -1,10 +1,5 @@
 """Recorder process: the match's MCAP log (docs/recording.md).
 
-Longer than 150 lines because the recorder is one process in two halves that share the
-file: `McapSink` writes channels, metadata and the file's end, and `RecorderNode` (over
-150 lines itself) gathers every process's taps and summaries, reports what the file
-lacks (`gaps`) and closes a truncated match.
-
 The recorder does not subscribe to the match's data keys: every other process
 taps what it sends and publishes it in batches (runtime/tap.py), which costs
 the match a fraction of what a second copy of every frame would. The recorder
@@ -444,23 +439,23 @@ class RecorderNode(Node):
             self._next_scene = tick + self._scene_every
             self.sink.add(scene.SCENE_TOPIC, ns, self.scene.update(self._decode_world(payload), ns))
 
-    def _referee_log(self, tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG002 - derivation signature
+    def _referee_log(self, tick: int, ns: int, payload: bytes) -> None:
         for log in self.scene.referee_log(self._decode_referee(payload), ns):
             self.sink.add(scene.LOG_TOPIC, ns, log)
 
-    def _events_log(self, tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG002 - derivation signature
+    def _events_log(self, tick: int, ns: int, payload: bytes) -> None:
         for log in self.scene.events_log(self._decode_events(payload), ns):
             self.sink.add(scene.LOG_TOPIC, ns, log)
 
     def _role_of(self, team: str, n: int):
-        def role(tick: int, ns: int, payload: bytes) -> None:  # noqa: ARG001 - derivation signature
+        def role(tick: int, ns: int, payload: bytes) -> None:
             self.scene.roles[(team, n)] = self._decode_role(payload).role
 
         return role
 
     # ------------------------------------------------------------------- loop
     def _on_signal(self, stop: threading.Event):
-        def handler(signum, frame):  # noqa: ARG001 - signal handler signature
+        def handler(signum, frame):
             self.interrupted = signal.Signals(signum).name
             stop.set()
 

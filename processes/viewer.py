@@ -1,9 +1,5 @@
 """Viewer process: watch a match as it plays, in the Foxglove app (docs/recording.md).
 
-Longer than 150 lines because `ViewerNode` (over 150 lines itself) holds the Foxglove
-server's wiring, its parameters and the one `watch` loop that turns frames into scene,
-log and match messages, all sharing the newest-frame rings and the server.
-
 `arena match --live [PORT]` starts it; `arena run viewer` attaches one to a
 match by hand. It serves the Foxglove WebSocket protocol (foxglove-sdk's
 server, which runs on the SDK's own threads) with:
@@ -203,11 +199,11 @@ class ViewerNode(Node):
             Parameter("pace", value=float(self.pace)),
         ]
 
-    def on_get_parameters(self, client, param_names, request_id=None):  # noqa: ARG002 - SDK callback
+    def on_get_parameters(self, client, param_names, request_id=None):
         with self._lock:
             return [p for p in self._parameters() if not param_names or p.name in param_names]
 
-    def on_set_parameters(self, client, parameters, request_id=None):  # noqa: ARG002 - SDK callback
+    def on_set_parameters(self, client, parameters, request_id=None):
         """Runs on the SDK's thread: sends a `Control` frame to the engine at once."""
         if not self.lockstep_control:
             return self._parameters()

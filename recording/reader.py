@@ -78,12 +78,12 @@ class Recording:
         return out
 
 
-def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:
+def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:  # noqa: C901, PLR0912, PLR0915 - one pass over the file, every topic and damage counted where met
     """Read `path`; keep the messages of the topics in `keep` (all when None)."""
     p = Path(path)
     try:
         size = p.stat().st_size
-        fh = open(p, "rb")  # noqa: SIM115 - closed below
+        fh = open(p, "rb")
     except OSError as exc:
         raise RecordingError(f"cannot read {path}: {exc.strerror}") from None
     if size == 0:

@@ -1,10 +1,5 @@
 """The Foxglove-viewable layer of a match recording (docs/recording.md).
 
-Longer than 150 lines because it is the one translation from match frames to Foxglove's
-scene, used by the recorder and the live viewer alike: the field's primitives and
-`SceneBuilder` (over 150 lines itself, mostly `update` and `beliefs`) share colours and
-frame conventions.
-
 Foxglove decodes neither msgpack nor CBOR, so next to the raw msgpack channels
 the recorder writes two protobuf channels with their schemas embedded, built
 with foxglove-sdk's message types:

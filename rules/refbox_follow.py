@@ -1,9 +1,5 @@
 """Following a human referee: a real RefBox's commands turned into our referee's state.
 
-Longer than 150 lines because the transition `follow`, the `Follower` that
-drives it in the referee, and `ViaRefbox`, the same follower inside our own
-base station for `--via-refbox`, are one mapping and change together.
-
 `arena match --refbox-follow HOST:PORT` (docs/refbox.md): our referee
 connects to the official MSL RefBox as a base station would
 (`RefboxClient`) and, instead of deciding, applies each command it receives

@@ -1,9 +1,5 @@
 """The MSL RefBox wire protocol, both generations, as pure functions and small readers.
 
-Longer than 150 lines because it is one protocol: the command
-tables, both framings, the worldstate validator and the team table belong
-together and are checked together (tests/unit/test_refbox_protocol.py).
-
 Sources (read with the RoboCup-MSL/RefBox repository and a KRSBI-B base station):
 * 2020 JSON protocol, RoboCup-MSL/RefBox `mslrb2015/Comms.pde`
   (`send_to_basestation`): one JSON object `{"command": C, "targetTeam": T}`

@@ -1,8 +1,5 @@
 """The RefBox's base-station server: a real TCP server on its own thread.
 
-Longer than 150 lines because `BridgeServer` is one class: accept, identify, send, read and
-close each handle their own socket errors, and they share the connection table.
-
 What it does, as the MSL RefBox does it (rules/refbox_protocol.py has the
 sources): a base station connects; it is identified by its source address
 (`a.b.c.*`) against the team table, or, without a table, takes the first free

@@ -33,12 +33,7 @@ tabled in docs/rules.md:
 Every restart is the MSL set-piece procedure: STOP, then the command with
 its team and ball spot (`setpieces.py`), then after the positioning time
 START for the same team. Time is the tick it is handed; nothing here reads a
-clock or draws a random number.
-
-Longer than 150 lines because every rule of docs/rules.md is a few lines
-here, and they are read, tested and changed as one table, next to the state
-they share.
-"""
+clock or draws a random number."""
 
 from __future__ import annotations
 

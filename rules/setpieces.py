@@ -36,11 +36,7 @@ A goalkeeper (robot 0) inside its own penalty area is exempt, so that a free
 kick near its goal does not pull it out. When the positioning time is over
 (START) the engine moves every robot still too close to the nearest free spot
 just outside the distance (`legal_spot`); the robot keeps its heading.
-A penalty has its own positions (`penalty_positions`).
-
-Longer than 150 lines because the spots, the distances and the placements that
-enforce them are one procedure, checked by one set of tests.
-"""
+A penalty has its own positions (`penalty_positions`)."""
 
 from __future__ import annotations
 

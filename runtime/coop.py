@@ -1,9 +1,5 @@
 """Cooperative lockstep: every node of a match in ONE thread, no locks.
 
-Longer than 150 lines because the cooperative bus, its channels and the `drive`
-scheduler that parks and wakes nodes on them are one mechanism: its invariant (who waits
-on which channel) holds only across all three.
-
 Each node's lockstep loop is a generator that yields `(inbound, k)` where it
 needs that link's frames due at tick k (runtime/lockstep.py). `drive` resumes
 each generator as long as the link it waits on is `ready(k)`, and parks it

@@ -1,9 +1,5 @@
 """Per-match credentials: zenoh users and passwords, a per-event TLS CA, MAC keys.
 
-Longer than 150 lines because a match's users, passwords and MAC keys, the zenoh
-fragments written from them and the per-match TLS CA are made together and must agree;
-the docstring explains the security design they implement.
-
 `arena match` makes one `Secrets` per match and writes, for every principal,
 one zenoh configuration fragment `<user>.json5` (schemas/README.md,
 "Security"): everything a C, C++ or Rust client needs besides the router's

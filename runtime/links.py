@@ -1,8 +1,5 @@
 """Link emulation: latency, jitter and Gilbert-Elliott bursty loss, seeded per link.
 
-Longer than 150 lines because of this docstring: the delay and loss models are written
-out with their formulas next to the code that implements them.
-
 Every inbound link of a process gets a `LinkEmulator` with its own RNG
 (derived from the master seed and the link's name). For each frame, in the
 order the sender sent them, it decides: drop, or deliver after a delay.

@@ -1,10 +1,5 @@
 """Deterministic lockstep time (design.md section 3).
 
-Longer than 150 lines because it is the lockstep protocol in one place: schedules,
-rejections, the watchdog, outbound links, the reactor and `Inbound` (over 150 lines
-itself: accept, emulate, hold and release one link's frames) share the invariants
-written out below.
-
 Conservative synchronisation with lookahead:
 
 * Every link has a **schedule** (period and phase, in ticks): its sender emits
@@ -157,7 +152,7 @@ class Watchdog:
             self._thread.join(timeout=1.0)
 
 
-def _drop(payload: bytes) -> None:  # noqa: ARG001 - a muted Outbound's put
+def _drop(payload: bytes) -> None:
     return None
 
 

@@ -1,9 +1,5 @@
 """A match configuration file (TOML): `arena match --config FILE.toml`, `arena config --print`.
 
-Longer than 150 lines because loading (with a checked message per key) and dumping (with
-each key's unit and comment) are the two directions of one file format and must stay
-symmetric.
-
 The file holds the `MatchConfig` tree a user may want to change: the match
 (seed, strategies, robots, half time), `[links]` (the preset and per-class
 overrides), and `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and

@@ -1,9 +1,5 @@
 """What every process of a match shares: identity, wiring, barrier, summary.
 
-Longer than 150 lines because `Node` (over 150 lines itself) is the one base class every
-process kind shares: wiring, links, the start barrier, the loops and the summary call
-each other through the same state, which mixins would scatter.
-
 A process kind subclasses `Node`, declares its links in `__init__` with
 `out(...)` and `inp(...)`, and implements `loop()`. `run()` then does the rest:
 
@@ -233,7 +229,7 @@ class Node:
     def on_peer_dead(self, peer: str) -> None:
         """Hook: a peer we were waiting for is dead (its inputs no longer come)."""
 
-    def _on_collector(self, key: str, alive: bool) -> None:  # noqa: ARG002
+    def _on_collector(self, key: str, alive: bool) -> None:
         self._collector = alive
 
     def _on_alive(self, key: str, alive: bool) -> None:

@@ -1,9 +1,5 @@
 """Pacing a lockstep match for a live viewer: real-time speed, pause, step.
 
-Longer than 150 lines because the `Pacer` is one small state machine (pace, pause, step,
-anchor) shared by the engine's loop and its own thread, whose rules read best side by
-side; a fifth of it is this docstring.
-
 `arena match --live` starts a viewer (processes/viewer.py); in lockstep the
 engine then waits on a `Pacer` before each tick, as it waits on a link: the
 lockstep loop yields `(pacer, k)`, and the pacer is ready for tick k when
@@ -42,7 +38,7 @@ POLL_S = 0.05  # [s] wall: pull mode, how often a paused engine looks for contro
 LIVE_WORLD_HZ = 10.0  # [Hz] match time: world frames an unpaced live match puts on the wire
 
 
-def _nowhere(payload: bytes) -> None:  # noqa: ARG001 - a gate not yet in front of a put
+def _nowhere(payload: bytes) -> None:
     return None
 
 
@@ -151,7 +147,7 @@ class Pacer:
                 if left > 0:
                     self._cond.wait(left)
 
-    def _is_dead(self, peer: str) -> bool:  # noqa: ARG002 - Inbound's interface
+    def _is_dead(self, peer: str) -> bool:
         return False
 
     def _give_up(self, why: str) -> None:

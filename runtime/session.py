@@ -1,9 +1,5 @@
 """Zenoh session factory, isolated by default.
 
-Longer than 150 lines because every way a zenoh session is opened (endpoints and their
-checks, scouting, lease, a user's zenoh runtime setting) lives here, so that isolation
-is decided in one place; an eighth of it is this docstring.
-
 Multicast scouting is off unless asked for, and every session has explicit
 endpoints, so twenty matches on one machine, or CI next to other zenoh
 processes on port 7447, never hear each other. On top of that every match has

@@ -1,10 +1,5 @@
 """The transport behind a small interface: zenoh for real, memory for unit tests.
 
-Longer than 150 lines because it holds the one `Transport` interface with both of its
-implementations, zenoh (with the MAC-verifying channel) and in-memory, kept side by side
-so that they stay in step; `ZenohTransport` is over 150 lines itself because it is that
-whole interface on zenoh, one short method per operation.
-
 Processes see only `Transport`: publishers, pull-style subscriptions (the
 main thread blocks in `recv`, the fastest receive style measured on 2 cores,
 see notes-zenoh-mcap.md), a local wake-up, liveliness, queryables (the match
@@ -401,7 +396,7 @@ class MemoryTransport:
         self.bus = bus
         self._tokens: list[str] = []
 
-    def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:  # noqa: ARG002
+    def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:
         # No attachments on the memory bus: it runs in one trusted process (unit tests).
         bus = self.bus
 
@@ -410,10 +405,10 @@ class MemoryTransport:
 
         return put
 
-    def subscribe(self, key: str, latest: int = 0, verify=None, on_forged=None) -> Channel:  # noqa: ARG002 - unbounded here
+    def subscribe(self, key: str, latest: int = 0, verify=None, on_forged=None) -> Channel:
         return self.bus.subscribe(self, key)
 
-    def subscribe_callback(self, key: str, callback: Callable[[bytes], None], verify=None, on_forged=None) -> None:  # noqa: ARG002
+    def subscribe_callback(self, key: str, callback: Callable[[bytes], None], verify=None, on_forged=None) -> None:
         # A callback would run in the sender's thread, inside the sender's own
         # tick: nodes on a memory bus pull from channels instead (Node.reactive).
         raise NotImplementedError("MemoryTransport delivers to channels only")
@@ -421,7 +416,7 @@ class MemoryTransport:
     def wake(self, key: str) -> None:
         self.bus.deliver(key, WAKE, only=self)
 
-    def has_subscribers(self, key: str) -> bool:  # noqa: ARG002
+    def has_subscribers(self, key: str) -> bool:
         return True
 
     def declare_alive(self, key: str) -> None:
@@ -438,7 +433,7 @@ class MemoryTransport:
         payload = self.bus._served.get(key)
         return payload if payload is None or isinstance(payload, bytes) else payload()
 
-    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:  # noqa: ARG002
+    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
         payload = self.query(key, timeout)
         if payload is not None:
             on_reply(payload)

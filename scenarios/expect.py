@@ -5,11 +5,7 @@ them). Each judges its window `[from, until]` (seconds; `within` is a
 shorthand for `until`) of the `Trace`: the ground-truth `world` frames (every
 tick), the referee's commands and the processes' digests. A judgement is
 `(passed, tick, detail)`: the tick is where it failed (the first offending
-tick of a "never" kind, the window's last tick of a "happens" kind).
-
-Longer than 150 lines because every kind of docs/scenarios.md is here, a few lines
-each, next to the validation that names a bad key.
-"""
+tick of a "never" kind, the window's last tick of a "happens" kind)."""
 
 from __future__ import annotations
 

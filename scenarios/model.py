@@ -9,11 +9,7 @@ the start becomes steps at tick 0 (`MatchConfig.scenario`), so the engine and
 the referee apply it like any other step (processes/director.py).
 
 Every problem is a `ScenarioError` with one line: the file, the key
-(`scenario[1].expect[0].within`) and what is wrong.
-
-Longer than 150 lines because it is the whole file format: one Struct per table,
-and the validation that turns each into engine steps, read as one tree.
-"""
+(`scenario[1].expect[0].within`) and what is wrong."""
 
 from __future__ import annotations
 

@@ -7,11 +7,7 @@ lockstep match itself. A failing run can be played again with `record`: the
 same run, written to an MCAP file that `arena review` reads.
 
 `Outcome` gathers the verdicts of one scenario over N seeds: the pass rate,
-its 95 % Wilson score interval, and the scenario's verdict (`min_pass`).
-
-Longer than 150 lines because a verdict, an outcome and the two engines' ways of
-playing a run belong together: they are what a rerun must reproduce.
-"""
+its 95 % Wilson score interval, and the scenario's verdict (`min_pass`)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
 """Generates schemas/README.md, the wire contract, from the declarations.
 
-Longer than 150 lines because it renders the whole wire contract (schemas/README.md):
-the header, how-to-join and security prose as long text constants, the type and
-constraint helpers, and the schedule table.
-
 The key table comes from schemas/keys.py (KEYS), the field tables from the
 msgspec Structs in schemas/messages.py with their `Meta` descriptions, so the
 document cannot drift from the code: `arena schemas --check` (and a test)

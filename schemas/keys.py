@@ -1,11 +1,7 @@
 """Key expressions: every data pair is one zenoh key under `arena/<match>/`.
 
 `KEYS` is the single table the wire contract (schemas/README.md), the
-recorder and the process wiring are derived from.
-
-Longer than 150 lines because every key expression of the wire is built
-here and nowhere else (the table, the infrastructure keys, the builders).
-"""
+recorder and the process wiring are derived from."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
 """The wire messages: one typed msgpack map per data pair of the IRIS diagram.
 
-Longer than 150 lines because it is the whole wire vocabulary: one small Struct per
-message, every field with its `Meta` description, in one module so that the contract
-renders from one place.
-
 Each message is a msgspec Struct encoded as a msgpack *map* with the field
 names as keys, so any stock msgpack library can read and write it. Every
 message carries `tick`: the control tick (default 20 ms) at which it was sent.

@@ -1,8 +1,5 @@
 """The strategy conformance suite: checks any `Strategy`, built-in or a user's plugin.
 
-Longer than 150 lines because it is one suite: the scripted inputs, the runner, and the
-short checks that use them.
-
 Like Gymnasium's ``api_test``/``seed_test``, every check is a plain function
 that raises `AssertionError` with a readable message, so that a plugin's own
 tests can run them::

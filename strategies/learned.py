@@ -1,8 +1,5 @@
 """A learned policy as a robot brain: observation, action and policy file (numpy only).
 
-Longer than 150 lines because the observation, the action and the policy file are
-one contract between a training process and a robot process: split, the two could drift.
-
 What a learning environment (`arena.learn`) and a deployed robot process share,
 so that a policy trained in one process plays unchanged as a robot process:
 
@@ -286,7 +283,7 @@ class RecordedActions:
         self.actions = [np.asarray(a) for a in actions]
         self.i = 0
 
-    def __call__(self, obs: np.ndarray) -> Any:  # noqa: ARG002
+    def __call__(self, obs: np.ndarray) -> Any:
         a = self.actions[self.i] if self.i < len(self.actions) else np.zeros_like(self.actions[0])
         self.i += 1
         return a
@@ -318,7 +315,7 @@ def save_policy(
 def load_policy(path: str | Path) -> PolicyFile:
     """Read a policy file; ConfigError (one line) if it cannot be."""
     try:
-        data = pickle.loads(Path(path).read_bytes())  # noqa: S301 - the user's own file, as a plugin is
+        data = pickle.loads(Path(path).read_bytes())
     except FileNotFoundError:
         raise ConfigError(f"policy file {path} not found") from None
     except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as exc:

@@ -1,8 +1,5 @@
 """IRIS strategy choice and role assignment (paper 2, "IRIS Base Station" and "IRIS Role Assignment").
 
-Longer than 150 lines because strategy choice, the areas and the role transitions of
-paper 2 are one automaton, written out below and implemented next to each other.
-
 * Strategy S of eq. 5: S1 when the score is level, S2 (offensive) when losing,
   S3 (defensive) when winning (`choose_strategy`).
 * Areas (paper 2, Fig. 5): the defender area runs from our goal line to

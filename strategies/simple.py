@@ -1,9 +1,5 @@
 """Chase-and-shoot: the simple baseline team play.
 
-Longer than 150 lines because `SimpleRobot` (over 150 lines itself) is the whole
-baseline robot, positioning, chasing, shooting and keeping goal, whose private helpers
-serve its two decisions, `_position` at a restart and `_play` in play.
-
 `STRATEGIES` offers it under the paper's four names; strategies/registry.py
 decides which names it gets. The behaviour:
 

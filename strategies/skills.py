@@ -1,9 +1,5 @@
 """Robot skills as pure geometry: where to stand, where to aim, when to kick.
 
-Longer than 150 lines because it is a library of small pure geometry functions (none
-over 35 lines) used by every strategy; splitting it would only spread the shared
-`SkillParams`.
-
 Everything here is a function of positions in the field frame (schemas/messages.py)
 and a frozen `SkillParams`; nothing keeps state, reads a clock or draws random
 numbers. The robot brain (:mod:`arena.strategies.iris`) turns the targets into

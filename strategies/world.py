@@ -1,9 +1,5 @@
 """Perception and fusion: the base station's P_A, P_B, P_ball (paper 2, eq. 5) and a robot's own view.
 
-Longer than 150 lines because both ends of perception live here, the base station's
-fusion (`BallFilter`, `TeamModel`) and a robot's own view (`RobotView`), which reuse the
-same `FusionParams` and ball filter.
-
 Base station (`TeamModel.update`), from the robots' reports R_n_B = {P_An, P_Bn, P_ball}:
 
 * P_A: each robot's own reported pose (the freshest report wins);
@@ -209,7 +205,7 @@ class RobotView:
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
-    def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
+    def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:  # noqa: PLR0912 - one branch per frame part of the world model
         own_ball = self.own_ball
         if sense is not None:
             p = sense.pose

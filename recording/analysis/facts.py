@@ -41,12 +41,7 @@ Between robots (`contact_s`, `overlap_s`, `max_overlap_m`): the footprints are
 the robots' squares; `contact_s` counts pair-seconds in play with the
 footprints within `CONTACT_GAP` of each other, `overlap_s` pair-seconds (at any
 time) with the footprints overlapping by more than `OVERLAP_DEPTH` (robots
-driving through each other), `max_overlap_m` the deepest overlap seen.
-
-Longer than 150 lines because `measure` is one pass over the world frames in
-which every fact is updated from the same per-frame state (who plays, the
-pending shots, the stuck spells); split, each part would re-walk the frames.
-"""
+driving through each other), `max_overlap_m` the deepest overlap seen."""
 
 from __future__ import annotations
 
@@ -113,7 +108,7 @@ class MatchFacts:
     send_offs: tuple[dict, ...] = ()
 
 
-def measure(
+def measure(  # noqa: C901, PLR0912, PLR0915 - every fact updated from one walk over the frames
     cfg: MatchConfig, worlds: list[World], referee: dict[int, Referee], extra: dict, distance: dict
 ) -> MatchFacts:
     f, radius, dt = cfg.field, cfg.rules.progress_radius, cfg.timing.dt

@@ -7,11 +7,7 @@ counts for the team whose robot holds the ball on its dribbler, else for the
 team of the robot nearest the ball if it is within `POSSESSION_RADIUS`, else
 for nobody (a loose ball). Distance per robot is the engine's Summary (physics
 at 250 Hz, the number `arena match` reports), or the world frames when the
-file has no summary.
-
-Longer than 150 lines because `analyse` gathers every section of the review
-dict in one place, so that its shape (what `--json` prints) reads at once.
-"""
+file has no summary."""
 
 from __future__ import annotations
 

@@ -32,12 +32,7 @@ STOP with the footprints in contact; speeds from the tick before it), the latenc
 offender acted on (the perception latency: it saw the opponent as it was that
 many ticks earlier), how much the centre-to-centre gap closed within that
 latency (what it could not yet see), and the offender's and the victim's
-speeds towards each other at the impact.
-
-Longer than 150 lines because the metres and the fouls are told apart with the
-same definitions (team mode, the kick line, the direction of motion), which
-belong next to each other.
-"""
+speeds towards each other at the impact."""
 
 from __future__ import annotations
 

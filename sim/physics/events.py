@@ -1,8 +1,5 @@
 """Line and foul events, and play on or off.
 
-Longer than 150 lines because of this docstring, which states the line and foul rules
-that the `Events` mixin implements.
-
 * **Play and stoppages.** The engine switches play off (`stop_play`) when
   the referee stops the game and on again at START (`start_play`). While
   play is off nothing counts as a touch, no event is reported and the

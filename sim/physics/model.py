@@ -7,11 +7,7 @@ wheels (`sim/drive.py`: IRIS omni4, paper 2 eq. 3-4, or Robotino omni3,
 paper 1 eq. 1-2): a body twist (mode "body") or wheel speeds (mode
 "wheels", forward kinematics) become a body twist within the wheel-speed
 saturation, max_speed and max_omega, turned into the field frame once per
-tick with the heading at mid-tick.
-
-Longer than 150 lines because `__init__` declares the state of every
-mixin in one place, so that it reads as one list.
-"""
+tick with the heading at mid-tick."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
 """Ball handling, the same for all four strategies: who goes for the ball, getting it, kicking and passing it.
 
-Longer than 150 lines because `HandlingMixin` is the one ball-handling behaviour of all
-four strategies, whose methods (choose the chaser, get the ball, turn and kick, pass,
-unstall, nudge) call one another; the rules they follow are listed below.
-
 * the ball: the robot whose area holds the ball and that is nearest goes
   for it (paper 2: "pick up the ball"); the others take their positions
   (`home`); a robot that has just passed leaves the ball to the receiver;

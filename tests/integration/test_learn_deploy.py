@@ -10,7 +10,7 @@ from tests.integration.helpers import arena_json
 pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from arena.learn import SoccerParallelEnv  # noqa: E402
+from arena.learn import SoccerParallelEnv
 
 
 def test_an_episode_replayed_through_the_distributed_match_gives_the_envs_digests(tmp_path):

@@ -11,13 +11,13 @@ import pytest
 pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test, parallel_seed_test
 
-from arena.learn import SoccerEnv, SoccerParallelEnv, make_vector_env  # noqa: E402
-from arena.runtime.config import ConfigError, MatchConfig  # noqa: E402
-from arena.strategies import registry  # noqa: E402
-from arena.tools.launch.inprocess import play_in_process  # noqa: E402
+from arena.learn import SoccerEnv, SoccerParallelEnv, make_vector_env
+from arena.runtime.config import ConfigError, MatchConfig
+from arena.strategies import registry
+from arena.tools.launch.inprocess import play_in_process
 
 SHORT = dict(home="AD", away="BS", half_time=0.6)  # 61 ticks: fast, and the kick-off is played
 

@@ -1,9 +1,6 @@
 """`arena bench match`: simulation speed of whole matches, as medians of several runs.
 `arena bench record`: the same with and without `--record`, and the ratio.
 
-Longer than 150 lines because it holds every `arena bench` subcommand (match, record,
-robot), each a short measure-and-print function.
-
 Speed is a feature measured here, never by timed assertions in tests: the
 machine is shared and noisy, so every figure is a median over `--runs` runs.
 """

@@ -1,9 +1,5 @@
 """`arena tournament --ray [ADDRESS]`: every fixture one Ray task, the tables on the driver.
 
-Longer than 150 lines because everything Ray-specific stays in this one module (Ray is
-imported only here): address and runtime-env parsing, the version fingerprint, the
-worker task and the driver's loop with its retries.
-
 Ray is imported only here, and only when `--ray` is given. Each task runs on a
 worker node the same `arena match ... --json` command that a local job runs,
 in its own process group with its own zenoh router (a unix socket in a private

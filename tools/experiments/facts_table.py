@@ -1,10 +1,6 @@
 """`arena facts` output: one line per match, the totals per strategy, the round robin's
 table, where the metres go and who was sent off, and all of it as one JSON object (`--json`,
-documented in docs/strategies.md).
-
-Longer than 150 lines because every table `arena facts` prints is formatted here, from the
-same totals its JSON holds.
-"""
+documented in docs/strategies.md)."""
 
 from __future__ import annotations
 

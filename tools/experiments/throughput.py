@@ -17,11 +17,7 @@ figure is derived, not measured, as the smaller of two bounds:
   measured match to 600 simulated seconds.
 The in-process engine's match is one thread (its CPU ~ its wall), so its two
 bounds agree; the distributed engine's eleven processes share the cores, so
-the CPU bound is the one that holds for it.
-
-Longer than 150 lines because the benchmark, its derived figures and the table
-that prints them with their definitions are one report, read side by side.
-"""
+the CPU bound is the one that holds for it."""
 
 from __future__ import annotations
 

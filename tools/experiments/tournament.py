@@ -1,9 +1,5 @@
 """`arena tournament`: round-robins of strategies, with the paper's tables and statistics.
 
-Longer than 150 lines because it is one tournament end to end: schedule, resume,
-statistics (standings, coverage, Bradley-Terry), the report, and `Runner` (over 150
-lines itself: one fixture played locally or in-process, with retry and stop).
-
 Every pairing of the strategies plays `legs` matches, alternating home and
 away, each with a seed derived from the tournament seed. Every match is a full,
 isolated `arena match` process group; `--jobs` of them run at once. Each
@@ -680,7 +676,7 @@ class Runner:
             if self.stopping:
                 return None
             t0 = time.monotonic()
-            log = open(self.logs_dir / f"{fx.id}.log", "w")  # noqa: SIM115 - handed to the child
+            log = open(self.logs_dir / f"{fx.id}.log", "w")
             proc = subprocess.Popen(
                 self.command(fx), stdout=subprocess.PIPE, stderr=log, text=True, start_new_session=True
             )
@@ -727,7 +723,7 @@ class Runner:
                 p.send_signal(signal.SIGINT)  # arena match stops its whole process group
 
 
-def _interrupt(signum, frame) -> None:  # noqa: ARG001
+def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
@@ -740,7 +736,7 @@ def _worker_init() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except OSError:
         pass
-    import arena.processes.engine  # noqa: F401 - the heavy imports (pymunk, numpy), once per worker
+    import arena.processes.engine
     import arena.tools.launch.inprocess  # noqa: F401
 
 

@@ -1,8 +1,5 @@
 """`arena up compose.yaml`: the compose file's services as local processes.
 
-Longer than 150 lines because it reads, expands and supervises a compose file end to end
-(`load_services`, `up`), mirroring `docker compose up` in one place.
-
 No Docker engine runs on our machines, so this reads the very same file
 `docker compose up` would, expands its `${VAR:-default}` variables, and starts
 each service's `command` as a local process, the router first. It sets

@@ -1,9 +1,5 @@
 """An honest match result: who failed, when, and whether the match counts.
 
-Longer than 150 lines because blame and outcome are one judgement and read best
-side by side with the failure kinds and the outcome rules they implement, which
-this docstring states in full.
-
 The launcher observes three kinds of failure, each with the process's name:
 
 * `crashed`: a child exited non-zero, or exited without a summary;

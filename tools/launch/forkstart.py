@@ -1,9 +1,5 @@
 """Start a match's processes by forking one parent that has imported everything.
 
-Longer than 150 lines because forking safely is one protocol (preload, fork, release
-pipe, re-title, child setup, `Popen`-like waiting) whose rules, listed below, must hold
-together.
-
 `arena match` used to start every process as `python -m arena run <kind>`:
 eleven interpreters, each importing zenoh, numpy, pymunk and the strategies,
 which took about 1.4 s of a match's wall time on a quiet host and ~2.5 s of
@@ -95,7 +91,7 @@ def warm() -> None:
         for value in vars(messages).values():
             if isinstance(value, type) and issubclass(value, messages.Base):
                 msgspec.msgpack.Decoder(value)
-    except Exception:  # noqa: BLE001, S110
+    except Exception:
         pass
 
 

@@ -94,7 +94,7 @@ def play_in_process(
     cfg: MatchConfig,
     watch: tuple[str, ...] = ("world",),
     timeout: float = 120.0,
-    record: str = "",  # noqa: ARG001
+    record: str = "",
 ):
     """Play `cfg` in this thread. Returns (summaries by process, {key name: [payload, ...]}).
 

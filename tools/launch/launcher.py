@@ -1,9 +1,5 @@
 """`arena match`: one match as a group of OS processes, supervised.
 
-Longer than 150 lines because it is the whole life of a distributed match: spawning,
-joins, the collector, supervision (`supervise`) and the result (`assemble`,
-`play_match`), which share the child table and the match's deadlines.
-
 The launcher hosts the match's zenoh router (a unix socket in a private temp
 dir unless `--listen` says otherwise), starts every process with the same
 `arena run <kind> ...` command a user would type, waits for each one's
@@ -242,7 +238,7 @@ def run_argv(
 
 def spawn(name: str, pid: ProcessId, argv: list[str], log_dir: Path, env: dict[str, str] | None = None) -> Child:
     log_path = log_dir / (name.replace("/", "_") + ".log")
-    fh = open(log_path, "wb")  # noqa: SIM115 - handed to the child
+    fh = open(log_path, "wb")
     try:
         popen = subprocess.Popen(
             argv,
@@ -444,7 +440,7 @@ def supervision_deadline(cfg: MatchConfig) -> float:
     return t.startup_timeout + play + t.wait_timeout + SUMMARY_GRACE + FINISH_GRACE
 
 
-def supervise(
+def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way a process can end
     transport: ZenohTransport,
     collector,
     keys: Keys,
@@ -729,7 +725,7 @@ def startup_seconds(summaries: dict[str, Summary], launched: float) -> float | N
     return round(started - launched, 3) if started else None
 
 
-def play_match(
+def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect are one sequence
     cfg: MatchConfig,
     *,
     match: str | None = None,

@@ -1,9 +1,5 @@
 """`arena run <kind>`: start one process of a match on its own.
 
-Longer than 150 lines because it is every way one process joins a match (configuration
-from a file, flags or the engine's queryable; credentials; duplicate refusal; the router
-of a secure match), which `run` ties together.
-
 This is the hardware-in-the-loop path: the same command runs a robot's
 process on the robot's own computer, or a base station on the team's laptop,
 against the rest of the match.
@@ -42,7 +38,7 @@ from arena.schemas.keys import Keys, process_names
 from arena.schemas.messages import Referee
 
 
-def _sigterm(signum, frame):  # noqa: ARG001 - signal handler signature
+def _sigterm(signum, frame):
     raise SystemExit(128 + signum)
 
 

@@ -1,9 +1,5 @@
 """A fork server: every match of a long-lived process gets forked, warm children.
 
-Longer than 150 lines because it is one protocol on both sides of one socket (the
-launcher's `Zygote`, the server's loop, the parked child) whose rules below must
-hold together.
-
 `tools/launch/forkstart.py` forks a match's processes from the launcher itself, which
 works only while the launcher has never opened zenoh: zenoh's runtime threads
 outlive a session and a fork lacks them. A process that plays match after match
@@ -186,7 +182,7 @@ def _serve(ctl: socket.socket, launcher: int, kinds: set[str], strategies: set[s
                 break
             for _ in range(int(msg)):
                 _park_one(ctl, launcher)
-    except BaseException:  # noqa: BLE001 - the launcher sees end-of-file and starts matches another way
+    except BaseException:
         code = 1
     os._exit(code)
 
@@ -227,7 +223,7 @@ def _parked(sock: socket.socket, launcher: int) -> None:
         os.environ.clear()
         os.environ.update(job["env"])
         forkstart._child(job["argv"], Path(job["log"]), fds[0], -1, launcher)
-    except BaseException:  # noqa: BLE001 - nothing to tell: the launcher sees the exit code
+    except BaseException:
         pass
     os._exit(code)
 

@@ -1,9 +1,5 @@
 """The trajectory and heatmap pictures of `arena review --plots` (issue 19: plots a team can read).
 
-Longer than 150 lines because it is both pictures of where the play was, with
-the robots' colours and markers and the heatmaps' shared scale that
-tools/review/animation.py uses too.
-
 * One colour and one marker per robot: team a's colours are blues, cyans and
   teals, team b's magentas, reds and oranges (the MSL cyan and magenta), so a
   robot's team shows at a glance and its number by hue and marker; the

@@ -1,9 +1,5 @@
 """`arena replay FILE.mcap --process robot/a/1`: one process against its recorded inputs.
 
-Longer than 150 lines because `replay` is the three-step procedure below as one function,
-kept whole so that it reads in the documented order, with its result types and CLI entry
-beside it.
-
 A lockstep match is a pure function of (configuration, seed), and so is each
 process given its inputs. Replay rebuilds the `MatchConfig` from the file's
 metadata and runs that ONE process's `Node` class (processes/__init__.py)
@@ -90,7 +86,7 @@ def _difference(key: str, index: int, recorded: bytes | None, replayed: bytes | 
     return Difference(tick=tick, key=key, index=index, recorded=a, replayed=b, fields=fields)
 
 
-def replay(source: str | Recording, process: str) -> ReplayResult:
+def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901, PLR0912 - one branch per way a recording can fail to replay
     """Replay `process` (e.g. "robot/a/1", "a/1", "basestation/b") from a recording."""
     rec = source if isinstance(source, Recording) else load(source)
     try:

@@ -1,8 +1,5 @@
 """`arena review FILE.mcap --html replay.html`: the match as one self-contained web page.
 
-Longer than 150 lines because the self-contained page is mostly its inline HTML and
-JavaScript (`PAGE`, `SCRIPT`), kept as one text so that the page stays a single file.
-
 The page needs no network and loads no script or font from anywhere: the
 timeline of the match (recording/analysis/timeline.py: ground truth decimated
 to 10 Hz, positions in whole centimetres) is embedded as JSON, and a small

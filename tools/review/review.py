@@ -1,8 +1,5 @@
 """`arena review FILE.mcap`: what happened in a recorded match.
 
-Longer than 150 lines because it is all of `arena review`'s output: the printed report
-and the matplotlib plots and animation, each a function over the same analysis.
-
 The analysis is `arena.recording.analysis` (shared with `arena facts` and the
 tests); this module prints it and draws the plots.
 
@@ -35,7 +32,7 @@ TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in t
 
 
 # ------------------------------------------------------------------ output
-def print_review(r: dict, console: Console | None = None) -> None:
+def print_review(r: dict, console: Console | None = None) -> None:  # noqa: C901, PLR0912 - one section of the report per branch
     console = console or Console()
     a, b = r["score"]
     console.print(

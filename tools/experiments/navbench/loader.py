@@ -66,7 +66,7 @@ def _parse(text: str, name: str) -> dict[str, Any]:
         raise ScenarioError(f"{name}: not valid TOML: {exc}") from None
 
 
-def _resolve(data: dict[str, Any], name: str) -> BenchSpec:
+def _resolve(data: dict[str, Any], name: str) -> BenchSpec:  # noqa: C901, PLR0912 - one branch per scenario key
     data = dict(data)
     defaults = data.pop("defaults", {})
     if not isinstance(defaults, dict):

@@ -11,7 +11,7 @@ from arena.tools.experiments.navbench.spec import METHODS, Scheme
 METHOD_COLOURS = {"apf": "tab:red", "sfm": "tab:orange", "f-sfm": "goldenrod", "mapf": "tab:purple"}
 
 
-def write_plots(r: Report, out_dir: str | Path) -> list[Path]:
+def write_plots(r: Report, out_dir: str | Path) -> list[Path]:  # noqa: PLR0915 - one figure per table of the papers
     """PNG trajectory plots in the manner of paper 1 Figs. 7-9 and paper 3 Figs. 7-8; returns the paths."""
     import matplotlib
 

@@ -1,8 +1,4 @@
-"""The bench's results as rows: per scheme, per method, timing and local minima; `Report.to_json` for `--json`.
-
-Longer than 150 lines because it holds every table the bench prints (per scheme, per
-method, timing, local minima), each a short row builder over the same results.
-"""
+"""The bench's results as rows: per scheme, per method, timing and local minima; `Report.to_json` for `--json`."""
 
 from __future__ import annotations
 

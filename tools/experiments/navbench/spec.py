@@ -1,8 +1,4 @@
-"""The scenario file's schema (`navbench.toml`, msgspec structs that reject unknown keys), its resolved form, and the bench's constants.
-
-Longer than 150 lines because it is the scenario file's whole schema, one small struct
-per table, with its resolved form next to it.
-"""
+"""The scenario file's schema (`navbench.toml`, msgspec structs that reject unknown keys), its resolved form, and the bench's constants."""
 
 from __future__ import annotations
 

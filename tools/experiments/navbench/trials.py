@@ -1,8 +1,4 @@
-"""One trial of paper 1's experiments: the robot and its scripted opponents stepped through the engine's own physics and sensors.
-
-Longer than 150 lines because `run_trial` is the experiment written out as one loop (perception,
-navigator, drive, engine tick, bookkeeping), kept whole so that it reads as the paper's procedure.
-"""
+"""One trial of paper 1's experiments: the robot and its scripted opponents stepped through the engine's own physics and sensors."""
 
 from __future__ import annotations
 
@@ -85,7 +81,7 @@ def trial_rng(seed: int, scenario: str, trial: int) -> np.random.Generator:
     return np.random.default_rng(derive(seed, "bench-nav", scenario, trial))
 
 
-def run_trial(sc: Scenario, scheme: Scheme, trial: int, seed: int = 0, clock: Clock = time.perf_counter_ns) -> Trial:
+def run_trial(sc: Scenario, scheme: Scheme, trial: int, seed: int = 0, clock: Clock = time.perf_counter_ns) -> Trial:  # noqa: PLR0915 - one trial, step by step as the papers run it
     """One trial of ``scheme`` in paper-1 style scenario ``sc``; deterministic given (seed, scenario, trial)."""
     spec, rp = sc.spec, sc.robot
     rng = trial_rng(seed, spec.name, trial)
