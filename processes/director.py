@@ -102,8 +102,8 @@ class Director:
             rp = self.cfg.robot
             d = math.hypot(x - x0, y - y0)
             v = min(rp.max_speed, math.sqrt(2.0 * rp.max_accel * d))
-            twist = (v * (x - x0) / d, v * (y - y0) / d, 0.0) if d > 0 else (0.0, 0.0, 0.0)
-            ph.teleport_robot(a.team, a.robot, (x0, y0, th0), twist)
+            if d > 0:
+                ph.push_robot(a.team, a.robot, v * (x - x0) / d, v * (y - y0) / d)
             return
         pose = (x, y, th0 if a.orientation is None else a.orientation)
         twist = (vx0 if a.vx is None else a.vx, vy0 if a.vy is None else a.vy, w0 if a.omega is None else a.omega)

@@ -101,7 +101,8 @@ def command(e, t: Trace, lo: int, hi: int) -> Judgement:
     for c in t.commands:
         if lo <= c.tick <= hi and _command_matches(c, e):
             return True, c.tick, f"{c.name} {c.team} at ({c.x:.2f}, {c.y:.2f}) at tick {c.tick}"
-    return False, hi, f"no {e.command} {e.team} in ticks {lo}..{hi}"
+    seen = [f"{c.name} {c.team} at ({c.x:.2f}, {c.y:.2f}) at tick {c.tick}" for c in t.commands if c.name == e.command]
+    return False, hi, f"no such {e.command} in ticks {lo}..{hi}" + (f" (seen: {'; '.join(seen[:3])})" if seen else "")
 
 
 def never_command(e, t: Trace, lo: int, hi: int) -> Judgement:

@@ -22,7 +22,14 @@ from pathlib import Path
 import msgspec
 from msgspec import Struct
 
-from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, ProcessId, ScenarioParams
+from arena.runtime.config import (
+    DEFAULT_PERCEPTION_LATENCY,
+    ConfigError,
+    MatchConfig,
+    ProcessId,
+    RulesParams,
+    ScenarioParams,
+)
 from arena.schemas.messages import Condition, RefereeOverride, Region, Step, TeleportBall, TeleportRobot
 from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
 from arena.strategies import registry
@@ -46,6 +53,7 @@ class Play(Spec):
     perception_latency: int = DEFAULT_PERCEPTION_LATENCY
     half_time: float = 300.0
     external: list[str] = []
+    rules: dict[str, float] = {}
 
 
 class BallSpec(Spec):
@@ -219,6 +227,7 @@ class Scenario:
             half_time=p.half_time,
             external=tuple(p.external),
             timing=dataclasses.replace(base.timing, perception_latency=p.perception_latency),
+            rules=dataclasses.replace(base.rules, **p.rules),
             scenario=self.params,
         )
 
@@ -287,6 +296,13 @@ def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
         raise ValueError(f"{where}.time_limit: a positive number of seconds, got {spec.time_limit}")
     if not 0.0 <= spec.min_pass <= 1.0:
         raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
+    known = {f.name: f.type for f in dataclasses.fields(RulesParams)}
+    for key, value in p.rules.items():
+        if key not in known:
+            raise ValueError(f"{where}.play.rules.{key}: not a rule parameter (docs/rules.md: {', '.join(known)})")
+        if not (math.isfinite(value) and value >= 0) or (known[key] == "int" and value != int(value)):
+            raise ValueError(f"{where}.play.rules.{key}: a number >= 0 (a whole one for counts), got {value}")
+    p.rules = {k: int(v) if known[k] == "int" else float(v) for k, v in p.rules.items()}
     steps: list[Step] = []
     stage, clock, score, attack = "", 0, (0, 0), 1
     if spec.start is not None:

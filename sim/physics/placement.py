@@ -34,6 +34,14 @@ class Placement:
         r.body.velocity = twist[0], twist[1]
         r.body.angular_velocity = twist[2]
 
+    def push_robot(self, team: str, n: int, vx: float, vy: float) -> None:
+        """Scenario control: robot n moving at (vx, vy) [m/s] from where it stands, the ball it holds kept;
+        its drive pulls it back to its command from there."""
+        r = self._by_id[(team, n)]
+        if not r.parked:
+            r.body.velocity = vx, vy
+            self._dirty = True
+
     def park_robot(self, team: str, n: int) -> tuple[float, float]:
         """Take robot n off the field for good (its process died); returns where it stands [m].
 

@@ -135,3 +135,15 @@ def test_referee_steps_are_in_tick_order_and_the_config_round_trips():
 def test_bad_scenario_params_are_refused(bad):
     with pytest.raises(ConfigError, match="scenario"):
         MatchConfig(scenario=ScenarioParams(**bad)).validate()
+
+
+def test_by_force_pushes_a_robot_from_where_it_stands():
+    steps = (
+        Step(at=0, actions=[RefereeOverride(command="STOP")]),
+        Step(at=10, actions=[TeleportRobot(team="b", robot=2, x=0.0, y=-3.0, by_force=True)]),
+    )
+    _, worlds, _ = play(steps, ticks=20)
+    at = {w.tick: w for w in worlds}
+    before, after = robot(at[9], "b", 2), robot(at[10], "b", 2)
+    assert (after.x, after.y) == (before.x, before.y), "no jump"
+    assert after.vy < -2.0 and abs(after.vx) < abs(after.vy), "moving towards the target"
