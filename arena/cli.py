@@ -600,6 +600,20 @@ def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
     return 0
 
 
+def warn_unreachable_refbox(endpoint: str) -> None:
+    """Said before the match starts, not only in its report: the referee keeps trying while it plays."""
+    from arena.rules import refbox_protocol as rp
+    from arena.rules.refbox_client import unreachable
+
+    host, port = rp.parse_endpoint(endpoint)
+    if why := unreachable(host, port):
+        print(
+            f"arena match: warning: --refbox-follow {endpoint}: cannot connect ({why}); the match starts and the "
+            "referee keeps trying, but until the RefBox answers nobody restarts play (never connected: the match is void)",
+            file=sys.stderr,
+        )
+
+
 def cmd_match(args: argparse.Namespace) -> int:
     from arena.tools.launch import launcher
 
@@ -625,6 +639,8 @@ def cmd_match(args: argparse.Namespace) -> int:
         cfg = cfg.replace(timing=dataclasses.replace(cfg.timing, startup_timeout=timeout))
     if args.engine == "inprocess":
         return match_inprocess(args, cfg, record)
+    if cfg.refbox.follow:
+        warn_unreachable_refbox(cfg.refbox.follow)
     show = not args.json and sys.stderr.isatty()
     try:
         result = launcher.play_match(

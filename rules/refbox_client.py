@@ -17,6 +17,17 @@ import time
 from arena.rules import refbox_protocol as rp
 
 
+def unreachable(host: str, port: int, timeout: float = 2.0) -> str:
+    """Why nothing accepts a TCP connection at host:port now ("" if something does): said before a match starts."""
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            return ""
+    except TimeoutError:
+        return f"no answer within {timeout:g} s"
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+
+
 class RefboxClient:
     """A base station's end of the RefBox connection: connects (and reconnects), reads commands.
 

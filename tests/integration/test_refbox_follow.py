@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import json
 import socket
+import subprocess
 import threading
 import time
 
 import msgpack
 from mcap.reader import make_reader
 
-from tests.integration.helpers import arena_json
+from tests.integration.helpers import ARENA, arena_json, free_port
 
 CYAN, MAGENTA = "224.16.32.201", "224.16.32.202"  # the targets `arena match` expects by default
 SCRIPT = [
@@ -40,17 +41,28 @@ class FakeRefBox(threading.Thread):
         self.peer = ""
 
     def run(self) -> None:
+        """Every connection gets the script (`arena match` first connects once to check that one answers)."""
         self.server.settimeout(120)
-        conn, addr = self.server.accept()
-        self.peer = addr[0]
+        with self.server:
+            while True:
+                try:
+                    conn, addr = self.server.accept()
+                except OSError:
+                    return
+                self.peer = addr[0]
+                threading.Thread(target=self.play, args=(conn,), daemon=True).start()
+
+    def play(self, conn: socket.socket) -> None:
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         with conn:
-            conn.sendall(json.dumps({"command": "WELCOME", "targetTeam": CYAN}).encode() + b"\0")
-            for command, target in SCRIPT:
-                time.sleep(0.1)
-                conn.sendall(json.dumps({"command": command, "targetTeam": target}).encode() + b"\0")
+            try:
+                conn.sendall(json.dumps({"command": "WELCOME", "targetTeam": CYAN}).encode() + b"\0")
+                for command, target in SCRIPT:
+                    time.sleep(0.1)
+                    conn.sendall(json.dumps({"command": command, "targetTeam": target}).encode() + b"\0")
+            except OSError:
+                return  # the check's connection, closed at once
             time.sleep(30)  # stay connected while the match plays
-        self.server.close()
 
 
 def test_refbox_follow_plays_the_scripted_commands(tmp_path):
@@ -86,3 +98,23 @@ def test_refbox_follow_plays_the_scripted_commands(tmp_path):
     assert played[: len(expected)] == expected
     corner = next(c for r in refs for c in r["commands"] if c["name"] == "CORNER")
     assert (abs(corner["x"]), abs(corner["y"])) == (5.75, 3.75)  # team a attacks +x in the first half
+
+
+def test_an_unreachable_refbox_is_said_before_the_match_plays_and_voids_it():
+    """It was silent while the match played, said `never connected` only in the report, and exited 0."""
+    port = free_port()
+    match = subprocess.Popen(
+        [*ARENA, "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "5",
+         "--refbox-follow", f"127.0.0.1:{port}", "--json"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        first = match.stderr.readline()
+        assert match.poll() is None, "said while the match plays, not after it"
+        assert f"--refbox-follow 127.0.0.1:{port}: cannot connect (Connection refused)" in first, first
+        out, err = match.communicate(timeout=120)
+    finally:
+        match.kill()
+    assert match.returncode == 1, err
+    assert json.loads(out)["outcome"] == "void"
+    assert f"void: --refbox-follow 127.0.0.1:{port}: never connected" in err and "Traceback" not in err

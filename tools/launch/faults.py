@@ -124,6 +124,11 @@ def outcome(
         if kind not in summaries and not void:
             f = next((f for f in faults if f["process"] == kind), None)
             reasons.append(f"{kind}: {f['reason']}" if f else f"{kind}: no summary")
+    referee = summaries.get("referee")
+    follow = referee.extra.get("refbox_follow") if referee is not None else None
+    if follow and not follow.get("connected"):
+        # Our rules only end a followed match: without the RefBox nobody restarted play, so it decided nothing.
+        reasons.append(f"--refbox-follow {follow['endpoint']}: never connected, so no referee at the RefBox ran it")
     engine = summaries.get("engine")
     ticks = engine.tick if engine is not None else 0
     if engine is not None and ticks < cfg.total_ticks:
