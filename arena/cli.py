@@ -102,7 +102,7 @@ examples:
   arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
   arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
   arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio
-  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present (the model before 2026-11-26)
+  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present
   arena facts --seeds 10 --home AD --away BS --json  # every match's facts and the totals per strategy, as JSON""",
     "replay": """examples:
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
@@ -207,7 +207,7 @@ def _add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tr
         default=None,
         metavar="TICKS",
         help="a robot at tick k sees the sense of tick k - TICKS (the model; changes digests), e.g. "
-        "--perception-latency 0 for the model before 2026-11-26 (default: timing.perception_latency, 3 = 60 ms)",
+        "--perception-latency 0 for robots that see the present (default: timing.perception_latency, 3 = 60 ms)",
     )
     p.add_argument(
         "--batch",
@@ -227,7 +227,7 @@ def every_match_latency(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="TICKS",
         help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
-        "e.g. 0 for the model before 2026-11-26",
+        "e.g. 0 for robots that see the present",
     )
 
 

@@ -133,8 +133,7 @@ class RulesParams:
     """The game rules the engine and the referee box enforce (docs/rules.md).
 
     Numbers follow the MSL rule book. Its 3 m set-piece distance belongs to a
-    22 m x 14 m field and would scale to 1.6 m here; issue 3 asks for at least
-    2 m, so 2 m it is.
+    22 m x 14 m field and would scale to 1.6 m here; we keep a floor of 2 m.
     """
 
     kickoff_time: float = 1.0  # [s] positioning time between KICKOFF and START
@@ -166,8 +165,7 @@ class TimingParams:
     referee_period: int = DEFAULT_PERIODS["referee"]  # [ticks] engine events -> referee -> everyone (10 Hz)
     world_period: int = DEFAULT_PERIODS["world"]  # [ticks] ground-truth `world` for viewers and the recorder
     # The perception latency L is the model (omni-vision pipelines of MSL robots: 30-60 ms;
-    # docs/architecture.md): 3 ticks, 60 ms, since 2026-11-26 (0 before; docs/performance.md,
-    # session 11). The batch is a transport detail: the digests are the same for every batch.
+    # docs/architecture.md): 3 ticks, 60 ms (0: a robot that sees the present). The batch is a transport detail: the digests are the same for every batch.
     # 0 and 0 are allowed (no latency; as many frames as L allows, L or 1).
     perception_latency: int = DEFAULT_PERCEPTION_LATENCY  # [ticks] a robot at tick k sees the `sense` of k - L
     batch: int = 0  # [frames] `sense`/`cmd` frames per message in lockstep (0: L, or 1)

@@ -200,7 +200,7 @@ class Outbound(Generic[M]):
     half of the same aligned grid (the engine's `cmd` from a robot, a robot's
     `sense`): with n <= L, nothing held on one half is due on the other
     (runtime/config.py `frames_per_message`), and flushing there too cost
-    ~5 % of a batched distributed match (docs/performance.md, session 10).
+    ~5 % of a batched distributed match.
     """
 
     __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last")
@@ -304,7 +304,7 @@ class Reactor:
         # process is about to act at). A sender owes the frame we miss only since it was last seen
         # announcing a wait of its own at a tick not past that frame (`upstream_waited`: the
         # monotonic time, now while it still announces one): before, it was stalled upstream, not at
-        # fault. So only the process whose sender owes a frame gives up (issue 20, "correct blame").
+        # fault. So only the process whose sender owes a frame gives up.
         # Counting from the start of our own wait instead blamed a sender that had just moved on
         # from one stalled wait to the next: its new wait is announced only `announce_after` later.
         self._announce = announce

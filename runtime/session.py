@@ -112,7 +112,7 @@ class NetConfig:
         if self.mode == "router" and not self.multicast and not self.connect:
             # zenoh 1.10 starts a router with a plain sleep of `scouting/delay` (500 ms by
             # default), meant for scouting and connecting to other routers. With neither, it
-            # only delayed every match's start by half a second (docs/performance.md, session 6).
+            # only delayed every match's start by half a second.
             c.insert_json5("scouting/delay", "0")
         for path, value in self.extra:
             c.insert_json5(path, value)
@@ -158,7 +158,7 @@ def open_session(net: NetConfig) -> zenoh.Session:
     if os.environ.get("ZENOH_RUNTIME") in (None, ONE_THREAD_RUNTIME, CLIENT_RUNTIME):
         # Ours, not the user's (children inherit the launcher's environment): choose per mode.
         # A router relays to clients (a spectator on `**`): dropping for a slow one must not
-        # hold the only thread that reads the peers' links (issue 20 item 6).
+        # hold the only thread that reads the peers' links.
         relays = net.mode in ("client", "router") or any(path == "access_control" for path, _ in net.extra)
         os.environ["ZENOH_RUNTIME"] = CLIENT_RUNTIME if relays else ONE_THREAD_RUNTIME
     check_runtime_variable(os.environ["ZENOH_RUNTIME"])

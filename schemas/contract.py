@@ -225,8 +225,8 @@ configuration is the JSON answer of a `get` on `arena/<match>/{CONFIG}` (see
 **A robot's schedule** (lockstep). The configuration's
 `timing.perception_latency` L (ticks) is the model's perception latency: a
 robot acting at tick k sees the `sense` of tick k - L, and no `sense` before
-tick L. L is 3 (60 ms) unless the match sets another (`--perception-latency`;
-it was 0 before 2026-11-26), so read it from the configuration. For every tick k = 0 .. `total_ticks` (from `field` or the
+tick L. L is 3 (60 ms) unless the match sets another (`--perception-latency`),
+so read it from the configuration. For every tick k = 0 .. `total_ticks` (from `field` or the
 configuration): wait for `sense` of tick k - L (nothing when k < L; and, to
 use them, the `order`s due by k: sent at 1, 6, 11, ..., delivered one tick
 later), then put exactly one `cmd` with `tick` = k, and at every comm tick

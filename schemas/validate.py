@@ -29,7 +29,7 @@ from arena.schemas.messages import Base, Cmd, EngineEvents, Referee
 # its exponent bits all set, so its first byte is 0x7f or 0xff. Translated through
 # _CLASSES (a header to 1, such a first byte to 2, any other byte to 0), a payload
 # holds b"\x01\x02" where it holds any of the four pairs: one scan instead of four,
-# which were ~6 % of a match's CPU in one process (docs/performance.md, session 8).
+# which were ~6 % of a match's CPU in one process.
 _CLASSES = bytes(1 if b in (0xCA, 0xCB) else 2 if b in (0x7F, 0xFF) else 0 for b in range(256))
 
 

@@ -1,4 +1,4 @@
-"""Facts about a whole match: the rules acceptance (issue 3) and "play that looks like soccer" (issue 4).
+"""Facts about a whole match: the rules at work and play that looks like soccer.
 
 `measure` reads one match's ground truth (`world`, every tick) and the
 referee's frames, from a recording (`arena review`) or from a match played in
@@ -12,7 +12,7 @@ process (`arena facts`, tools/experiments/facts.py), and measures:
 * `stuck_s`: the longest time the ball, in play, stayed within
   `RulesParams.progress_radius` of one point: what NO_PROGRESS bounds.
 
-Team play (issue 4), per team in `teams` (`TeamFacts`, team a first):
+Team play, per team in `teams` (`TeamFacts`, team a first):
 
 * `shots`: strikes (the ball's speed jumps by more than `STRIKE_DV` in one
   tick, the new last toucher is the striker) whose straight path crosses the
@@ -157,7 +157,7 @@ def measure(  # noqa: C901, PLR0912, PLR0915 - every fact updated from one walk 
             if ref.commands:
                 for s in open_shots:  # a command ends every pending shot (a goal is matched below)
                     s["end"] = min(s["end"], w.tick)
-        # ---- rules facts (issue 3)
+        # ---- rules facts
         if abs(w.ball_x) > fence_x or abs(w.ball_y) > fence_y:
             outside += 1
         moving = math.hypot(w.ball_vx, w.ball_vy) >= STILL_SPEED

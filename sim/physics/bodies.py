@@ -54,7 +54,7 @@ _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
 # The per-substep calls straight into Chipmunk, without pymunk's Python wrappers
 # around them (its `__setattr__` hook, the batch set-up, `Space.step`'s queues):
 # the same C functions with the same arguments, so the same floats, for about a
-# third of the Python work of a substep (docs/performance.md, session 9).
+# third of the Python work of a substep.
 # tests/unit/test_physics.py checks them against pymunk's public API.
 step_space = lib.cpSpaceStep  # (space._space, dt): `Space.step` without its add/remove-later queues
 set_velocity = lib.cpBodySetVelocity  # (body._body, (vx, vy)): `Body.velocity = vx, vy`

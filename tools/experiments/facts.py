@@ -1,5 +1,5 @@
 """`arena facts`: facts about whole matches played in process, the rules
-acceptance (issue 3) and "play that looks like soccer" (issue 4).
+at work and play that looks like soccer.
 
 `match_facts(cfg)` plays one match in-process (tools/launch/inprocess.py, the very
 `Node` code of a real match) and measures it with the one analysis of the

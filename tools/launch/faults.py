@@ -10,8 +10,7 @@ The launcher observes three kinds of failure, each with the process's name:
 The processes themselves report whom they gave up waiting for (`Summary.dead`,
 with their tick in `dead_at`). A process that was itself cut off sees everyone
 else vanish, so its claims are not evidence: `blame` keeps only the claims the
-launcher's own view of the liveliness tokens confirms (issue 20, "correct
-blame"). A peer that is alive but silent is claimed (`extra["silent"]`) only
+launcher's own view of the liveliness tokens confirms. A peer that is alive but silent is claimed (`extra["silent"]`) only
 by the receiver whose sender owes the frame: a receiver waits on while its
 sender announces a wait of its own at a tick not past the missing frame, and
 for a full wait_timeout after it took that announcement back

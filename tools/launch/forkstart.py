@@ -71,7 +71,7 @@ def preload(kinds: set[str], strategies: set[str]) -> None:
 
 
 def warm() -> None:
-    """Do once, in the parent, what every child did first (profiled, session 6).
+    """Do once, in the parent, what every child did first (profiled: the imports that each child would repeat).
 
     Each line was on a child's path to the first tick: the CLI parser (~40 ms to
     build), numpy.random (the engine's sensor noise imports it: ~80 ms), msgspec's

@@ -383,7 +383,7 @@ FINISH_GRACE = 10.0
 # hand-started processes; the lockstep runs on the peers' direct links. A put it
 # relays is DROP on the way out: a slow spectator on `**` loses frames instead of
 # blocking the router, which stopped reading from the peers, whose BLOCK puts then
-# held their only zenoh thread until leases lapsed (issue 20 item 6).
+# held their only zenoh thread until leases lapsed (tests/integration/test_spectator.py).
 SPECTATOR_SAFE = (
     (
         "qos/network",
@@ -409,7 +409,7 @@ def relay_safe(router_zid: str, peer: str, match: str, robots: int, external: se
     lockstep waits on it. Under BLOCK, a router behind on a peer's link filled that peer's
     queue towards it, and a put made in a zenoh callback (reactive nodes) then waited on
     zenoh's only thread, the one that would write the queue out: 5 s (`wait_before_close`),
-    then the link closed and the router saw the peer's token vanish (issue 20 item 6).
+    then the link closed and the router saw the peer's token vanish.
 
     Except for what an `--external` process (a client, through the router) receives: it
     waits for those frames in its lockstep, and a dropped one would stall it and blame it,

@@ -1,4 +1,4 @@
-"""The trajectory and heatmap pictures of `arena review --plots` (issue 19: plots a team can read).
+"""The trajectory and heatmap pictures of `arena review --plots` (plots a team can read).
 
 * One colour and one marker per robot: team a's colours are blues, cyans and
   teals, team b's magentas, reds and oranges (the MSL cyan and magenta), so a

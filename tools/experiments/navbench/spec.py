@@ -28,7 +28,7 @@ PAPER_FSFM_MS = 35.27  # [ms] the same with the FIS
 PAPER_FIS_OVERHEAD = 9.05  # [%]
 
 
-FSFM_BUDGET_US = 50.0  # [us] issue 7: median F-SFM step on this machine
+FSFM_BUDGET_US = 50.0  # [us] median F-SFM step on the development machine
 
 
 PARK_Y = -4.6  # [m] spare robots and the ball wait in the run-off below the field
