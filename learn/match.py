@@ -75,8 +75,14 @@ def _gated(node, gate: Gate, skip: int) -> Iterator[Any]:
 class SteppedMatch:
     """One match, played up to each decision tick of its learners. `learners`: robot ids like "a/1"."""
 
-    def __init__(self, cfg: MatchConfig, learners: list[str], frame_skip: int = 1, discrete: bool = False):
+    def __init__(
+        self, cfg: MatchConfig, learners: list[str], frame_skip: int = 1, discrete: bool = False, keep: bool = False
+    ):
+        """`keep`: keep every `world` and `referee` frame (`worlds`, `referees`), to judge a scenario."""
         self.cfg = cfg
+        self.keep = keep
+        self.worlds: list[World] = []
+        self.referees: list[Referee] = []
         self.frame_skip = frame_skip
         self.bus = bus = CoopBus()
         keys = Keys("learn")
@@ -127,6 +133,8 @@ class SteppedMatch:
         self.new_commands = []
         while (raw := self.referee_ch.try_recv()) is not None:
             ref = _referee(raw)
+            if self.keep:
+                self.referees.append(ref)
             self.referee = ref
             self.score = (ref.score_a, ref.score_b)
             self.attack_dir_a = ref.attack_dir_a
@@ -134,8 +142,10 @@ class SteppedMatch:
         last = None
         while (raw := self.world_ch.try_recv()) is not None:
             last = raw
+            if self.keep:
+                self.worlds.append(_world(raw))
         if last is not None:
-            w = _world(last)
+            w = self.worlds[-1] if self.keep else _world(last)
             self.ball = (w.ball_x, w.ball_y)
 
     def act(self, actions: dict[str, Any]) -> None:

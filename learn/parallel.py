@@ -108,6 +108,8 @@ class SoccerParallelEnv(ParallelEnv):
         self.match: SteppedMatch | None = None
         self._seed = self.cfg.seed
         self.recorded: dict[str, list[Any]] = {}
+        self.scenario = None
+        self.verdict: dict[str, Any] | None = None
 
     # ------------------------------------------------------------- spaces
     def observation_space(self, agent: str) -> spaces.Space:
@@ -121,7 +123,16 @@ class SoccerParallelEnv(ParallelEnv):
         """Start the match of `seed` (the previous seed + 1 when None); `options`: {"scenario": path}."""
         self._seed = (self._seed + 1) % 2**63 if seed is None else int(seed) % 2**63
         cfg = self.cfg.replace(seed=self._seed)
-        self.match = SteppedMatch(cfg, self.possible_agents, self.frame_skip, self.discrete)
+        scenario = (options or {}).get("scenario")
+        self.scenario = None if scenario is None else self._scenario(scenario)
+        if self.scenario is not None:
+            cfg = self.scenario.config(self._seed, base=cfg)
+            if cfg.robots != self.cfg.robots:
+                raise ValueError(
+                    f"scenario {self.scenario.name!r} plays {cfg.robots} robots a team, this env {self.cfg.robots}"
+                )
+        self.verdict: dict[str, Any] | None = None
+        self.match = SteppedMatch(cfg, self.possible_agents, self.frame_skip, self.discrete, keep=bool(scenario))
         self.agents = list(self.possible_agents)
         self.recorded = {a: [] for a in self.agents}
         self.match.advance()
@@ -144,13 +155,17 @@ class SoccerParallelEnv(ParallelEnv):
         if m.ball is not None and self._last_ball is not None:
             progress = (m.ball[0] - self._last_ball[0]) * m.attack_dir_a
         self._last_score, self._last_ball = m.score, m.ball
+        goal = (ga or gb) and self.end_on_goal
+        over = m.over or (self.until == "half" and m.tick >= m.cfg.half_ticks)
+        passed = None
+        if self.scenario is not None and (goal or over):
+            self.verdict = self._judge()
+            passed = self.verdict["passed"]
         out = {
-            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands),
-            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands),
+            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, passed),
+            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, passed),
         }
         rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
-        goal = (ga or gb) and self.end_on_goal
-        over = m.over or (self.until == "half" and m.tick >= self.cfg.half_ticks)
         terms = {a: bool(goal) for a in self.agents}
         truncs = {a: bool(over and not goal) for a in self.agents}
         obs = self._observations()
@@ -187,4 +202,39 @@ class SoccerParallelEnv(ParallelEnv):
 
     def _info(self) -> dict[str, Any]:
         m = self.match
-        return {"tick": m.tick, "score": m.score, "seed": self._seed}
+        info: dict[str, Any] = {"tick": m.tick, "score": m.score, "seed": self._seed}
+        if self.verdict is not None:
+            info["scenario"] = self.verdict
+        return info
+
+    # ----------------------------------------------------------- scenarios
+    @staticmethod
+    def _scenario(scenario: Any):
+        """A scenario (arena.scenarios), or the path of a file holding exactly one, or (path, name)."""
+        from arena.scenarios import Scenario, load
+
+        if isinstance(scenario, Scenario):
+            return scenario
+        if isinstance(scenario, tuple):
+            return load(*scenario)
+        return load(scenario)
+
+    def _judge(self) -> dict[str, Any]:
+        """Every expectation of the scenario, judged on the episode so far (arena.scenarios.expect)."""
+        from arena.scenarios.expect import Trace, judge
+
+        m, sc = self.match, self.scenario
+        f = m.cfg.field
+        trace = Trace(
+            dt=m.cfg.timing.dt,
+            worlds=m.worlds,
+            commands=[c for r in m.referees for c in r.commands],
+            digests=m.digests(),
+            fence=(f.length / 2 + f.runoff, f.width / 2 + f.runoff),
+        )
+        failures = []
+        for e in sc.spec.expect:
+            ok, tick, detail = judge(e, trace, sc.spec.time_limit)
+            if not ok:
+                failures.append({"expectation": e.name, "tick": tick, "detail": detail})
+        return {"name": sc.name, "passed": not failures, "failures": failures}

@@ -23,6 +23,8 @@ class Outcome:
     goals_against: int
     ball_progress: float  # [m] the ball's move towards the team's opponent goal during the step
     commands: list[RefCommand] = field(default_factory=list)  # the referee's commands issued during the step
+    # A scenario's episode, at its last step: whether every expectation came true; None before and without one.
+    scenario_passed: bool | None = None
 
     def fouls_against(self, robot: int) -> int:
         """Cards given to this team's robot `robot` during the step."""
