@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import statistics
 import time
 
@@ -35,9 +36,10 @@ def match_rate(cfg: MatchConfig) -> float:
     return (cfg.total_ticks + 1) / (time.process_time() - t0)
 
 
-def env_rate(cfg: MatchConfig, agents: list[str]) -> float:
+def env_rate(cfg: MatchConfig, agents: list[str], frame_skip: int = 1) -> float:
     """One whole-match episode (reset included): env steps per CPU-second."""
     env = SoccerParallelEnv(
+        frame_skip=frame_skip,
         agents=agents,
         home=cfg.home,
         away=cfg.away,
@@ -56,8 +58,12 @@ def env_rate(cfg: MatchConfig, agents: list[str]) -> float:
     return n / (time.process_time() - t0)
 
 
-def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1) -> float:
-    """`workers` SoccerEnvs in their own processes: wall-clock env steps per second over `steps` vector steps."""
+def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1):
+    """`workers` SoccerEnvs in their own processes, `steps` vector steps after 20 to warm up.
+
+    Returns (wall-clock env steps per second, CPU-seconds per env step of this process and the workers
+    together, forking and every reset included)."""
+    cpu0 = time.process_time() + _children_cpu()
     venv = make_vector_env(
         workers, robot="a/1", home=strategy, away=strategy, half_time=half_time, frame_skip=frame_skip
     )
@@ -70,9 +76,16 @@ def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame
         for i in range(steps):
             batch[:] = ACTIONS[i % len(ACTIONS)]
             venv.step(batch)
-        return workers * steps / (time.perf_counter() - t0)
+        wall = time.perf_counter() - t0
     finally:
-        venv.close()
+        venv.close()  # joins the workers: their CPU time is counted from here
+    cpu = time.process_time() + _children_cpu() - cpu0
+    return workers * steps / wall, cpu / (workers * (steps + 20))
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def bench_learn(
@@ -93,6 +106,10 @@ def bench_learn(
     for skip in (1, 5):
         console.print(f"vector env, frame_skip {skip}: 1 worker, then 2, {steps // skip} steps each ...")
         vec[skip] = [vector_rate(w, steps // skip, half_time, strategy, skip) for w in (1, 2)]
+    in_process = {
+        1: med["env1"],
+        5: env_rate(MatchConfig(seed=500, home=strategy, away=strategy, half_time=half_time), ["a/1"], 5),
+    }
     out = {
         "runs": runs,
         "half_time": half_time,
@@ -106,8 +123,13 @@ def bench_learn(
         "env3_ratio": round(med["env3"] / med["match"], 3),
         "all": {k: [round(x, 1) for x in v] for k, v in rates.items()},
         # frame_skip -> [1 worker, 2 workers] wall-clock env steps per second, and their ratio
-        "vector_steps_per_second": {str(k): [round(x, 1) for x in v] for k, v in vec.items()},
-        "vector_ratio": {str(k): round(v[1] / v[0], 3) for k, v in vec.items()},
+        "vector_steps_per_second": {str(k): [round(v[0][0], 1), round(v[1][0], 1)] for k, v in vec.items()},
+        "vector_ratio": {str(k): round(v[1][0] / v[0][0], 3) for k, v in vec.items()},
+        # frame_skip -> [1 worker, 2 workers, one env in this process] CPU microseconds per env step
+        "cpu_us_per_step": {
+            str(k): [round(1e6 * v[0][1], 1), round(1e6 * v[1][1], 1), round(1e6 / in_process[k], 1)]
+            for k, v in vec.items()
+        },
     }
     if as_json:
         print(json.dumps(out, indent=2))
@@ -118,10 +140,12 @@ def bench_learn(
         f"{out['env1_ratio']:.2f} x the match (target >= 0.9)"
     )
     print(f"env, 3 robots          {out['env3_steps_per_cpu_second']:8.0f} steps/cpu-s  {out['env3_ratio']:.2f} x")
-    for skip, (v1, v2) in vec.items():
+    for skip, ((v1, _), (v2, _)) in vec.items():
+        c1, c2, c0 = out["cpu_us_per_step"][str(skip)]
         print(
             f"vector env, frame_skip {skip}: 1 worker {v1:6.0f} steps/s, 2 workers {v2:6.0f} steps/s (wall): "
-            f"{v2 / v1:.2f} x (target >= 1.8 on 2 idle cores)"
+            f"{v2 / v1:.2f} x (target >= 1.8 on 2 idle cores); CPU per step: {c1:.0f} us with 1 worker, "
+            f"{c2:.0f} us with 2, {c0:.0f} us in one process"
         )
     print(f"host: {out['cpus']} cpus, 1-minute load average {out['loadavg_1min']}")
     return 0

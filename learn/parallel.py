@@ -30,6 +30,7 @@ policy's actions (`arena.learn.deploy`).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -120,7 +121,8 @@ class SoccerParallelEnv(ParallelEnv):
 
     # ---------------------------------------------------------------- API
     def reset(self, seed: int | None = None, options: dict | None = None):
-        """Start the match of `seed` (the previous seed + 1 when None); `options`: {"scenario": path}."""
+        """Start the match of `seed` (the previous seed + 1 when None), or with `options={"scenario": S}`
+        the run of scenario S (a file with one scenario, a (path, name) pair, or an `arena.scenarios.Scenario`)."""
         self._seed = (self._seed + 1) % 2**63 if seed is None else int(seed) % 2**63
         cfg = self.cfg.replace(seed=self._seed)
         scenario = (options or {}).get("scenario")
@@ -151,9 +153,13 @@ class SoccerParallelEnv(ParallelEnv):
         m.advance()
         ga = m.score[0] - self._last_score[0]
         gb = m.score[1] - self._last_score[1]
-        progress = 0.0
+        progress, closing = 0.0, {"a": 0.0, "b": 0.0}
         if m.ball is not None and self._last_ball is not None:
             progress = (m.ball[0] - self._last_ball[0]) * m.attack_dir_a
+            hl = m.cfg.field.length / 2
+            for team, gx in (("a", hl * m.attack_dir_a), ("b", -hl * m.attack_dir_a)):
+                before = math.hypot(self._last_ball[0] - gx, self._last_ball[1])
+                closing[team] = before - math.hypot(m.ball[0] - gx, m.ball[1])
         self._last_score, self._last_ball = m.score, m.ball
         goal = (ga or gb) and self.end_on_goal
         over = m.over or (self.until == "half" and m.tick >= m.cfg.half_ticks)
@@ -162,8 +168,8 @@ class SoccerParallelEnv(ParallelEnv):
             self.verdict = self._judge()
             passed = self.verdict["passed"]
         out = {
-            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, passed),
-            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, passed),
+            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, closing["a"], passed),
+            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, closing["b"], passed),
         }
         rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
         terms = {a: bool(goal) for a in self.agents}

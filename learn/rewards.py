@@ -21,8 +21,9 @@ class Outcome:
     team: str  # "a" or "b"
     goals_for: int  # goals the team scored during the step
     goals_against: int
-    ball_progress: float  # [m] the ball's move towards the team's opponent goal during the step
+    ball_progress: float  # [m] the ball's move towards the team's opponent goal line during the step
     commands: list[RefCommand] = field(default_factory=list)  # the referee's commands issued during the step
+    ball_closing: float = 0.0  # [m] how much nearer the ball came to the centre of the opponent goal
     # A scenario's episode, at its last step: whether every expectation came true; None before and without one.
     scenario_passed: bool | None = None
 

@@ -148,3 +148,47 @@ def test_arena_bench_learn_reports_the_ratios():
     assert out["match_ticks_per_cpu_second"] > 0 and out["env1_steps_per_cpu_second"] > 0
     assert out["env1_ratio"] == round(out["env1_steps_per_cpu_second"] / out["match_ticks_per_cpu_second"], 3)
     assert set(out["vector_ratio"]) == {"1", "5"}
+
+
+SHOT = """
+[[scenario]]
+name = "shoot"
+time_limit = 3.0
+[scenario.play]
+robots = 2
+[scenario.start.ball]
+x = 4.5
+y = 0.0
+[[scenario.start.robots]]
+robot = "a/1"
+x = 3.9
+y = 0.0
+theta = 0.0
+[[scenario.start.robots]]
+robot = "b/0"
+present = false
+[[scenario.expect]]
+name = "a scores"
+kind = "goal"
+team = "a"
+"""
+
+
+def test_a_scenario_is_an_episode_judged_at_its_end(tmp_path):
+    path = tmp_path / "shoot.scenario.toml"
+    path.write_text(SHOT)
+    env = SoccerParallelEnv(agents=["a/1"], robots=2, frame_skip=5)
+    shoot, wait = np.array([0.6, 0, 0, 1], np.float32), np.zeros(4, np.float32)
+    verdicts = {}
+    for name, action in (("shoot", shoot), ("wait", wait)):
+        obs, info = env.reset(seed=2, options={"scenario": str(path)})
+        assert env.match.cfg.total_ticks == 150 and "scenario" not in info["a/1"]
+        steps = 0
+        while env.agents:
+            obs, rew, term, trunc, info = env.step({"a/1": action})
+            steps += 1
+        verdicts[name] = (info["a/1"]["scenario"]["passed"], term["a/1"], trunc["a/1"], rew["a/1"], steps)
+    assert verdicts["shoot"][:4] == (True, True, False, 1.0) and verdicts["shoot"][4] < 30
+    assert verdicts["wait"] == (False, False, True, 0.0, 31)
+    with pytest.raises(ValueError, match="plays 2 robots a team, this env 3"):
+        SoccerParallelEnv(agents=["a/1"]).reset(seed=1, options={"scenario": str(path)})
