@@ -193,7 +193,7 @@ class SoccerParallelEnv(ParallelEnv):
         by its strategy: `arena match --home policy:PATH` (team a) plays this episode again."""
         mine = {int(a.split("/")[1]): RecordedActions(self.recorded[a]) for a in self.recorded if a[0] == team}
         base = self.cfg.strategy_of(team)
-        return str(save_policy(path, mine, base, self.frame_skip, self.discrete))
+        return str(save_policy(path, mine, base, self.frame_skip, self.discrete, self.cfg.robots))
 
     def observe(self, agent: str) -> Any:
         return self._shape(observe(*self.match.seen(agent), self._views[agent]))

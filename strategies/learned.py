@@ -112,14 +112,16 @@ class View:
     high: np.ndarray = field(repr=False, compare=False, default=None)  # type: ignore[assignment]
 
     @classmethod
-    def of(cls, cfg: MatchConfig, team: str) -> View:
-        fields = obs_fields(cfg.robots)
+    def of(cls, cfg: MatchConfig, team: str, robots: int = 0) -> View:
+        """`robots`: the team size the observation is shaped for (its robot slots); 0: the match's."""
+        robots = robots or cfg.robots
+        fields = obs_fields(robots)
         low = np.concatenate([np.full(n, lo, np.float32) for _, n, lo, _, _ in fields])
         high = np.concatenate([np.full(n, hi, np.float32) for _, n, _, hi, _ in fields])
         r = cfg.robot
         return cls(
             team,
-            cfg.robots,
+            robots,
             cfg.field.length / 2,
             cfg.field.width / 2,
             r.max_speed,
@@ -297,6 +299,7 @@ class PolicyFile:
     policies: dict[int, Callable[[np.ndarray], Any]]
     frame_skip: int = 1
     discrete: bool = False
+    robots: int = 0  # the team size it was trained with: its observations have that many robot slots (0: any)
 
 
 def save_policy(
@@ -305,10 +308,14 @@ def save_policy(
     base: str,
     frame_skip: int = 1,
     discrete: bool = False,
+    robots: int = 0,
 ) -> Path:
-    """Write a policy file: `policies` maps robot numbers to picklable callables obs -> action."""
+    """Write a policy file: `policies` maps robot numbers to picklable callables obs -> action.
+
+    `robots`: the team size it was trained with, so that a match of another size still gives it
+    observations of the size it knows (the nearest robots fill the slots)."""
     p = Path(path)
-    p.write_bytes(pickle.dumps(PolicyFile(base, dict(policies), frame_skip, discrete)))
+    p.write_bytes(pickle.dumps(PolicyFile(base, dict(policies), frame_skip, discrete, robots)))
     return p
 
 
@@ -338,7 +345,7 @@ def policy_strategy(name: str) -> Strategy:
         if ctx.n not in pf.policies:
             return base.make_robot(ctx)
         policy = load_policy(path).policies[ctx.n]  # a fresh copy per robot: policies may keep state
-        view = View.of(ctx.cfg, ctx.team)
+        view = View.of(ctx.cfg, ctx.team, pf.robots)
         return LearnerBrain(
             ctx, lambda _k, sense, order: policy(observe(sense, order, view)), pf.frame_skip, pf.discrete
         )

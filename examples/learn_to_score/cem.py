@@ -119,7 +119,7 @@ def main() -> None:
         result[name] = {"mean_return": round(ret, 4), "goals": goals}
         print(f"{name}: {goals} goals in {args.eval_seeds} seeds, mean return {ret:.3f}", flush=True)
     result["curve"] = curve
-    save_policy(out / "policy.pkl", {1: trained}, base="basic-static", frame_skip=FRAME_SKIP)
+    save_policy(out / "policy.pkl", {1: trained}, base="basic-static", frame_skip=FRAME_SKIP, robots=ROBOTS)
     (out / "results.json").write_text(json.dumps(result, indent=2))
     plot(curve, result, out / "learning-curve.png")
     print(f"wrote {out}/learning-curve.png, {out}/policy.pkl, {out}/results.json")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -192,3 +193,30 @@ def test_a_scenario_is_an_episode_judged_at_its_end(tmp_path):
     assert verdicts["wait"] == (False, False, True, 0.0, 31)
     with pytest.raises(ValueError, match="plays 2 robots a team, this env 3"):
         SoccerParallelEnv(agents=["a/1"]).reset(seed=1, options={"scenario": str(path)})
+
+
+def test_a_policy_trained_on_two_robots_a_team_plays_a_3v3_match(tmp_path):
+    from arena.learn import LinearPolicy, save_policy
+    from arena.strategies.learned import obs_fields
+
+    size = sum(n for _, n, *_ in obs_fields(2))
+    policy = LinearPolicy(np.zeros((4, size)), np.array([0.5, 0.0, 0.0, 0.0]))
+    path = save_policy(tmp_path / "p.pkl", {1: policy}, base="BS", robots=2)
+    cfg = MatchConfig(seed=1, home=registry.resolve_name(f"policy:{path}"), away="basic-static", half_time=0.5)
+    summaries, _ = play_in_process(cfg, watch=())  # a 69-number observation would fail the 4 x 57 weights
+    assert summaries["robot/a/1"].tick == cfg.total_ticks
+    assert summaries["engine"].extra["distance_m"]["a/1"] > 0.2  # it drove
+
+
+def test_the_learning_example_runs(tmp_path):
+    import json
+
+    example = Path(__file__).parents[2] / "examples" / "learn_to_score" / "cem.py"
+    args = ["--iterations", "1", "--population", "2", "--seeds-per-candidate", "1", "--eval-seeds", "1"]
+    r = subprocess.run(
+        [sys.executable, str(example), "--out", str(tmp_path), *args], capture_output=True, text=True, timeout=120
+    )
+    assert r.returncode == 0, r.stderr
+    result = json.loads((tmp_path / "results.json").read_text())
+    assert set(result) >= {"trained", "untrained", "curve"} and (tmp_path / "learning-curve.png").stat().st_size
+    assert registry.resolve_name(f"policy:{tmp_path / 'policy.pkl'}").startswith("policy:/")
