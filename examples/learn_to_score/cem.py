@@ -95,18 +95,20 @@ def main() -> None:
         scores = np.array([evaluate(env, policy_of(t, cols, size), seeds)[0] for t in thetas])
         elite = thetas[np.argsort(scores)[-n_elite:]]
         mean, std = elite.mean(axis=0), elite.std(axis=0) + 0.02
+        at_mean, _ = evaluate(env, policy_of(mean, cols, size), seeds)  # the new mean, on the same seeds
         curve.append(
             {
                 "iteration": it + 1,
                 "episodes": (it + 1) * args.population * len(seeds),
-                "mean": float(scores.mean()),
+                "population": float(scores.mean()),
                 "elite": float(np.sort(scores)[-n_elite:].mean()),
                 "best": float(scores.max()),
+                "mean_policy": at_mean,
             }
         )
         print(
-            f"iteration {it + 1}: return mean {scores.mean():.3f}, elite {curve[-1]['elite']:.3f}, "
-            f"best {scores.max():.3f} ({time.process_time() - t0:.0f} cpu-s)",
+            f"iteration {it + 1}: return: population {scores.mean():.3f}, elite {curve[-1]['elite']:.3f}, "
+            f"new mean policy {at_mean:.3f} ({time.process_time() - t0:.0f} cpu-s)",
             flush=True,
         )
     trained = policy_of(mean, cols, size)
@@ -133,14 +135,15 @@ def plot(curve, result, path: Path) -> None:
 
     x = [c["episodes"] for c in curve]
     fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(x, [c["mean"] for c in curve], marker="o", label="population mean")
-    ax.plot(x, [c["elite"] for c in curve], marker="s", label="elite (best fifth) mean")
+    ax.plot(x, [c["population"] for c in curve], marker="o", label="population (sampled policies), mean")
+    ax.plot(x, [c["elite"] for c in curve], marker="s", label="elite (best fifth), mean")
+    ax.plot(x, [c["mean_policy"] for c in curve], marker="^", label="the refitted mean policy")
     ax.axhline(result["untrained"]["mean_return"], color="grey", ls="--", label="untrained, 50 held-out seeds")
     ax.axhline(result["trained"]["mean_return"], color="green", ls="--", label="trained, 50 held-out seeds")
     ax.set_xlabel("training episodes")
     ax.set_ylabel("return (goal +1, 0.2 per metre the ball nears the goal)")
     ax.set_title("CEM, linear policy: score from the penalty area's edge past a keeper")
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -220,3 +220,36 @@ def test_the_learning_example_runs(tmp_path):
     result = json.loads((tmp_path / "results.json").read_text())
     assert set(result) >= {"trained", "untrained", "curve"} and (tmp_path / "learning-curve.png").stat().st_size
     assert registry.resolve_name(f"policy:{tmp_path / 'policy.pkl'}").startswith("policy:/")
+
+
+PUSH = """
+[[scenario]]
+name = "push"
+time_limit = 3.0
+[scenario.play]
+robots = 2
+[scenario.start.ball]
+x = -3.0
+y = 2.0
+[[scenario.start.robots]]
+robot = "a/1"
+x = 3.0
+y = 0.0
+theta = 0.0
+"""
+
+
+def test_a_learner_that_pushes_gets_the_foul(tmp_path):
+    path = tmp_path / "push.scenario.toml"
+    path.write_text(PUSH)
+    seen = []
+
+    def reward(agent, outcome):
+        seen.extend((c.name, c.team) for c in outcome.commands)
+        return 0.0
+
+    env = SoccerParallelEnv(agents=["a/1"], robots=2, frame_skip=5, reward=reward)
+    env.reset(seed=1, options={"scenario": str(path)})
+    while env.agents:
+        env.step({"a/1": np.array([1.0, 0, 0, 0], np.float32)})
+    assert ("FREEKICK", "b") in seen, seen  # it drove into b's keeper
