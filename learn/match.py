@@ -35,7 +35,7 @@ _world = msgspec.msgpack.Decoder(World).decode
 class Gate:
     """Where a learner's robot waits for its action; duck-types the `Inbound` a cooperative task parks on."""
 
-    __slots__ = ("key", "sender", "paired", "released", "waiter", "_channel")
+    __slots__ = ("key", "sender", "paired", "released", "waiter", "waited", "_channel")
 
     def __init__(self, name: str):
         self.key = f"action/{name}"
@@ -43,6 +43,7 @@ class Gate:
         self.paired = False  # the robot puts its held-back `cmd` batch as it parks here
         self.released = -1  # the last tick whose action is set
         self.waiter: Task | None = None
+        self.waited = -1  # the tick a driver last waited on it for (`runtime/coop.py` sets it)
         self._channel = self
 
     def ready(self, k: int) -> bool:

@@ -48,7 +48,7 @@ def policy_of(theta: np.ndarray, cols: list[int], size: int) -> LinearPolicy:
     return LinearPolicy(w, theta[:, -1])
 
 
-def reward(agent: str, o: Outcome) -> float:  # noqa: ARG001
+def reward(agent: str, o: Outcome) -> float:
     """+1 a goal, -1 one conceded, and 0.2 per metre the ball came nearer the goal's centre, but not over
     a step in which the referee stopped play or placed the ball (a goal kick moves it without a kick)."""
     shaping = 0.0 if o.commands else 0.2 * o.ball_closing
