@@ -1019,16 +1019,17 @@ def cmd_strategies(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps({"strategies": rows}, indent=2))
         return 0
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
+
+    from arena.tools.console import console as make_console
 
     t = Table(title="strategies (arena match --home NAME --away ALIAS)")
     for col in ("name", "alias", "from", "conformance"):
         t.add_column(col)
     for r in rows:
         t.add_row(r["name"], "/".join(r["aliases"]) or "-", escape(r["source"]), escape(r["conformance"]))
-    Console().print(t)
+    make_console().print(t)
     return 0 if not any(r["conformance"].startswith("fails") for r in rows) else 1
 
 

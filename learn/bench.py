@@ -19,11 +19,11 @@ import statistics
 import time
 
 import numpy as np
-from rich.console import Console
 
 from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.single import make_vector_env
 from arena.runtime.config import MatchConfig
+from arena.tools.console import console as make_console
 from arena.tools.launch.inprocess import play_in_process
 
 ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  # cycled: no draw in the loop
@@ -91,7 +91,7 @@ def _children_cpu() -> float:
 def bench_learn(
     runs: int = 3, half_time: float = 30.0, strategy: str = "advance-dynamic", as_json: bool = False
 ) -> int:
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     rates: dict[str, list[float]] = {"match": [], "env1": [], "env3": []}
     for i in range(runs):
         cfg = MatchConfig(seed=500 + i, home=strategy, away=strategy, half_time=half_time)

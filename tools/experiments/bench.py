@@ -12,18 +12,18 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
 from arena.runtime.config import MatchConfig
+from arena.tools.console import console as make_console
 from arena.tools.launch import launcher, zygote
 
 
 def bench_match(
     runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
 ) -> int:
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     results = []
     # Before the first router: every match's processes are forked by the zygote (tools/launch/zygote.py),
     # the first match's too (warm: the zygote has imported everything before the first launch).
@@ -85,7 +85,7 @@ def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: b
     t.add_column("value", justify="right")
     for name, value in rows:
         t.add_row(escape(name), value)  # "[s]" is a unit, not rich markup
-    Console().print(t)
+    make_console().print(t)
     return 0
 
 
@@ -93,7 +93,7 @@ def bench_record(
     runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
 ) -> int:
     """The cost of `--record`: the same matches with and without a recorder, interleaved."""
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     plain, recorded, sizes = [], [], []
     zygote.start(ready=len(MatchConfig(robots=robots).processes()) + 1)
     with tempfile.TemporaryDirectory(prefix="arena-bench-") as tmp:
@@ -201,5 +201,5 @@ def bench_robot(strategy: str = "advance-dynamic", as_json: bool = False) -> int
     t.add_column("value", justify="right")
     t.add_row(r"robot control step (perception, behaviour, navigation) \[us]", f"{out['robot_step_us']:.1f}")
     t.add_row(r"F-SFM step, 5 obstacles \[us]", f"{out['fsfm_step_us']:.1f}")
-    Console().print(t)
+    make_console().print(t)
     return 0

@@ -43,10 +43,11 @@ def match_facts(cfg: MatchConfig) -> MatchFacts:
 def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = False) -> list[MatchFacts]:
     """`match_facts` of every configuration, in worker processes (spawned: no fork of threads),
     in the order given; `progress`: say on stderr as each match ends (a bar on a terminal)."""
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    console, bar_shown = Console(stderr=True), progress and sys.stderr.isatty()
+    from arena.tools.console import console as make_console
+
+    console, bar_shown = make_console(stderr=True), progress and sys.stderr.isatty()
     columns = (TextColumn("[bold]facts[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     context = multiprocessing.get_context("spawn")
     pool, stopped = ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context), True

@@ -29,8 +29,7 @@ import subprocess
 import sys
 import time
 
-from rich.console import Console
-
+from arena.tools.console import console as make_console
 from arena.tools.experiments.tournament import default_jobs
 
 ENGINES = ("processes", "inprocess")
@@ -99,7 +98,7 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
 
 
 def bench_throughput(runs: int, half_time: float, robots: int, link: str, strategy: str, as_json: bool) -> int:
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     cores = os.cpu_count() or 1
     jobs = default_jobs()
     played: dict[str, list[dict]] = {e: [] for e in ENGINES}
@@ -159,7 +158,7 @@ def bench_throughput(runs: int, half_time: float, robots: int, link: str, strate
         f"{q['matches_per_hour']:.0f}",
         f"{q['matches_per_hour'] / max(1e-9, p['matches_per_hour']):.2f}x",
     )
-    Console().print(t)
+    make_console().print(t)
     console.print(f"digests equal in every pair: {'yes' if same else 'NO'}")
     console.print("throughput derived: " + out["throughput_how"])
     console.print(f"(1) {LAUNCH_DEFINITIONS['command']}")

@@ -779,8 +779,9 @@ def play_local(jobs: int, runner: Runner, todo: list[Fixture], arrived) -> bool:
 
 def run(opts: TournamentOptions) -> tuple[dict, bool]:
     """Play (or resume) the tournament. Returns (summary, interrupted)."""
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from arena.tools.console import console as make_console
 
     strategies = list(opts.strategies)
     out = Path(opts.out)
@@ -803,7 +804,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
         print(f"arena tournament: --resume: {len(results)} of {len(fixtures)} matches kept from {out}", file=sys.stderr)
     t0 = time.monotonic()
     interrupted = False
-    console = Console(stderr=True)
+    console = make_console(stderr=True)
     show = not opts.json and sys.stderr.isatty()
     with Progress(
         TextColumn("[bold]tournament[/]"),
@@ -867,10 +868,11 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
 
 
 def print_summary(summary: dict) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    c = Console()
+    from arena.tools.console import console as make_console
+
+    c = make_console()
     t = Table(title="standings (3/1/0; by P, GD, GF)")
     for col in ("team", "W", "D", "L", "GF", "GA", "GD", "P", "rating (95 % CI)", "robot1/robot2"):
         t.add_column(col, justify="right")

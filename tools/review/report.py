@@ -5,9 +5,11 @@ from __future__ import annotations
 from rich.console import Console
 from rich.table import Table
 
+from arena.tools.console import console as make_console
+
 
 def print_match(result: dict, console: Console | None = None) -> None:
-    console = console or Console()
+    console = console or make_console()
     a, b = result["score"]
     console.print(
         f"[bold]{result['home']}[/] (a) [bold]{a} : {b}[/] [bold]{result['away']}[/] (b)   "

@@ -25,6 +25,7 @@ from rich.table import Table
 from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import Recording, RecordingError, load
 from arena.schemas.messages import Referee, World
+from arena.tools.console import console as make_console
 from arena.tools.review import animation
 from arena.tools.review import plots as pictures
 
@@ -33,7 +34,7 @@ TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in t
 
 # ------------------------------------------------------------------ output
 def print_review(r: dict, console: Console | None = None) -> None:  # noqa: C901, PLR0912 - one section of the report per branch
-    console = console or Console()
+    console = console or make_console()
     a, b = r["score"]
     console.print(
         f"[bold]{r['home']}[/] (a) [bold]{a} : {b}[/] [bold]{r['away']}[/] (b)   seed {r['seed']}, link {r['link']}"

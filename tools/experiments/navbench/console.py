@@ -15,14 +15,13 @@ from arena.tools.experiments.navbench.spec import (
 
 
 def print_report(r: Report, console: Any = None) -> None:
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
 
     if console is None:
-        console = Console()
-        if not console.is_terminal:
-            console = Console(width=150)  # piped: wide enough for the tables
+        from arena.tools.console import console as make_console
+
+        console = make_console()
     rows = results_rows(r)
     methods = method_rows(r)
     for sc in r.spec.scenarios:

@@ -79,7 +79,6 @@ def main(
 
     `only`: scenario names, each entry may hold several separated by commas.
     """
-    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     names = [s for part in only for s in part.split(",") if s]
@@ -90,7 +89,9 @@ def main(
         out = Path(plots)
         if out.exists() and not out.is_dir():
             raise ConfigError(f"--plots {plots}: exists and is not a directory")
-    err = Console(stderr=True)
+    from arena.tools.console import console as make_console
+
+    err = make_console(stderr=True)
     with Progress(
         TextColumn("{task.description}"),
         BarColumn(),
