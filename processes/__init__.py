@@ -1,6 +1,6 @@
 """The process kinds and nothing else: one module per kind (engine, referee,
 basestation, robot, recorder, refbox, viewer), all shaped the same: a `Node` subclass with its
-wiring, `act` and its loops; argument parsing stays in arena/cli.py. The
+wiring, `act` and its loops; argument parsing stays in arena/commands/. The
 library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
 `arena.strategies`, `arena.runtime`, `arena.schemas`. Only `arena.tools` and
 `arena.cli` import this package."""

@@ -1,1 +1,21 @@
-"""One small module per `arena` sub-command: it builds its parser and calls a typed function."""
+"""One module per `arena` sub-command: `arena/commands/<name>.py` builds its
+parser (`add_parser(sub)`, with examples in its help) and turns the parsed
+flags into a call of a typed function of the packages below (`run(args) -> int`,
+the exit code). `arena/cli.py` only dispatches. Modules whose name starts with
+`_` are shared flag groups and helpers, not commands.
+
+Nothing outside arena/ imports this package (tests/unit/test_layering.py).
+"""
+
+from __future__ import annotations
+
+import pkgutil
+
+# The order of `arena --help`; a command module not listed here follows, by name.
+ORDER = ("match", "run", "up", "tournament", "bench", "facts", "review", "replay", "config", "strategies", "schemas")
+
+
+def names() -> list[str]:
+    """Every sub-command: a module of this package whose name does not start with `_`."""
+    found = {m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")}
+    return [n for n in ORDER if n in found] + sorted(found - set(ORDER))

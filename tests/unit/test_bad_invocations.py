@@ -152,9 +152,9 @@ def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, busy_port, garbag
 
 
 def test_the_table_covers_every_subcommand():
-    from arena.cli import build_parser
+    from arena.cli import parser
 
-    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    sub = next(a for a in parser()._actions if a.dest == "command")
     covered = {args[0] for args, _ in BAD if args}
     assert set(sub.choices) - covered == set(), "every subcommand needs bad invocations in the table"
     assert len(BAD) >= 40
@@ -162,11 +162,12 @@ def test_the_table_covers_every_subcommand():
 
 def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, capsys):
     from arena import cli
+    from arena.commands import schemas
 
     def broken(args):
         raise ZeroDivisionError("the bug")
 
-    monkeypatch.setattr(cli, "cmd_schemas", broken)
+    monkeypatch.setattr(schemas, "run", broken)
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     assert cli.main(["schemas", "--check"]) == 1
     err = capsys.readouterr().err.strip()
@@ -178,8 +179,8 @@ def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, c
 @pytest.mark.parametrize(
     ("command", "said"),
     [
-        ("cmd_review", "arena review: interrupted"),
-        ("cmd_match", "arena match: interrupted; every process of the match was stopped"),
+        ("review", "arena review: interrupted"),
+        ("match", "arena match: interrupted; every process of the match was stopped"),
     ],
 )
 def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
@@ -188,8 +189,8 @@ def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, command, interrupted)
-    argv = ["review", "m.mcap"] if command == "cmd_review" else M
+    monkeypatch.setattr(cli.command(command), "run", interrupted)
+    argv = ["review", "m.mcap"] if command == "review" else M
     assert cli.main(argv) == 130
     assert capsys.readouterr().err.strip() == said
 

@@ -51,7 +51,7 @@ LEGACY = {"perception_latency": 0}
 
 @dataclass(frozen=True)
 class TournamentOptions:
-    """What `arena tournament` plays and how: its flags, typed (arena/cli.py builds one from argv)."""
+    """What `arena tournament` plays and how: its flags, typed (arena/commands/tournament.py builds one from argv)."""
 
     strategies: tuple[str, ...]  # resolved names, in the order given
     legs: int = 10
@@ -87,7 +87,7 @@ class TournamentOptions:
 
 def settings(opts: TournamentOptions) -> dict:
     """Everything needed to play the tournament again (tournament.json, report.md, --resume's check)."""
-    from arena.cli import package_version
+    from arena.runtime.version import package_version
 
     return {
         "strategies": list(opts.strategies),

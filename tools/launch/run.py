@@ -87,6 +87,32 @@ def load_config(path: str) -> MatchConfig:
     return MatchConfig.from_json(text)
 
 
+def record_path(text: str, fresh: bool = False) -> str:
+    """An absolute path for a new MCAP file whose directory exists (children may run elsewhere).
+
+    `fresh`: an existing file is refused, not overwritten (arena match; the recorder
+    it starts gets the path it checked)."""
+    path = Path(text).expanduser().resolve()
+    if not path.parent.is_dir():
+        raise ConfigError(f"--record {text}: directory {path.parent} does not exist")
+    if path.is_dir():
+        raise ConfigError(f"--record {text} is a directory")
+    if fresh and path.exists():
+        size = path.stat().st_size / 1e6
+        raise ConfigError(f"--record {text} exists ({size:.1f} MB): give a new file name, or delete it first")
+    # Tried now, not by the recorder after the match has started: a recorder that
+    # cannot write holds every process at the start barrier until it times out.
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"--record {text}: cannot write it ({exc.strerror or exc})") from None
+    if not existed:
+        path.unlink()
+    return str(path)
+
+
 REFUSED_AFTER = 6.0  # [s] listening but not connected this long is a refusal: zenoh retries a connect every <= 4 s
 
 

@@ -1,4 +1,5 @@
-"""Checks of one scenario entry: its robot preset, timing and positions, and typed parameter overrides."""
+"""Checks of one scenario entry: its robot preset, timing and positions, typed parameter overrides,
+unique names, and merging a table over its defaults."""
 
 from __future__ import annotations
 
@@ -65,3 +66,16 @@ def _override(obj: Any, overrides: dict[str, Any], where: str) -> Any:
         return dataclasses.replace(obj, **changes)
     except (TypeError, ValueError) as exc:
         raise ScenarioError(f"{where}: {exc}") from None
+
+
+def _merge(defaults: dict[str, Any], table: dict[str, Any]) -> dict[str, Any]:
+    out = dict(defaults)
+    for k, v in table.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def _unique(name: str, seen: set[str], where: str) -> None:
+    if name in seen:
+        raise ScenarioError(f"{where}: the name is used twice")
+    seen.add(name)

@@ -11,7 +11,7 @@ import msgspec
 
 from arena.navigation import NAVIGATORS, PARAMS
 from arena.sim.drive import Drive
-from arena.tools.experiments.navbench.checks import _check_timing, _on_field, _override, _robot
+from arena.tools.experiments.navbench.checks import _check_timing, _merge, _on_field, _override, _robot, _unique
 from arena.tools.experiments.navbench.spec import (
     BUILTIN,
     BenchFile,
@@ -140,16 +140,3 @@ def _resolve(data: dict[str, Any], name: str) -> BenchSpec:  # noqa: C901, PLR09
             raise ScenarioError(f"{where}: no methods")
         minima.append(LocalMinimum(lm, robot, tuple(methods)))
     return BenchSpec(name, tuple(scenarios_out), tuple(minima))
-
-
-def _merge(defaults: dict[str, Any], table: dict[str, Any]) -> dict[str, Any]:
-    out = dict(defaults)
-    for k, v in table.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
-    return out
-
-
-def _unique(name: str, seen: set[str], where: str) -> None:
-    if name in seen:
-        raise ScenarioError(f"{where}: the name is used twice")
-    seen.add(name)

@@ -1,0 +1,112 @@
+"""The flags that describe one match (`--home`, `--away`, `--half-time`, links, ...)
+and the one place that turns them into a `MatchConfig`."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+from arena.commands._common import half_time
+from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
+
+
+def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = True) -> None:
+    p.add_argument("--home", required=required, metavar="STRATEGY", help="team a's strategy (name or BS/BD/AS/AD)")
+    p.add_argument("--away", required=required, metavar="STRATEGY", help="team b's strategy")
+    # Defaults of None: the match's own default, or --config FILE's value, applies (match_config).
+    p.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team, goalkeeper included (3)")
+    p.add_argument(
+        "--half-time",
+        type=half_time,
+        default=None,
+        metavar="SECONDS",
+        help=f"simulated half length [s], at most {MAX_HALF_TIME:g} (300)",
+    )
+    if seed:
+        p.add_argument("--seed", type=int, default=None, metavar="N", help="master seed (0)")
+    p.add_argument("--link", default=None, metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
+    p.add_argument(
+        "--link-param",
+        action="append",
+        default=[],
+        metavar="CLASS.PARAM=V",
+        help="override one link parameter, e.g. wifi.latency_ms=12 (repeatable)",
+    )
+    p.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="a robot at tick k sees the sense of tick k - TICKS (the model; changes digests), e.g. "
+        "--perception-latency 0 for robots that see the present (default: timing.perception_latency, 3 = 60 ms)",
+    )
+    p.add_argument(
+        "--batch",
+        type=int,
+        default=None,
+        metavar="N",
+        help="sense/cmd frames per message, 1..perception latency; 0 = as many as it allows (a transport "
+        "detail: digests are the same for every N), e.g. --batch 1 for one frame per message (0)",
+    )
+
+
+def every_match_latency(p: argparse.ArgumentParser) -> None:
+    """`--perception-latency` of a command that plays many matches (tournament, facts)."""
+    p.add_argument(
+        "--perception-latency",
+        type=int,
+        default=None,
+        metavar="TICKS",
+        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
+        "e.g. 0 for robots that see the present",
+    )
+
+
+def match_config(
+    args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None
+) -> MatchConfig:
+    from arena.runtime.links import parse_override, resolve
+    from arena.strategies import registry
+
+    overrides: dict[str, dict[str, float]] = {}
+    for text in args.link_param:
+        cls, param, value = parse_override(text)
+        overrides.setdefault(cls, {})[param] = value
+    base = MatchConfig()
+    if getattr(args, "config_file", None):
+        from arena.runtime import matchfile
+
+        base = matchfile.load(args.config_file)
+    link = args.link if args.link is not None else base.link
+    if args.link is None:  # the file's overrides, then the flags' on top
+        merged = {cls: dict(ps) for cls, ps in base.link_overrides.items()}
+        for cls, ps in overrides.items():
+            merged.setdefault(cls, {}).update(ps)
+        overrides = merged
+    resolve(link, overrides)  # validates preset, classes and values
+    home = registry.resolve_name(args.home or base.home)
+    away = registry.resolve_name(args.away or base.away)
+    timing = base.timing
+    if getattr(args, "perception_latency", None) is not None:
+        timing = dataclasses.replace(timing, perception_latency=args.perception_latency)
+    if getattr(args, "batch", None) is not None:
+        timing = dataclasses.replace(timing, batch=args.batch)
+    cfg = base.replace(
+        timing=timing,
+        seed=args.seed if args.seed is not None else base.seed,
+        home=home,
+        away=away,
+        robots=args.robots if args.robots is not None else base.robots,
+        half_time=args.half_time if args.half_time is not None else base.half_time,
+        link=link,
+        link_overrides=overrides,
+        realtime=realtime,
+        tap=tap,
+        **({"refbox": refbox} if refbox is not None else {}),
+        external=tuple(
+            ProcessId.parse(e).short if ProcessId.parse(e).kind == "robot" else str(ProcessId.parse(e))
+            for e in external
+        ),
+    )
+    cfg.validate()
+    return cfg

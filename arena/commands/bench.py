@@ -1,0 +1,93 @@
+"""`arena bench WHAT`: benchmarks that print throughput and ratios (medians of several runs)."""
+
+from __future__ import annotations
+
+import argparse
+
+from arena.commands._common import add_command, half_time, positive_int
+from arena.runtime.config import ConfigError, MatchConfig
+
+CATCH_SIGTERM = True
+STOPS_PROCESSES = True
+
+EXAMPLES = """examples:
+  arena bench match                # median rtf of 3 lockstep 2x60 s 3v3 matches
+  arena bench match --runs 5 --half-time 120 --link wifi
+  arena bench record               # median rtf with and without --record, and the ratio
+  arena bench robot                # median us per robot control step and per F-SFM step
+  arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
+  arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
+  arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
+  arena bench nav --trials 3 --only static,SAROG --plots navplots/
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
+
+
+def add_parser(sub) -> None:
+    b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
+    b.add_argument(
+        "what",
+        choices=["match", "record", "robot", "nav", "throughput", "learn"],
+        help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
+        "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
+        "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
+        "on 2 workers vs. 1 (needs the learn extra)",
+    )
+    b.add_argument(
+        "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
+    )
+    b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
+    b.add_argument("--half-time", type=half_time, default=60.0, metavar="SECONDS", help="half length [s] (60)")
+    b.add_argument("--robots", type=int, default=3, metavar="N")
+    b.add_argument("--link", default="ideal", metavar="PRESET")
+    b.add_argument("--json", action="store_true")
+    b.add_argument(
+        "--trials", type=positive_int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)"
+    )
+    b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
+    b.add_argument(
+        "--scenarios",
+        metavar="FILE",
+        help="nav: scenario file (default: the built-in tools/experiments/navbench/navbench.toml)",
+    )
+    b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
+    b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
+
+
+def run(args: argparse.Namespace) -> int:
+    from arena.strategies import registry
+    from arena.tools.experiments import bench
+
+    if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
+        from arena.runtime.links import resolve
+
+        resolve(args.link, {})
+        MatchConfig(robots=args.robots, half_time=args.half_time, link=args.link).validate()
+        if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
+            registry.resolve_name(args.strategy)
+    if args.what == "record":
+        return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
+    if args.what == "robot":
+        return bench.bench_robot(args.strategy, args.json)
+    if args.what == "learn":
+        registry.resolve_name(args.strategy)
+        try:
+            from arena.learn.bench import bench_learn
+        except ImportError as exc:
+            raise ConfigError(str(exc)) from None
+        return bench_learn(args.runs, args.half_time, args.strategy, args.json)
+    if args.what == "throughput":
+        from arena.tools.experiments import throughput
+
+        return throughput.bench_throughput(args.runs, args.half_time, args.robots, args.link, args.strategy, args.json)
+    if args.what == "nav":
+        from arena.tools.experiments import navbench
+
+        return navbench.main(
+            scenarios=args.scenarios,
+            only=args.only or (),
+            trials=args.trials,
+            seed=args.seed,
+            plots=args.plots,
+            as_json=args.json,
+        )
+    return bench.bench_match(args.runs, args.half_time, args.robots, args.link, args.json)

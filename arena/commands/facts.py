@@ -1,0 +1,61 @@
+"""`arena facts`: play matches in process and measure them, per match and per strategy."""
+
+from __future__ import annotations
+
+import argparse
+
+from arena.commands._common import add_command, half_time
+from arena.commands._match_flags import every_match_latency
+from arena.runtime.config import ConfigError
+
+CATCH_SIGTERM = True
+STOPS_PROCESSES = True
+
+EXAMPLES = """examples:
+  arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process
+  arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
+  arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio
+  arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present
+  arena facts --seeds 10 --home AD --away BS --json  # every match's facts and the totals per strategy, as JSON"""
+
+
+def add_parser(sub) -> None:
+    fa = add_command(
+        sub,
+        "facts",
+        "play matches in process and measure them: rules and team-play facts per match and strategy",
+        EXAMPLES,
+    )
+    fa.add_argument("--seeds", type=int, default=20, metavar="N", help="matches, seeds first-seed.. (20)")
+    fa.add_argument("--first-seed", type=int, default=0, metavar="S", help="first seed (0)")
+    fa.add_argument(
+        "--half-time", type=half_time, default=60.0, metavar="SECONDS", help="simulated half length [s] (60)"
+    )
+    fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
+    fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
+    fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once (default: up to 2)")
+    fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
+    fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
+    fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
+    fa.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
+    every_match_latency(fa)
+
+
+def run(args: argparse.Namespace) -> int:
+    from arena.tools.experiments import facts
+
+    if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
+        raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")
+    return facts.main(
+        seeds=args.seeds,
+        first_seed=args.first_seed,
+        half_time=args.half_time,
+        home=args.home,
+        away=args.away,
+        workers=args.workers or None,
+        round_robin_of=[s for s in (args.round_robin or "").split(",") if s] or None,
+        legs=args.legs,
+        seed=args.seed,
+        perception_latency=args.perception_latency,
+        as_json=args.json,
+    )

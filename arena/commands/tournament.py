@@ -1,0 +1,117 @@
+"""`arena tournament`: a round-robin of strategies, the paper's tables, charts and ratings."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from arena.commands._common import ENGINE_FLAG, add_command, half_time, positive_int
+from arena.commands._match_flags import every_match_latency
+from arena.runtime.config import ConfigError
+
+EXAMPLES = """examples:
+  arena tournament                                  # the paper's experiment: 4 strategies x 10 legs = 60 matches
+  arena tournament --strategies AD,BS --legs 4 --half-time 60 --out runs/quick
+  arena tournament --out runs/paper --resume        # continue after Ctrl-C or a crash
+  arena tournament --link congested-wifi --jobs 2 --json
+  arena tournament --ray                            # every match a task on a local Ray instance (docs/cluster.md)
+  arena tournament --ray auto --out runs/big        # join the Ray cluster this node belongs to (ray start ...)
+  arena tournament --ray 10.0.0.5:6379 --resume     # join the cluster whose head node is there
+  arena tournament --ray auto --ray-runtime-env '{"pip": ["soccer-arena==0.1.0"]}'   # workers install it
+  arena tournament --legs 10 --engine inprocess     # one worker process per core, same digests, ~2.5x faster"""
+
+
+def add_parser(sub) -> None:
+    t = add_command(sub, "tournament", "round-robin of strategies: the paper's tables, charts and ratings", EXAMPLES)
+    t.add_argument("--strategies", default="AD,AS,BD,BS", metavar="A,B,...", help="strategies (AD,AS,BD,BS)")
+    t.add_argument(
+        "--legs", type=positive_int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
+    )
+    t.add_argument(
+        "--half-time", type=half_time, default=300.0, metavar="SECONDS", help="simulated half length [s] (300)"
+    )
+    t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
+    t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
+    t.add_argument(
+        "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
+    )
+    every_match_latency(t)
+    t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
+    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
+    t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
+    t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
+    t.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
+        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
+    )
+    t.add_argument(
+        "--ray-runtime-env",
+        metavar="JSON",
+        help='with --ray: a Ray runtime_env for the workers, e.g. \'{"pip": ["soccer-arena==0.1.0"]}\'',
+    )
+    t.add_argument("--json", action="store_true", help="print one JSON object")
+    t.add_argument("--engine", **ENGINE_FLAG)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from arena.runtime.links import parse_override, resolve
+    from arena.strategies import registry
+    from arena.tools.experiments import tournament
+
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise ConfigError(f"--out {args.out} exists and is not a directory")
+    names = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
+    if len(set(names)) < 2:
+        raise ConfigError("--strategies needs at least two different strategies")
+    if args.legs < 1 or args.jobs < 0 or args.half_time <= 0 or not 1 <= args.robots <= 6:
+        raise ConfigError("--legs >= 1, --jobs >= 0, --half-time > 0 and --robots 1..6, please")
+    overrides: dict[str, dict[str, float]] = {}
+    for text in args.link_param:
+        cls, param, value = parse_override(text)
+        overrides.setdefault(cls, {})[param] = value
+    resolve(args.link, overrides)
+    if args.perception_latency is not None:  # its range, as arena match checks it
+        from arena.runtime.config import MatchConfig, TimingParams
+
+        MatchConfig(timing=TimingParams(perception_latency=args.perception_latency)).validate()
+    if args.ray is not None:
+        from arena.tools.experiments.cluster import parse_address, parse_runtime_env
+
+        parse_address(args.ray)
+        parse_runtime_env(args.ray_runtime_env)
+    elif args.ray_runtime_env is not None:
+        raise ConfigError("--ray-runtime-env needs --ray")
+    opts = tournament.TournamentOptions(
+        strategies=tuple(names),
+        legs=args.legs,
+        half_time=args.half_time,
+        robots=args.robots,
+        link=args.link,
+        link_param=tuple(args.link_param),
+        perception_latency=args.perception_latency,
+        seed=args.seed,
+        jobs=args.jobs,
+        out=Path(args.out),
+        resume=args.resume,
+        json=args.json,
+        engine=args.engine,
+        ray=args.ray,
+        ray_runtime_env=args.ray_runtime_env,
+    )
+    summary, interrupted = tournament.run(opts)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        tournament.print_summary(summary)
+    if interrupted:
+        print("arena tournament: interrupted; finished matches are kept (continue with --resume)", file=sys.stderr)
+        return 130
+    return 0
