@@ -22,7 +22,8 @@ import msgspec
 
 from arena.processes import node_class
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.coop import CoopBus, CoopTransport, Task, run_runnable
+from arena.runtime.coop import CoopBus, Task, run_runnable
+from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
 from arena.schemas.messages import Order, Referee, Sense, World
 from arena.strategies.base import RobotContext
@@ -35,7 +36,7 @@ _world = msgspec.msgpack.Decoder(World).decode
 class Gate:
     """Where a learner's robot waits for its action; duck-types the `Inbound` a cooperative task parks on."""
 
-    __slots__ = ("key", "sender", "paired", "released", "waiter", "waited", "_channel")
+    __slots__ = ("key", "sender", "paired", "released", "waiter", "channel", "waited")
 
     def __init__(self, name: str):
         self.key = f"action/{name}"
@@ -43,17 +44,14 @@ class Gate:
         self.paired = False  # the robot puts its held-back `cmd` batch as it parks here
         self.released = -1  # the last tick whose action is set
         self.waiter: Task | None = None
-        self.waited = -1  # the tick a driver last waited on it for (`runtime/coop.py` sets it)
-        self._channel = self
+        self.channel = self  # a parked task waits on it as on a link's channel
+        self.waited = -1  # the tick a driver last waited on it for (runtime/drivers.py `advance` sets it)
 
     def ready(self, k: int) -> bool:
         return self.released >= k
 
-    def try_recv(self) -> None:
-        return None
-
-    def _accept(self, raw: bytes, _: Any) -> None:  # pragma: no cover - nothing is ever put here
-        pass
+    def drain(self) -> None:
+        """Nothing arrives here: only `release` opens the gate."""
 
     def release(self, k: int, runnable) -> None:
         self.released = k
@@ -89,7 +87,9 @@ class SteppedMatch:
         keys = Keys("learn")
         self.referee_ch = bus.subscribe(None, keys.key("referee"))
         self.world_ch = bus.subscribe(None, keys.key("world"))
-        self.nodes = {str(p): node_class(p.kind)(p, cfg, CoopTransport(bus), keys) for p in cfg.processes()}
+        self.nodes = {
+            str(p): node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p))) for p in cfg.processes()
+        }
         self.actions: dict[str, Any] = {}
         self.gates: dict[str, Gate] = {}
         self.robot_of: dict[str, Any] = {}
@@ -103,7 +103,9 @@ class SteppedMatch:
                 self.gates[agent] = gate = Gate(agent)
                 self.robot_of[agent] = node
                 steps = _gated(node, gate, frame_skip)
-            tasks.append(Task(name, steps, node.batch_flusher()))
+            task = node.driver  # its `Task`; the gated loop is driven, not `Node.playing`
+            task.steps, task.flush = steps, node.batch_flusher()
+            tasks.append(task)
         self.tasks = tasks
         self.learner_tasks = {a: next(t for t in tasks if t.name == f"robot/{a}") for a in learners}
         self.tick = 0  # the decision tick the learners wait at

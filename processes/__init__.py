@@ -1,6 +1,7 @@
 """The process kinds and nothing else: one module per kind (engine, referee,
 basestation, robot, recorder, refbox, viewer), all shaped the same: a `Node` subclass with its
-wiring, `act` and its loops; argument parsing stays in arena/commands/. The
+wiring, `act` and its loops, or for the two that watch from outside the lockstep (`OBSERVERS`)
+an `Observer` with its `observe`; argument parsing stays in arena/commands/. The
 library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
 `arena.strategies`, `arena.runtime`, `arena.schemas`. Only `arena.tools` and
 `arena.cli` import this package."""
@@ -19,6 +20,7 @@ NODES = {
     "refbox": ("arena.processes.refbox", "RefboxNode"),
     "viewer": ("arena.processes.viewer", "ViewerNode"),
 }
+OBSERVERS = frozenset(("recorder", "viewer"))  # `Observer`s: in nobody's lockstep, no driver
 
 
 def node_class(kind: str):

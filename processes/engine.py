@@ -45,6 +45,7 @@ from arena.rules import setpieces
 from arena.rules.referee_box import check_referee
 from arena.runtime import seeds
 from arena.runtime.config import TEAMS, MatchConfig
+from arena.runtime.drivers import Reactor
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
@@ -205,9 +206,9 @@ class EngineNode(Node):
             if problem:
                 self.rejections.reject(key, "malformed", problem)
 
-        if self.reactor is not None:
+        if isinstance(self.driver, Reactor):
             self.transport.subscribe_callback(key, on_control)
-            pacer.start(self.reactor.poke)
+            pacer.start(self.driver.poke)
         else:
             channel = self.transport.subscribe(key)
             pacer.pull_from(channel.try_recv)
@@ -282,17 +283,17 @@ class EngineNode(Node):
             total_ticks=cfg.total_ticks,
         )
 
-    def loop(self) -> None:
+    def loop(self) -> Waits:
         if self.pacer is not None:
             # A live match: the viewer's state now (a pause set before the start holds tick 0).
             raw = self.transport.query(self.keys.control(), timeout=2.0)
             if raw is not None and self.pacer.control_raw(raw):
                 self.rejections.reject(self.keys.control(), "malformed", "the viewer's control state")
-        super().loop()
+        yield from super().loop()
 
     def lockstep(self) -> Waits:
         # The field frame is part of the loop, not of `loop()`: whoever drives the
-        # generator (Reactor, pull, the cooperative driver of tools/launch/inprocess.py)
+        # generator (runtime/drivers.py: Reactor, Pull, the cooperative driver)
         # sends it first, so the engine's digest is the same under every driver.
         self.field_out.send(self.field_spec())
         last = self.cfg.total_ticks
@@ -357,12 +358,10 @@ class EngineNode(Node):
             if delay > 0:
                 time.sleep(delay)
 
-    def run(self):
-        try:
-            return super().run()
-        finally:
-            if self.pacer is not None:
-                self.pacer.stop()
+    def close(self) -> None:
+        super().close()
+        if self.pacer is not None:
+            self.pacer.stop()
 
     def summary_extra(self) -> dict[str, object]:
         return {

@@ -50,7 +50,7 @@ import msgspec
 
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
-from arena.runtime.node import Node
+from arena.runtime.node import Observer
 from arena.schemas.keys import KEYS, routes, spec_of
 from arena.schemas.messages import EngineEvents, Referee, Summary, TapBatch, World
 
@@ -175,7 +175,7 @@ class McapSink:
         self.writer.close()
 
 
-class RecorderNode(Node):
+class RecorderNode(Observer):
     """`path`: the MCAP file to write. Only the recorder gets it; the others see `cfg.tap`."""
 
     def __init__(self, *args, path: str = "", **kwargs):
@@ -461,7 +461,7 @@ class RecorderNode(Node):
 
         return handler
 
-    def loop(self) -> None:
+    def observe(self) -> None:
         stop = threading.Event()
         previous = {}
         if threading.current_thread() is threading.main_thread():
@@ -485,7 +485,7 @@ class RecorderNode(Node):
         if self.interrupted:
             raise SystemExit(128 + signal.Signals[self.interrupted].value)
 
-    # A cooperative match (tools/launch/inprocess.py) calls these two instead of `loop`.
+    # A cooperative match (tools/launch/inprocess.py) calls these two instead of `observe`.
     def pump(self) -> None:
         """Take in the tap batches and summaries that are there; write what every watermark passed."""
         self._drain()

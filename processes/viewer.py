@@ -45,7 +45,7 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
-from arena.runtime.node import Node
+from arena.runtime.node import Observer
 from arena.schemas.messages import Control, EngineEvents, FieldSpec, Order, Referee, Report, World
 
 POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
@@ -125,7 +125,7 @@ class _Listener(ServerListener):
         return self.node.on_set_parameters(client, parameters, request_id)
 
 
-class ViewerNode(Node):
+class ViewerNode(Observer):
     def _owned(self, name: str, sender: str) -> dict:
         """Only the owner's frames (their MAC, runtime/mac.py), when this viewer holds the owner's key."""
         key = self.keys.key(name)
@@ -359,7 +359,7 @@ class ViewerNode(Node):
             time.sleep(POLL_S)
 
     # ---------------------------------------------------------------- loops
-    def loop(self) -> None:
+    def observe(self) -> None:
         """The same watch loop in both modes: the viewer takes part in no lockstep."""
         if threading.current_thread() is threading.main_thread():  # a process of its own, never a test's thread
             idle = self.lockstep_control and self.pace == 0
@@ -368,12 +368,6 @@ class ViewerNode(Node):
             self.watch()
         finally:
             self.server.stop()
-
-    def lockstep(self):
-        raise NotImplementedError("the viewer has no lockstep: see loop()")
-
-    def loop_realtime(self) -> None:
-        self.watch()
 
     def summary_extra(self) -> dict[str, object]:
         return {"port": self.port, "scenes": self.scenes, "referee_logs": self.logs}

@@ -1,8 +1,10 @@
 """Cooperative lockstep: every node of a match in ONE thread, no locks.
 
 Each node's lockstep loop is a generator that yields `(inbound, k)` where it
-needs that link's frames due at tick k (runtime/lockstep.py). `drive` resumes
-each generator as long as the link it waits on is `ready(k)`, and parks it
+needs that link's frames due at tick k (runtime/lockstep.py). Each node's
+driver is a `Task` (a `Driver`, runtime/drivers.py), and `play` runs every
+node's `Node.playing()` at once: `drive` resumes each one with the drivers'
+shared `advance` as long as the link it waits on is `ready(k)`, and parks it
 otherwise; a frame put on the channel a parked node waits on makes that node
 runnable again. Frames are the very msgpack bytes a real match sends, on the
 in-memory bus (`CoopBus`, a `MemoryBus` without locks whose channels know who
@@ -21,11 +23,16 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Any
 
+from arena.runtime.drivers import Wait, advance, subscribe
 from arena.runtime.lockstep import Inbound, Waits
-from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.runtime.transport import MemoryBus
+from arena.schemas.messages import Summary
+
+if TYPE_CHECKING:
+    from arena.runtime.node import Node
 
 
 class WouldBlock(RuntimeError):
@@ -84,25 +91,44 @@ class CoopBus(MemoryBus):
         return ch
 
 
-class CoopTransport(MemoryTransport):
-    """A `MemoryTransport` on a `CoopBus`: `Node` starts no watchdog thread for it."""
+class Task:
+    """One node's driver in a cooperative match (`Node(driver=Task(name))`), and its loop as
+    `drive` sees it. A `Driver` (runtime/drivers.py) whose `drive` hands the loop's waits to
+    the scheduler; the start barrier is skipped: every node is there by construction."""
+
+    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "resumes", "summary")
 
     cooperative = True
+    watchdog = None  # nothing blocks: a deadlock is detected by `drive`, not waited out
+    connect = staticmethod(subscribe)
 
-
-class Task:
-    """One node's lockstep loop as the driver sees it."""
-
-    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "resumes")
-
-    def __init__(self, name: str, steps: Waits, flush: Callable[[], None] | None = None):
+    def __init__(self, name: str, steps: Waits | None = None, flush: Callable[[], None] | None = None):
         self.name = name
         self.steps = steps
         self.flush = flush  # called as the task parks on a link not `paired` (`Node.batch_flusher`)
-        self.waiting: tuple[Inbound[Any], int] | None = None
+        self.waiting: Wait | None = None
         self.done = False
         self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
         self.resumes = 0
+        self.summary: Summary | None = None  # what `play` played to its end returned
+
+    def drive(self, steps: Waits, before_wait: Callable[[], None] | None) -> Waits:
+        self.flush = before_wait
+        yield from steps
+
+    def before_wait(self) -> None:
+        # Looked up at each park: `drive` sets it once the node's loop starts.
+        if self.flush is not None:
+            self.flush()
+
+    def cpu_s(self) -> list[float]:
+        return [round(self.busy_s, 3), 0.0]
+
+    def close(self) -> None:
+        pass
+
+    def playing(self, node: Node) -> Waits:
+        self.summary = yield from node.playing()
 
 
 class NodeFailed(RuntimeError):
@@ -113,30 +139,34 @@ class NodeFailed(RuntimeError):
         self.name = name
 
 
+def _drained(ib: Inbound[Any], k: int) -> bool:
+    """`advance`'s last look: take in what arrived on the link's channel."""
+    ib.drain()
+    return ib.ready(k)
+
+
 def _advance(task: Task) -> None:
-    """Run `task` until it waits on a link that is not ready, or ends."""
-    w = task.waiting
-    steps = task.steps
-    while True:
-        if w is not None:
-            ib, k = w
-            if not ib.ready(k):
-                ch = ib._channel
-                while (raw := ch.try_recv()) is not None:
-                    ib._accept(raw, None)
-                if not ib.ready(k):
-                    task.waiting = w
-                    ch.waiter = task  # type: ignore[union-attr]
-                    if task.flush is not None and not ib.paired:
-                        task.flush()
-                    return
-        try:
-            w = next(steps)
-            w[0].waited = w[1]
-        except StopIteration:
-            task.waiting = None
-            task.done = True
-            return
+    """Run `task` until it waits on a link that is not ready (parked on its channel), or ends."""
+    task.waiting = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
+    if task.waiting is None:
+        task.done = True
+    else:
+        task.waiting[0].channel.waiter = task  # type: ignore[union-attr]
+
+
+def play(
+    bus: CoopBus, nodes: Iterable[Node], on_idle: Callable[[], None] | None = None, quit_early: set[str] | None = None
+) -> tuple[dict[str, Summary], list[str]]:
+    """Play every node's match (`Node.playing`: loop and summary) at once, each driven by its
+    `Task`; returns their summaries by name and the deadlocks met (`drive`)."""
+    tasks: list[Task] = []
+    for node in nodes:
+        task = node.driver
+        assert isinstance(task, Task), f"{node.name}: a cooperative match's nodes are driven by a coop.Task"
+        task.steps = task.playing(node)
+        tasks.append(task)
+    deadlocks = drive(bus, tasks, on_idle, quit_early)
+    return {t.name: t.summary for t in tasks if t.summary is not None}, deadlocks
 
 
 def drive(
@@ -184,11 +214,11 @@ def drive(
         stuck = [t for t in parked if t.waiting[0].sender not in live] or parked  # type: ignore[index]
         for t in stuck:
             ib, k = t.waiting  # type: ignore[misc]
-            ib._channel.waiter = None  # type: ignore[union-attr]
+            ib.channel.waiter = None  # type: ignore[union-attr]
             why = "its loop ended" if ib.sender not in live else f"nobody can send tick {k}"
             if ib.sender not in live and quit_early is not None:
                 quit_early.add(ib.sender)
-            ib._give_up(f"deadlock: {why} (cooperative driver)")
+            ib.give_up(f"deadlock: {why} (cooperative driver)")
             runnable.append(t)
 
 

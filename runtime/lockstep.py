@@ -1,5 +1,7 @@
 """Deterministic lockstep time (design.md section 3).
 
+The links are here; what runs a loop over them, the drivers, is runtime/drivers.py.
+
 Conservative synchronisation with lookahead:
 
 * Every link has a **schedule** (period and phase, in ticks): its sender emits
@@ -272,132 +274,6 @@ class Outbound(Generic[M]):
 Waits = Generator[tuple["Inbound[Any]", int], None, None]
 
 
-def pull(steps: Waits, before_wait: Callable[[], None] | None = None) -> None:
-    """Drive a lockstep loop from this thread, blocking in each link's `sync`;
-    `before_wait()` first where the link is not ready nor `paired` (`Outbound.flush`)."""
-    for ib, k in steps:
-        ib.waited = k
-        if before_wait is not None and not ib.paired and not ib.ready(k):
-            before_wait()
-        ib.sync(k)
-
-
-class Reactor:
-    """Drive a lockstep loop from the transport's receive callbacks.
-
-    The loop runs on the thread that delivers the frame it was waiting for,
-    so a frame in and the frames it causes out take no thread hand-over: on
-    the 2-core machine a hand-over (futex wake-up, context switch) costs
-    about as much CPU as the message itself. The main thread only waits for
-    the end and bounds every wait: a link silent for `timeout` seconds of
-    wall time is given up (wall time detects failures only, never behaviour).
-    """
-
-    def __init__(
-        self,
-        timeout: float,
-        announce: Callable[[int | None], None] | None = None,
-        upstream_waited: Callable[[str, int], float | None] | None = None,
-    ):
-        self.timeout = timeout
-        # A wait longer than `announce_after` is announced (a liveliness token naming the tick this
-        # process is about to act at). A sender owes the frame we miss only since it was last seen
-        # announcing a wait of its own at a tick not past that frame (`upstream_waited`: the
-        # monotonic time, now while it still announces one): before, it was stalled upstream, not at
-        # fault. So only the process whose sender owes a frame gives up.
-        # Counting from the start of our own wait instead blamed a sender that had just moved on
-        # from one stalled wait to the next: its new wait is announced only `announce_after` later.
-        self._announce = announce
-        self._upstream_waited = upstream_waited
-        self.announce_after = min(1.0, timeout / 4)
-        self._announced: int | None = None
-        self.lock = threading.Lock()
-        self.done = threading.Event()
-        self._steps: Waits | None = None
-        self._waiting: tuple[Inbound[Any], int] | None = None
-        self._since = 0.0
-        self.error: BaseException | None = None
-        self.before_wait: Callable[[], None] | None = None  # called as the loop starts to wait on a link not `paired`
-
-    def on_frame(self, ib: Inbound[Any], raw: bytes) -> None:
-        with self.lock:
-            ib.feed(raw)
-            if self._steps is not None:
-                self._advance()
-
-    def poke(self) -> None:
-        """Look again at what the loop waits for: something other than a frame (a pacer's
-        clock or a viewer's control, runtime/pace.py) may have made it ready."""
-        with self.lock:
-            if self._steps is not None:
-                self._advance()
-
-    def _advance(self) -> None:
-        try:
-            while True:
-                if self._waiting is not None:
-                    ib, k = self._waiting
-                    if not ib.ready(k):
-                        # As in `Inbound.sync`: a wake-up while we wait for a gone sender.
-                        if ib.woken and ib._is_dead(ib.sender):
-                            ib._give_up("its liveliness token vanished")
-                            continue
-                        ib.woken = False
-                        if self.before_wait is not None and not ib.paired:
-                            self.before_wait()
-                        return
-                self._waiting = next(self._steps)  # type: ignore[arg-type]
-                self._waiting[0].waited = self._waiting[1]
-                self._since = time.monotonic()  # the start of this wait (failure detection only)
-        except StopIteration:
-            self._finish()
-        except BaseException as exc:  # raised again on the main thread by `run`
-            self.error = exc
-            self._finish()
-
-    def _finish(self) -> None:
-        self._steps = None
-        self._waiting = None
-        self.done.set()
-
-    def run(self, steps: Waits) -> None:
-        """Start the loop here, then wait for it to end on the callbacks' thread."""
-        with self.lock:
-            self._steps = steps
-            self._advance()
-        while not self.done.wait(0.1):
-            with self.lock:
-                waited = time.monotonic() - self._since
-                want = self._waiting[1] if self._waiting is not None and waited >= self.announce_after else None
-            self._set_announced(want)
-            with self.lock:
-                if self._waiting is None:
-                    continue
-                ib, k = self._waiting
-                now = time.monotonic()
-                if now - self._since < self.timeout:
-                    continue
-                missing = ib.schedule.first_after(ib.last_seen)
-                waited = None if self._upstream_waited is None else self._upstream_waited(ib.sender, missing)
-                if waited is not None and now - waited < self.timeout:
-                    # Its sender waits for its own upstream, or did until lately: it owes the frame
-                    # only since then. Asked again at the next look; our own wait stays announced
-                    # (resetting `_since` here took our token back for `announce_after`).
-                    continue
-                ib._give_up(f"silent for {self.timeout:g} s waiting for tick {k}")
-                self._advance()
-        self._set_announced(None)
-        if self.error is not None:
-            raise self.error
-
-    def _set_announced(self, tick: int | None) -> None:
-        """Announce the wait before acting at `tick` (None: no wait worth announcing). Main thread only."""
-        if self._announce is None or tick == self._announced:
-            return
-        self._announce(tick)
-        self._announced = tick
-
-
 class Inbound(Generic[M]):
     """One inbound link, in lockstep: schedule, lag, link emulation, validation."""
 
@@ -406,7 +282,7 @@ class Inbound(Generic[M]):
         *,
         key: str,
         msg_type: type[M],
-        channel: Channel | None,
+        channel: Channel | None,  # None: the driver connects it (runtime/drivers.py `Driver.connect`)
         schedule: Schedule,
         lag: int,
         link_class: str,
@@ -414,7 +290,7 @@ class Inbound(Generic[M]):
         emulator: LinkEmulator,
         dt: float,
         rejections: Rejections,
-        watchdog: Watchdog,
+        watchdog: Watchdog | None,  # bounds `sync` and `recv_clock`; None where nothing blocks in them
         is_dead: Callable[[str], bool],
         on_dead: Callable[[str, str], None],
         check: Callable[[M], str | None] | None = None,
@@ -422,7 +298,7 @@ class Inbound(Generic[M]):
         self.key = key
         self.msg_type = msg_type
         self._decode = msgspec.msgpack.Decoder(msg_type).decode
-        self._channel = channel
+        self.channel = channel
         self.schedule = schedule
         # Every tick, from tick 0 (sense, cmd): the next frame is last_seen + 1 and
         # the last one due by k is k itself; saves two method calls per frame.
@@ -448,7 +324,7 @@ class Inbound(Generic[M]):
         self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
         self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
-        self.waited = -1  # the last k its lockstep loop yielded it with (set by the driver: pull, Reactor, coop)
+        self.waited = -1  # the last k its lockstep loop yielded it with (set by the drivers' `advance`)
 
     # ------------------------------------------------------------------ intake
     def _accept(self, raw: bytes, now_tick: int | None) -> bool:
@@ -561,11 +437,22 @@ class Inbound(Generic[M]):
                 self._stand_in = False
                 return
 
+    # ------------------------------------------------- what drivers ask of a link
     def ready(self, k: int) -> bool:
         """Every frame sent at or before k - lag is in (or the sender is dead)."""
         if self._every_tick:  # last_at_or_before(j) is j (or -1 below 0, which last_seen >= -1 meets either way)
             return self.dead or self.last_seen >= k - self.lag
         return self.dead or self.last_seen >= self.schedule.last_at_or_before(k - self.lag)
+
+    def drain(self) -> None:
+        """Lockstep, never blocking: take in whatever has arrived on the channel (the cooperative driver)."""
+        ch = self.channel
+        while (raw := ch.try_recv()) is not None:  # type: ignore[union-attr]
+            self._accept(raw, None)
+
+    def sender_gone(self) -> bool:
+        """Its sender's liveliness token has vanished."""
+        return self._is_dead(self.sender)
 
     def feed(self, raw: bytes) -> None:
         """Reactive lockstep: one frame from the transport's callback (see `Reactor`)."""
@@ -579,7 +466,7 @@ class Inbound(Generic[M]):
         target = self.schedule.last_at_or_before(k - self.lag)
         if self.last_seen >= target or self.dead:
             return
-        ch = self._channel
+        ch = self.channel
         wd = self._watchdog
         while self.last_seen < target:
             raw = ch.try_recv()
@@ -591,11 +478,11 @@ class Inbound(Generic[M]):
                 wd.disarm()
             if raw == WAKE:
                 # A wake-up means a dead peer or a timeout; a stale one is ignored.
-                if self._is_dead(self.sender):
-                    self._give_up("its liveliness token vanished")
+                if self.sender_gone():
+                    self.give_up("its liveliness token vanished")
                     return
                 if expired:
-                    self._give_up(f"silent for {wd.timeout:g} s waiting for tick {target}")
+                    self.give_up(f"silent for {wd.timeout:g} s waiting for tick {target}")
                     return
                 continue
             self._accept(raw, None)
@@ -603,14 +490,14 @@ class Inbound(Generic[M]):
     def poll(self, now_tick: int) -> None:
         """Real-time mode: take whatever has arrived, never block."""
         while True:
-            raw = self._channel.try_recv()
+            raw = self.channel.try_recv()
             if raw is None:
                 return
             self._accept(raw, now_tick)
 
     def recv_clock(self) -> int | None:
         """Real-time mode, clock link: block for the next frame; returns its tick."""
-        ch = self._channel
+        ch = self.channel
         wd = self._watchdog
         while True:
             wd.arm(self.key)
@@ -618,15 +505,16 @@ class Inbound(Generic[M]):
             expired = wd.expired()
             wd.disarm()
             if raw == WAKE:
-                if expired or self._is_dead(self.sender):
-                    self._give_up("silent in real-time mode")
+                if expired or self.sender_gone():
+                    self.give_up("silent in real-time mode")
                     return None
                 continue
             before = self.last_seen
             if self._accept(raw, None) and self.last_seen > before:
                 return self.last_seen
 
-    def _give_up(self, why: str) -> None:
+    def give_up(self, why: str) -> None:
+        """Stop waiting for this link (its sender is dead); `why` is recorded with the sender."""
         self.dead = True
         self._on_dead(self.sender, f"{self.key}: {why}")
 

@@ -1,12 +1,20 @@
 """What every process of a match shares: identity, wiring, barrier, summary.
 
-A process kind subclasses `Node`, declares its links in `__init__` with
-`out(...)` and `inp(...)`, and implements `loop()`. `run()` then does the rest:
+Two shapes of process:
+
+* a `Node` takes part in the lockstep: it declares its links in `__init__`
+  with `out(...)` and `inp(...)`, and implements `lockstep()` (and
+  `loop_realtime()`); a `Driver` (runtime/drivers.py) runs that loop;
+* an `Observer` (the recorder, the viewer) is in nobody's lockstep and has
+  none of its own: it implements `observe()`.
+
+`play()` then does the rest, the same for both and under every driver:
 
 1. declares the liveliness token `arena/<m>/alive/<process>` *after* every
    subscription, so a peer that sees the token can already reach it;
-2. waits (bounded) until every process of the match has its token;
-3. runs `loop()`;
+2. waits (bounded) until every process of the match has its token (not under
+   the cooperative driver, where every node is there by construction);
+3. runs the loop (`loop()`);
 4. publishes its `Summary` (digest, counters, link statistics).
 """
 
@@ -17,22 +25,22 @@ import gc
 import hashlib
 import logging
 import os
-import resource
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from typing import Any, TypeVar
 
 from arena.runtime import seeds
 from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.drivers import Driver, Pull, Reactor, Wait, own_cpu_s
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
-from arena.runtime.lockstep import Inbound, Latest, Outbound, Reactor, Rejections, Schedule, Waits, Watchdog, pull
+from arena.runtime.lockstep import Inbound, Latest, Outbound, Rejections, Schedule, Waits
 from arena.runtime.mac import Keyring
 from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
-from arena.schemas.keys import KEY_BY_NAME, SERVED, SIGNED_DATA, WAITING, Keys
+from arena.schemas.keys import KEY_BY_NAME, SERVED, SIGNED_DATA, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 
@@ -50,7 +58,14 @@ class StartupError(RuntimeError):
     """The match could not start: a process never came up."""
 
 
-class Node:
+class Peer:
+    """One process of a match: identity, keys, the start barrier, liveliness, the summary.
+
+    A subclass is a `Node` (in the lockstep) or an `Observer` (outside it).
+    """
+
+    cooperative = False  # True: played by a cooperative scheduler (runtime/drivers.py `Driver`)
+
     def __init__(self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys):
         self.pid = pid
         self.name = str(pid)
@@ -61,30 +76,9 @@ class Node:
         # This process's MAC key and the keys of the senders it verifies (runtime/mac.py);
         # the transport carries them because they come with the session's credentials.
         self.keyring: Keyring = getattr(transport, "keyring", None) or Keyring(self.name)
-        self.links = resolve(cfg.link, cfg.link_overrides)
         self.digest = hashlib.blake2b(digest_size=16)
         self.rejections = Rejections(self.log)
-        # Lockstep over zenoh runs the loop in the receive callbacks (`Reactor`);
-        # real time, and the memory transport of in-process runs, pull instead.
-        self.reactive = not cfg.realtime and getattr(transport, "callbacks", False)
-        # Waits announced by liveliness tokens (`Reactor`): a zenoh transport has them.
-        self._announces = hasattr(transport, "declare_token")
-        self._waits: dict[str, set[int]] = {}  # peer -> the ticks it announces waiting before
-        self._waited: dict[str, dict[int, float]] = {}  # peer -> tick -> when it took that announcement back
-        self._wait_token: Callable[[], None] | None = None
         self.silent: dict[str, int] = {}  # peers given up on while alive and not waiting themselves
-        self.reactor = (
-            Reactor(
-                cfg.timing.wait_timeout,
-                self._announce_wait if self._announces else None,
-                self._upstream_waited if self._announces else None,
-            )
-            if self.reactive
-            else None
-        )
-        # A cooperative driver (runtime/coop.py) bounds the waits itself: no thread.
-        cooperative = getattr(transport, "cooperative", False)
-        self.watchdog = Watchdog(transport, cfg.timing.wait_timeout, thread=not (self.reactive or cooperative))
         self.outbound: list[Outbound[Any]] = []
         self.inbound: list[Inbound[Any]] = []
         self.gone: set[str] = set()  # peers whose liveliness token vanished
@@ -100,84 +94,8 @@ class Node:
         # Called with the peers still missing, once a wait at the start barrier
         # passes 1 s and whenever that list changes (`arena run` by hand prints it).
         self.on_waiting: Callable[[list[str]], None] | None = None
-        # A recorded match: everything this process sends also goes to its tap
-        # (runtime/tap.py), which the recorder collects.
-        self.tap: Tap | None = None
+        self.tap: Tap | None = None  # a `Node`'s, in a recorded match
         self._tap_handoff: Handoff | None = None
-        if cfg.tap and pid.kind not in ("recorder", "viewer"):  # they send no data
-            put = transport.publisher(keys.tap(self.name), sign=self.keyring.signer(keys.tap(self.name)))
-            self._tap_handoff = Handoff(put) if self.reactive else None
-            self.tap = Tap(self.name, self._tap_handoff or put)
-
-    # ----------------------------------------------------------------- wiring
-    def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
-        """An outbound key. `viewers_only`: nobody in the lockstep waits for it, so it
-        is not put on the wire while nobody listens (it still counts in the digest).
-        A key of `SERVED` (schemas/keys.py) is also served: a query gets its last frame."""
-        key = self.keys.key(name, team, n)
-        sign = self.keyring.signer(key) if self.keys.rel(key) in SIGNED_DATA else None
-        put = self.transport.publisher(key, when_matched=viewers_only, sign=sign)
-        if self.tap is None:
-            ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
-        else:
-            ob = TappedOutbound(key, self.keys.rel(key), put, self.digest, self.tap)
-        if name in SERVED:
-            latest = Latest()
-            ob.put_through(latest.wrap)
-            self.transport.serve(key, latest.get)
-        self.outbound.append(ob)
-        return ob
-
-    def inp(
-        self,
-        name: str,
-        team: str = "",
-        n: int | None = None,
-        *,
-        check: Callable[[M], str | None] | None = None,
-        ideal: bool = False,
-        lag: int | None = None,
-    ) -> Inbound[Any]:
-        """An inbound key, with the schedule, lag and sender of its `KeySpec` (schemas/keys.py)
-        and the periods of this match's configuration.
-
-        `ideal`: no link emulation (a listener outside the modelled links), which may
-        also take the frames with a shorter `lag` than the key's.
-        """
-        spec = KEY_BY_NAME[name]
-        schedule = self.schedule(name)
-        lag = spec.timing.lag if lag is None else lag
-        sender = spec.sender_id(team, n)
-        key = self.keys.key(name, team, n)
-        model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
-        emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
-        verify = self.keyring.verifier(sender, key) if self.keys.rel(key) in SIGNED_DATA else None
-        on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {sender}")
-        ib: Inbound[Any] = Inbound(
-            key=key,
-            msg_type=spec.message,
-            channel=None if self.reactor else self.transport.subscribe(key, verify=verify, on_forged=on_forged),
-            schedule=schedule,
-            lag=lag,
-            link_class=spec.link_class,
-            sender=sender,
-            emulator=emulator,
-            dt=self.cfg.timing.dt,
-            rejections=self.rejections,
-            watchdog=self.watchdog,
-            is_dead=self._is_gone,
-            on_dead=self._record_dead,
-            check=check,
-        )
-        ib.strict = not self.cfg.realtime
-        if self.reactor is not None:
-            self.transport.subscribe_callback(key, functools.partial(self.reactor.on_frame, ib), verify, on_forged)
-        self.inbound.append(ib)
-        return ib
-
-    def schedule(self, name: str) -> Schedule:
-        """The schedule of key `name` in this match: its `Timing` with the configured periods."""
-        return Schedule(*KEY_BY_NAME[name].timing.schedule(self.cfg.timing.periods()))
 
     def rng(self, *path: object):
         """This process's own RNG for `path` (one per component)."""
@@ -195,36 +113,6 @@ class Node:
             if " silent for " in why:
                 self.silent[peer] = self.last_tick
             self.on_peer_dead(peer)
-
-    def _on_waiting(self, key: str, alive: bool) -> None:
-        peer, _, text = key.split(f"/{WAITING}/", 1)[-1].rpartition("/")
-        if not text.isdigit():
-            return  # not a token this runtime declares: ignored
-        tick = int(text)
-        with self._alive_cond:
-            ticks = self._waits.setdefault(peer, set())
-            if alive:
-                ticks.add(tick)
-            else:
-                ticks.discard(tick)
-                # Wall time for failure detection only: from here on it may owe its frames.
-                self._waited.setdefault(peer, {})[tick] = time.monotonic()
-
-    def _upstream_waited(self, peer: str, missing: int) -> float | None:
-        """When `peer` was last seen blocked itself, before acting at a tick not past `missing`
-        (it owed us nothing then): now while it still announces such a wait, the monotonic time
-        it took the last one back otherwise, None if it never announced one."""
-        with self._alive_cond:
-            if any(s <= missing for s in self._waits.get(peer, ())):
-                return time.monotonic()
-            return max((t for s, t in self._waited.get(peer, {}).items() if s <= missing), default=None)
-
-    def _announce_wait(self, tick: int | None) -> None:
-        if self._wait_token is not None:
-            self._wait_token()
-            self._wait_token = None
-        if tick is not None:
-            self._wait_token = self.transport.declare_token(self.keys.waiting(self.name, tick))  # type: ignore[attr-defined]
 
     def on_peer_dead(self, peer: str) -> None:
         """Hook: a peer we were waiting for is dead (its inputs no longer come)."""
@@ -253,8 +141,6 @@ class Node:
     def barrier(self) -> None:
         self.transport.watch_alive(self.keys.collector(), self._on_collector)
         self.transport.watch_alive(self.keys.alive_all(), self._on_alive)
-        if self._announces:
-            self.transport.watch_alive(self.keys.waiting_all(), self._on_waiting)
         self.transport.declare_alive(self.keys.alive(self.name))
         expected = set(self.expected_peers())
         start = time.monotonic()
@@ -283,55 +169,45 @@ class Node:
         if told is not None and self.on_waiting is not None:
             self.on_waiting([])
 
-    # -------------------------------------------------------------------- run
-    def loop(self) -> None:
-        """The whole match: the lockstep loop, or the real-time one with `--realtime`."""
-        if self.cfg.realtime:
-            self.loop_realtime()
-        else:
-            self.drive(self.lockstep())
-
-    def lockstep(self) -> Waits:
-        """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""
+    # ------------------------------------------------------------------- play
+    def loop(self) -> Waits:
+        """The match itself, between the barrier and the summary (a `Node`'s lockstep, an `Observer`'s watch)."""
         raise NotImplementedError
 
-    def loop_realtime(self) -> None:
-        raise NotImplementedError
-
-    def batch_flusher(self) -> Callable[[], None] | None:
-        """What a driver calls before this node waits on a link not `paired`: put its
-        held-back batches (`Outbound.batch`); None if it batches nothing."""
-        batched = tuple(o for o in self.outbound if o.batching)
-        if not batched:
-            return None
-
-        def flush() -> None:
-            for o in batched:
-                o.flush()
-
-        return flush
-
-    def drive(self, steps: Waits) -> None:
-        if self.reactor is not None:
-            self.reactor.before_wait = self.batch_flusher()
-            self.reactor.run(steps)
-        else:
-            pull(steps, self.batch_flusher())
-
-    def summary_extra(self) -> dict[str, object]:
-        return {}
-
-    def run(self) -> msgs.Summary:
+    def playing(self) -> Generator[Wait, None, msgs.Summary]:
+        """`play`, as a generator: it yields the waits of a cooperative driver's loop (runtime/coop.py
+        `play`); under a blocking driver it yields nothing. Returns the Summary."""
         try:
-            self.barrier()
+            if not self.cooperative:
+                self.barrier()
             settle_heap()
             self.play_started = time.time()
             t0 = time.perf_counter()
-            self.loop()
+            yield from self.loop()
             self._wall_s = time.perf_counter() - t0
         finally:
-            self.watchdog.stop()
+            self.close()
         return self.conclude()
+
+    def play(self) -> msgs.Summary:
+        """This process's whole match: the start barrier, the loop, the summary (published and returned)."""
+        steps = self.playing()
+        try:
+            next(steps)
+        except StopIteration as end:
+            return end.value
+        steps.close()
+        raise RuntimeError(f"{self.name}: a cooperative driver's node is played by its scheduler (runtime/coop.py)")
+
+    def close(self) -> None:
+        """After the loop, whatever happened in it: stop what the loop needed (threads, servers)."""
+
+    def cpu_s(self) -> list[float]:
+        """[user, system] CPU seconds this process took (the summary's `cpu_s`)."""
+        return own_cpu_s()
+
+    def summary_extra(self) -> dict[str, object]:
+        return {}
 
     def conclude(self) -> msgs.Summary:
         """After the loop: the tap's final batch, then the Summary, published and returned."""
@@ -399,7 +275,7 @@ class Node:
             dead=sorted(self.dead),
             tick_us=tick_us,
             wall_s=self._wall_s,
-            cpu_s=list(resource.getrusage(resource.RUSAGE_SELF)[:2]),
+            cpu_s=self.cpu_s(),
             extra={
                 **self.summary_extra(),
                 "play_started": self.play_started,
@@ -409,3 +285,142 @@ class Node:
             conflicts={self.keys.rel(k): n for k, n in sorted(self.rejections.conflicts.items())},
             dead_at=dict(sorted(self.dead_at.items())),
         )
+
+
+class Node(Peer):
+    """A process in the lockstep: its links, its lockstep loop, and the `Driver` that runs it.
+
+    `driver`: `Pull` (blocking on this thread) unless given; a zenoh match in lockstep
+    gives a `Reactor` (tools/launch/run.py), a cooperative match a `coop.Task`.
+    """
+
+    def __init__(
+        self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys, driver: Driver | None = None
+    ):
+        super().__init__(pid, cfg, transport, keys)
+        self.driver: Driver = driver if driver is not None else Pull(transport, cfg.timing.wait_timeout)
+        self.cooperative = self.driver.cooperative
+        self.links = resolve(cfg.link, cfg.link_overrides)
+        # A recorded match: everything this process sends also goes to its tap
+        # (runtime/tap.py), which the recorder collects. A `Reactor` runs the loop on
+        # the transport's receive thread, where a large put must not block: a `Handoff`.
+        if cfg.tap:
+            put = transport.publisher(keys.tap(self.name), sign=self.keyring.signer(keys.tap(self.name)))
+            self._tap_handoff = Handoff(put) if isinstance(self.driver, Reactor) else None
+            self.tap = Tap(self.name, self._tap_handoff or put)
+
+    # ----------------------------------------------------------------- wiring
+    def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
+        """An outbound key. `viewers_only`: nobody in the lockstep waits for it, so it
+        is not put on the wire while nobody listens (it still counts in the digest).
+        A key of `SERVED` (schemas/keys.py) is also served: a query gets its last frame."""
+        key = self.keys.key(name, team, n)
+        sign = self.keyring.signer(key) if self.keys.rel(key) in SIGNED_DATA else None
+        put = self.transport.publisher(key, when_matched=viewers_only, sign=sign)
+        if self.tap is None:
+            ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
+        else:
+            ob = TappedOutbound(key, self.keys.rel(key), put, self.digest, self.tap)
+        if name in SERVED:
+            latest = Latest()
+            ob.put_through(latest.wrap)
+            self.transport.serve(key, latest.get)
+        self.outbound.append(ob)
+        return ob
+
+    def inp(
+        self,
+        name: str,
+        team: str = "",
+        n: int | None = None,
+        *,
+        check: Callable[[M], str | None] | None = None,
+        ideal: bool = False,
+        lag: int | None = None,
+    ) -> Inbound[Any]:
+        """An inbound key, with the schedule, lag and sender of its `KeySpec` (schemas/keys.py)
+        and the periods of this match's configuration.
+
+        `ideal`: no link emulation (a listener outside the modelled links), which may
+        also take the frames with a shorter `lag` than the key's.
+        """
+        spec = KEY_BY_NAME[name]
+        schedule = self.schedule(name)
+        lag = spec.timing.lag if lag is None else lag
+        sender = spec.sender_id(team, n)
+        key = self.keys.key(name, team, n)
+        model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
+        emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
+        verify = self.keyring.verifier(sender, key) if self.keys.rel(key) in SIGNED_DATA else None
+        on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {sender}")
+        ib: Inbound[Any] = Inbound(
+            key=key,
+            msg_type=spec.message,
+            channel=None,
+            schedule=schedule,
+            lag=lag,
+            link_class=spec.link_class,
+            sender=sender,
+            emulator=emulator,
+            dt=self.cfg.timing.dt,
+            rejections=self.rejections,
+            watchdog=self.driver.watchdog,
+            is_dead=self._is_gone,
+            on_dead=self._record_dead,
+            check=check,
+        )
+        ib.strict = not self.cfg.realtime
+        self.driver.connect(ib, self.transport, verify, on_forged)
+        self.inbound.append(ib)
+        return ib
+
+    def schedule(self, name: str) -> Schedule:
+        """The schedule of key `name` in this match: its `Timing` with the configured periods."""
+        return Schedule(*KEY_BY_NAME[name].timing.schedule(self.cfg.timing.periods()))
+
+    # ------------------------------------------------------------------- loop
+    def loop(self) -> Waits:
+        """The whole match: the lockstep loop under the driver, or the real-time one with `--realtime`."""
+        if self.cfg.realtime and not self.cooperative:
+            self.loop_realtime()
+            return
+        yield from self.driver.drive(self.lockstep(), self.batch_flusher())
+
+    def lockstep(self) -> Waits:
+        """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""
+        raise NotImplementedError
+
+    def loop_realtime(self) -> None:
+        raise NotImplementedError
+
+    def batch_flusher(self) -> Callable[[], None] | None:
+        """What a driver calls before this node waits on a link not `paired`: put its
+        held-back batches (`Outbound.batch`); None if it batches nothing."""
+        batched = tuple(o for o in self.outbound if o.batching)
+        if not batched:
+            return None
+
+        def flush() -> None:
+            for o in batched:
+                o.flush()
+
+        return flush
+
+    def close(self) -> None:
+        self.driver.close()
+
+    def cpu_s(self) -> list[float]:
+        return self.driver.cpu_s()
+
+
+class Observer(Peer):
+    """A process that watches a match from outside its lockstep (the recorder, the viewer):
+    nobody waits for it, and it waits for nobody's frames in lockstep."""
+
+    def loop(self) -> Waits:
+        self.observe()
+        yield from ()
+
+    def observe(self) -> None:
+        """Watch the match until it is over (or this process is stopped)."""
+        raise NotImplementedError

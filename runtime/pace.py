@@ -12,7 +12,7 @@ k is the same whenever it runs, so pacing and pausing never change a digest.
 The wall clock is read for waiting only, never for behaviour.
 
 The viewer sends `Control` frames on `arena/<m>/control`; the engine hands
-them to `control`. In reactive lockstep (runtime/lockstep.py, `Reactor`) the
+them to `control`. In reactive lockstep (runtime/drivers.py, `Reactor`) the
 loop runs in zenoh's callbacks, so nothing may sleep there: a small thread of
 the pacer calls `poke` (the Reactor's) when a tick's time has come, and a
 control frame pokes it too. In pull mode `sync` blocks on the main thread.
@@ -79,7 +79,8 @@ class WireGate:
 
 
 class Pacer:
-    """Duck-types a lockstep `Inbound` (`ready`, `sync`, `woken`, `paired`, `sender`, `_give_up`)."""
+    """Duck-types a lockstep `Inbound` for the drivers (`ready`, `sync`, `drain`, `woken`, `paired`,
+    `sender`, `sender_gone`, `give_up`; runtime/drivers.py)."""
 
     sender = "viewer"
     key = "control"
@@ -147,10 +148,13 @@ class Pacer:
                 if left > 0:
                     self._cond.wait(left)
 
-    def _is_dead(self, peer: str) -> bool:
+    def drain(self) -> None:
+        """Nothing to take in: control frames come through `pull_from` or `control`."""
+
+    def sender_gone(self) -> bool:
         return False
 
-    def _give_up(self, why: str) -> None:
+    def give_up(self, why: str) -> None:
         """The Reactor's bound on one wait: a pause longer than wait_timeout resumes the match."""
         self.log.warning("paused for too long (%s): playing on", why)
         with self._cond:

@@ -71,7 +71,7 @@ class Tap:
 class Handoff:
     """A put that happens on a thread of its own, in order.
 
-    A reactive node (runtime/lockstep.py, `Reactor`) runs on zenoh's only
+    A reactive node (runtime/drivers.py, `Reactor`) runs on zenoh's only
     network thread. A tap batch is large (up to ~100 kB for the engine): a
     blocking put that needs more room than the transmit queue has would wait
     for the transmit task, which runs on that same thread. So batches leave

@@ -157,7 +157,6 @@ class ZenohTransport:
     """
 
     FIFO = 1 << 14  # frames buffered per subscription
-    callbacks = True  # subscribe_callback works (Node.reactive)
 
     def __init__(self, session: zenoh.Session, keyring: object = None):
         self.session = session
@@ -390,8 +389,6 @@ class MemoryBus:
 
 
 class MemoryTransport:
-    callbacks = False
-
     def __init__(self, bus: MemoryBus):
         self.bus = bus
         self._tokens: list[str] = []
@@ -410,7 +407,7 @@ class MemoryTransport:
 
     def subscribe_callback(self, key: str, callback: Callable[[bytes], None], verify=None, on_forged=None) -> None:
         # A callback would run in the sender's thread, inside the sender's own
-        # tick: nodes on a memory bus pull from channels instead (Node.reactive).
+        # tick: nodes on a memory bus pull from channels instead (runtime/drivers.py `Pull`).
         raise NotImplementedError("MemoryTransport delivers to channels only")
 
     def wake(self, key: str) -> None:

@@ -84,7 +84,7 @@ def test_exact_blame_of_a_robot_that_sends_cmd_but_no_report(reap, tmp_path, sec
     station gave up, the engine, stalled on robot a/0's cmd, got it and moved on to robot a/1's, still
     stalled; it took back its announced wait and announced the new one only a second later, and the
     b robots, whose own timeouts came within that second, found it not waiting. A sender now owes a
-    frame only a full timeout after it was last seen waiting (runtime/lockstep.py `Reactor`).
+    frame only a full timeout after it was last seen waiting (runtime/drivers.py `Reactor`).
     """
     result = play_with_a_silent_robot(reap, tmp_path, secure)
     assert result["dead"] == ["robot/a/1"], result["faults"]

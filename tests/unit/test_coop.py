@@ -48,3 +48,41 @@ def test_a_node_that_raises_ends_the_match_with_its_name(monkeypatch):
     monkeypatch.setattr(inprocess, "node_class", lambda kind: Broken if kind == "robot" else node_class(kind))
     with pytest.raises(inprocess.InprocessError, match="robot/a/0 failed: ZeroDivisionError"):
         inprocess.play_match(MatchConfig(seed=4, half_time=1.0))
+
+
+def test_observers_are_not_nodes_and_a_node_takes_its_driver():
+    """The recorder and viewer are `Observer`s (no lockstep, no driver); a `Node` is driven by what it is given."""
+    import gc
+
+    from arena.processes import OBSERVERS
+    from arena.runtime.config import ProcessId
+    from arena.runtime.coop import CoopBus, Task
+    from arena.runtime.drivers import Pull, Reactor
+    from arena.runtime.node import Node, Observer
+    from arena.runtime.transport import MemoryBus, MemoryTransport
+    from arena.schemas.keys import Keys
+    from arena.tools.launch import run
+
+    for kind in OBSERVERS:
+        cls = node_class(kind)
+        assert issubclass(cls, Observer) and not issubclass(cls, Node) and not hasattr(cls, "lockstep")
+    cfg = MatchConfig(seed=4, half_time=1.0)
+    pid = ProcessId("robot", "a", 0)
+    pulled = RobotNode(pid, cfg, MemoryTransport(MemoryBus()), Keys("t"))
+    assert isinstance(pulled.driver, Pull) and pulled.inbound[0].channel is not None
+    pulled.close()
+    coop = RobotNode(pid, cfg, MemoryTransport(CoopBus()), Keys("t"), driver=Task(str(pid)))
+    with pytest.raises(RuntimeError, match="played by its scheduler"):
+        coop.play()  # its loop waits at once on a frame only a scheduler can bring
+    gc.unfreeze()
+
+    class Tokens(MemoryTransport):
+        def watch_alive(self, key_expr, on_change):
+            self.watched = key_expr
+
+    tr = Tokens(MemoryBus())
+    assert isinstance(run.driver(pid, cfg, tr, Keys("t"))["driver"], Reactor) and tr.watched == Keys("t").waiting_all()
+    realtime = run.driver(pid, cfg.replace(realtime=True), tr, Keys("t"))["driver"]
+    assert isinstance(realtime, Pull)
+    realtime.close()
+    assert run.driver(ProcessId("recorder"), cfg, tr, Keys("t")) == {}

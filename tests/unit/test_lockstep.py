@@ -200,7 +200,7 @@ def _two_harnesses(**kw):
 
 def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
     """Same frames, any arrival order between links: the same steps, whoever drives."""
-    from arena.runtime.lockstep import Reactor, pull
+    from arena.runtime.drivers import Reactor, pull
 
     pulled: list = []
     a, b = _two_harnesses()
@@ -227,8 +227,67 @@ def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
         harness.close()
 
 
+def test_every_driver_runs_a_loop_through_the_one_advance_and_flushes_before_a_wait_not_paired():
+    """`Pull`, `Reactor` and the cooperative `Task` take the same steps; each calls `before_wait`
+    only where the loop is about to wait on a link that is not ready and not `paired`."""
+    from arena.runtime import coop
+    from arena.runtime.drivers import Pull, Reactor
+
+    def fed(a, b):
+        for raw in _frames(range(7)):
+            a.put(raw)
+        for raw in _frames(range(0, 7, 2)):
+            b.put(raw)
+
+    runs = {}
+    for name in ("pull", "reactor", "coop"):
+        log: list = []
+        flushed: list = []
+        a, b = _two_harnesses()
+        b.inbound.paired = True  # never flushed for
+        steps = _two_link_loop(a.inbound, b.inbound, log)
+        flush = lambda log=log, flushed=flushed: flushed.append(len(log))
+        if name == "pull":
+            fed(a, b)
+            driver = Pull(a.rx, 5.0)
+            assert list(driver.drive(steps, flush)) == [], "a blocking driver yields nothing"
+            driver.close()
+        elif name == "reactor":
+            reactor = Reactor(timeout=5.0)
+            runner = threading.Thread(target=lambda r=reactor, s=steps, f=flush: list(r.drive(s, f)))
+            runner.start()
+            for t in range(7):
+                reactor.on_frame(a.inbound, _frames([t])[0])
+                if t % 2 == 0:
+                    reactor.on_frame(b.inbound, _frames([t])[0])
+            runner.join(5.0)
+            assert not runner.is_alive() and reactor.error is None
+        else:
+            bus = coop.CoopBus()
+            a.inbound.channel = bus.subscribe(None, "arena/t/a")
+            b.inbound.channel = bus.subscribe(None, "arena/t/b")
+            task = coop.Task("n")
+            task.steps = task.drive(steps, flush)
+            coop._advance(task)
+            assert task.waiting == (a.inbound, 1) and flushed == [1], "parked at the first missing frame, flushed"
+            for t in range(7):
+                bus.deliver("arena/t/a", _frames([t])[0])
+                if t % 2 == 0:
+                    bus.deliver("arena/t/b", _frames([t])[0])
+            assert coop.drive(bus, [task]) == [] and task.done
+        runs[name] = (log, flushed)
+        for harness in (a, b):
+            harness.close()
+    assert runs["pull"][0] == runs["reactor"][0] == runs["coop"][0] and len(runs["pull"][0]) == 7
+    # Pulling, each frame is taken in by the `sync` after the flush: one flush per wait on `a`,
+    # none for `b` (paired). The others flush only where the frame was not there yet.
+    assert runs["pull"][1] == [1, 2, 3, 4, 5, 6]
+    assert runs["coop"][1] == [1], "the coop driver takes in what arrived before it parks"
+    assert set(runs["reactor"][1]) <= set(runs["pull"][1])
+
+
 def test_the_reactor_stops_at_the_first_missing_frame_and_goes_on_when_it_comes():
-    from arena.runtime.lockstep import Reactor
+    from arena.runtime.drivers import Reactor
 
     log: list = []
     a, b = _two_harnesses()
@@ -249,7 +308,7 @@ def test_the_reactor_stops_at_the_first_missing_frame_and_goes_on_when_it_comes(
 
 
 def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
-    from arena.runtime.lockstep import Reactor
+    from arena.runtime.drivers import Reactor
 
     a, b = _two_harnesses()
     log: list = []
@@ -285,7 +344,7 @@ def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
 def test_the_reactor_announces_a_long_wait_and_waits_on_while_its_sender_waits_upstream():
     """Issue 20: only the receiver of the frame that is owed gives up; a sender that waits for its own
     upstream at a tick not past the missing frame owes nothing yet."""
-    from arena.runtime.lockstep import Reactor
+    from arena.runtime.drivers import Reactor
 
     h = Harness()
     announced: list = []
@@ -321,7 +380,7 @@ def test_a_sender_owes_a_frame_only_since_it_stopped_waiting_upstream():
     `announce_after` later. A receiver whose own timeout fell in that gap gave up on it. Its silence
     is counted from when it took its last announcement back, and the receiver's own wait stays
     announced meanwhile (it used to take its token back for `announce_after` whenever it waited on)."""
-    from arena.runtime.lockstep import Reactor
+    from arena.runtime.drivers import Reactor
 
     h = Harness()
     timeout = 0.8  # announce_after 0.2: a token taken back would show at the next look, 0.1 s later
@@ -362,31 +421,35 @@ def test_a_sender_owes_a_frame_only_since_it_stopped_waiting_upstream():
 
 
 def test_a_node_remembers_when_a_peer_stopped_waiting_before_each_tick():
-    """`Node._upstream_waited`, fed by the peers' `waiting/<process>/<tick>` tokens."""
-    from arena.runtime.node import Node
+    """`WaitBoard.upstream_waited`, fed by the peers' `waiting/<process>/<tick>` tokens."""
+    from arena.runtime.drivers import WaitBoard
+    from arena.schemas.keys import Keys
 
-    node = Node.__new__(Node)  # only the waiting-token bookkeeping
-    node._alive_cond = threading.Condition()
-    node._waits, node._waited = {}, {}
+    class Tokens(MemoryTransport):
+        def watch_alive(self, key_expr, on_change):
+            self.watched = key_expr
+
+    board = WaitBoard(Tokens(MemoryBus()), Keys("m"), "robot/a/0")
+    assert board._transport.watched == Keys("m").waiting_all()
     key = "arena/m/waiting/{}/{}".format
-    assert node._upstream_waited("engine", 4) is None, "never announced a wait"
-    node._on_waiting(key("engine", 3), True)
+    assert board.upstream_waited("engine", 4) is None, "never announced a wait"
+    board.on_waiting(key("engine", 3), True)
     before = time.monotonic()
-    assert node._upstream_waited("engine", 4) >= before, "waits now"
-    assert node._upstream_waited("engine", 2) is None, "before acting at 3, it owes frame 2"
-    node._on_waiting(key("engine", 3), False)
-    gone = node._upstream_waited("engine", 4)
+    assert board.upstream_waited("engine", 4) >= before, "waits now"
+    assert board.upstream_waited("engine", 2) is None, "before acting at 3, it owes frame 2"
+    board.on_waiting(key("engine", 3), False)
+    gone = board.upstream_waited("engine", 4)
     assert before <= gone <= time.monotonic(), "until the moment it took its token back"
     time.sleep(0.01)
-    assert node._upstream_waited("engine", 4) == gone
-    node._on_waiting(key("engine", 7), True)
-    assert node._upstream_waited("engine", 4) == gone, "a wait past the missing frame is no excuse"
-    node._on_waiting(key("robot/a/1", 2), True)
-    assert node._upstream_waited("robot/a/1", 2) is not None and node._upstream_waited("engine", 3) == gone
+    assert board.upstream_waited("engine", 4) == gone
+    board.on_waiting(key("engine", 7), True)
+    assert board.upstream_waited("engine", 4) == gone, "a wait past the missing frame is no excuse"
+    board.on_waiting(key("robot/a/1", 2), True)
+    assert board.upstream_waited("robot/a/1", 2) is not None and board.upstream_waited("engine", 3) == gone
 
 
 def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
-    from arena.runtime.lockstep import Reactor
+    from arena.runtime.drivers import Reactor
 
     h = Harness()
 

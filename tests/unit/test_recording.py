@@ -79,7 +79,7 @@ def test_outbound_taps_only_when_the_match_records(recording):
     node = RobotNode(ProcessId("robot", "a", 1), cfg, MemoryTransport(MemoryBus()), Keys("t"))
     assert {type(ob) for ob in node.outbound} == ({TappedOutbound} if recording else {Outbound})
     assert (node.tap is not None) == recording
-    node.watchdog.stop()
+    node.close()
 
 
 # --------------------------------------------------------------------- content

@@ -35,7 +35,7 @@ def test_robot_a1_puts_only_on_its_cmd_and_report():
         "referee",
         "ack/robot/a/1",
     }
-    # its liveliness, and the tokens that announce its long lockstep waits (runtime/lockstep.py Reactor)
+    # its liveliness, and the tokens that announce its long lockstep waits (runtime/drivers.py Reactor)
     assert _rel(perms["liveliness_token/ingress"]) == {"alive/robot/a/1", "waiting/robot/a/1/*"}
 
 

@@ -14,7 +14,7 @@ launcher's own view of the liveliness tokens confirms. A peer that is alive but 
 by the receiver whose sender owes the frame: a receiver waits on while its
 sender announces a wait of its own at a tick not past the missing frame, and
 for a full wait_timeout after it took that announcement back
-(runtime/lockstep.py `Reactor`), so the processes downstream of a stalled
+(runtime/drivers.py `Reactor`), so the processes downstream of a stalled
 one make no claims of their own.
 
 The outcome:
@@ -62,7 +62,7 @@ def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
     dead: dict[str, int] = {}
     # A peer given up on as alive but silent (`extra["silent"]`): the claimant checked that the peer
     # was not itself waiting for its own upstream, nor had been for `wait_timeout`
-    # (runtime/lockstep.py `Reactor`), so the peer owes a frame. Taken in tick order: a process
+    # (runtime/drivers.py `Reactor`), so the peer owes a frame. Taken in tick order: a process
     # already found silent is no witness against its peers (its base station muted its orders,
     # so it then found the base station silent in turn).
     silent = sorted(

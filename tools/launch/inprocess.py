@@ -1,8 +1,8 @@
 """`arena match --engine inprocess`: a whole match in one process and one thread.
 
-The very same `Node` code as in a distributed match, driven cooperatively
-(runtime/coop.py): each node's lockstep generator is resumed when the link it
-waits on is ready, frames are the same msgpack bytes on an in-memory bus, and
+The very same `Node` code as in a distributed match, each node played by
+`Node.playing` under a cooperative driver (runtime/coop.py `play`): each
+node's lockstep generator is resumed when the link it waits on is ready, frames are the same msgpack bytes on an in-memory bus, and
 no node has a thread of its own. The per-process digests are those of the
 distributed run (tests/golden/digests.json pins 20 configurations; an
 integration test compares against real processes over zenoh).
@@ -21,14 +21,12 @@ import gc
 import os
 import time
 
-import msgspec
-
 from arena.processes import node_class
+from arena.runtime import coop
 from arena.runtime.config import MatchConfig
-from arena.runtime.coop import CoopBus, CoopTransport, NodeFailed, Task, drive
-from arena.runtime.node import settle_heap
+from arena.runtime.coop import CoopBus, NodeFailed, Task
+from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
-from arena.schemas.messages import Summary
 
 ENGINE = "inprocess"
 LOCKSTEP_KINDS = {"engine", "referee", "basestation", "robot", "recorder"}  # what this engine can host
@@ -44,20 +42,17 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     bus = CoopBus()
     keys = Keys("inprocess")
     taps = {name: bus.subscribe(None, keys.key(name)) for name in watch}
-    nodes = {
-        str(p): node_class(p.kind)(
-            p, cfg, CoopTransport(bus), keys, **({"path": record} if record and p.kind == "recorder" else {})
-        )
-        for p in cfg.processes()
-    }
-    recorder = nodes.pop("recorder", None)
-    settle_heap()
-    started = time.time()
-    t0 = time.perf_counter()
-    tasks = [Task(name, node.lockstep(), node.batch_flusher()) for name, node in nodes.items()]
+    recorder = None
+    nodes = []
+    for p in cfg.processes():
+        if p.kind == "recorder":  # an observer: it drains the taps between rounds of the run queue
+            recorder = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, path=record)
+        else:
+            nodes.append(node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p))))
     quit_early: set[str] = set()
+    t0 = time.perf_counter()
     try:
-        deadlocks = drive(bus, tasks, on_idle=recorder.pump if recorder is not None else None, quit_early=quit_early)
+        summaries, deadlocks = coop.play(bus, nodes, recorder.pump if recorder is not None else None, quit_early)
     except NodeFailed as exc:
         if recorder is not None:
             recorder.finish()
@@ -69,14 +64,7 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
         raise
     play = time.perf_counter() - t0
     for line in deadlocks:
-        nodes[tasks[0].name].log.error("%s", line)
-    summaries: dict[str, Summary] = {}
-    for task in tasks:
-        node = nodes[task.name]
-        node._wall_s = play
-        node.play_started = started
-        s = node.conclude()
-        summaries[task.name] = msgspec.structs.replace(s, cpu_s=[round(task.busy_s, 3), 0.0])
+        nodes[0].log.error("%s", line)
     if recorder is not None:
         recorder.finish()
         summaries["recorder"] = recorder.conclude()

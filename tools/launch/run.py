@@ -27,9 +27,10 @@ from pathlib import Path
 import msgspec
 import zenoh
 
-from arena.processes import node_class
+from arena.processes import OBSERVERS, node_class
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.credentials import COLLECTOR_PRINCIPAL, Secrets, load_fragment, secure_endpoint
+from arena.runtime.drivers import Driver, Pull, WaitBoard
 from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
@@ -209,6 +210,18 @@ def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
     )
 
 
+def driver(pid: ProcessId, cfg: MatchConfig, transport: ZenohTransport, keys: Keys) -> dict[str, Driver]:
+    """The driver of a lockstep node over zenoh, as a keyword for its constructor (none for an observer):
+    the receive callbacks (`Reactor`, blaming silent peers by their announced waits), or in real time
+    a blocking `Pull`."""
+    if pid.kind in OBSERVERS:
+        return {}
+    timeout = cfg.timing.wait_timeout
+    if cfg.realtime:
+        return {"driver": Pull(transport, timeout)}
+    return {"driver": WaitBoard(transport, keys, str(pid)).reactor(timeout)}
+
+
 def run(
     pid: ProcessId,
     match: str,
@@ -279,13 +292,13 @@ def run(
                 ref_sub = session.declare_subscriber(
                     keys.key("referee"), lambda s: last_ref[:1].clear() or last_ref.append(s.payload.to_bytes())
                 )
-            node = node_class(pid.kind)(pid, cfg, transport, keys, **extra)
+            node = node_class(pid.kind)(pid, cfg, transport, keys, **extra, **driver(pid, cfg, transport, keys))
             node.on_waiting = lambda missing: tell(
                 f"waiting for: {', '.join(missing)} (up to {cfg.timing.startup_timeout:g} s)"
                 if missing
                 else "every process is here: playing"
             )
-            node.run()
+            node.play()
         finally:
             if ref_sub is not None:
                 ref_sub.undeclare()

@@ -34,8 +34,9 @@ import msgspec
 from arena.processes import node_class
 from arena.recording.reader import Recording, RecordingError, load
 from arena.runtime.config import ConfigError, ProcessId
-from arena.runtime.coop import CoopBus, CoopTransport, NodeFailed, Task, drive
+from arena.runtime.coop import CoopBus, NodeFailed, Task, drive
 from arena.runtime.lockstep import BATCH_HEADS, decode_batch
+from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
 
 
@@ -106,7 +107,9 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
     name = str(pid)
     bus = CoopBus()
     keys = Keys("replay")
-    node = node_class(pid.kind)(pid, cfg, CoopTransport(bus), keys)
+    task = Task(name)  # its driver: only its lockstep is driven (no barrier; its summary below)
+    node = node_class(pid.kind)(pid, cfg, MemoryTransport(bus), keys, driver=task)
+    task.steps = node.lockstep()
     outputs = [(keys.rel(ob.key), bus.subscribe(None, ob.key)) for ob in node.outbound]
     for ib in node.inbound:
         for payload in rec.payloads(keys.rel(ib.key)):
@@ -114,7 +117,7 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
     if rec.truncated:  # its inputs stop where the file does; giving up on every sender there is expected
         node.log.addFilter(lambda r: r.msg != "treating %s as dead: %s")
     try:
-        drive(bus, [Task(name, node.lockstep())])
+        drive(bus, [task])
     except NodeFailed as exc:
         raise exc.__cause__ from None  # the node's own error, as if it had run alone
     summary = [node.conclude()]
