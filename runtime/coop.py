@@ -165,7 +165,7 @@ def play(
         assert isinstance(task, Task), f"{node.name}: a cooperative match's nodes are driven by a coop.Task"
         task.steps = task.playing(node)
         tasks.append(task)
-    deadlocks = drive(bus, tasks, on_idle, quit_early)
+    deadlocks = drive(bus, tasks, on_idle=on_idle, quit_early=quit_early)
     return {t.name: t.summary for t in tasks if t.summary is not None}, deadlocks
 
 

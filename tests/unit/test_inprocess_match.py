@@ -100,13 +100,14 @@ def test_bad_referee_frames_are_rejected_by_engine_and_base_stations_and_change_
 def test_ctrl_c_in_process_leaves_a_whole_recording_that_says_it_was_stopped(tmp_path, monkeypatch):
     """The in-process engine left a truncated file on Ctrl-C; the recorder process writes one that says SIGINT."""
     from arena.recording.reader import load
+    from arena.runtime import coop
     from arena.tools.launch import inprocess
 
     def interrupted(bus, tasks, **kw):
         kw["on_idle"]()
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(inprocess, "drive", interrupted)
+    monkeypatch.setattr(coop, "drive", interrupted)
     path = tmp_path / "stopped.mcap"
     with pytest.raises(KeyboardInterrupt):
         inprocess._play(MatchConfig(half_time=1.0, home="BS", away="BS"), (), record=str(path))

@@ -465,7 +465,7 @@ def test_an_error_in_a_reactive_loop_is_raised_on_the_main_thread():
 def test_the_counters_count_the_frames_waited_for_not_those_racing_the_end():
     """links.sensor.sent was 72012, 72004, 72006 in runs of one seed: frames that landed after the
     receiver's last wait were counted or not depending on how fast its summary was taken."""
-    from arena.runtime.lockstep import pull
+    from arena.runtime.drivers import pull
 
     harness = Harness(emulator=ScriptedLink([0.0, None, 30.0, 0.0, None, 0.0, 0.0]))
     try:
