@@ -284,18 +284,8 @@ def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
     return Step(at=-1, when=cond, actions=actions)
 
 
-def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
-    """Validate one scenario table (raises ValueError naming the key below `scenario[i]`)."""
-    from arena.scenarios.expect import check_expect
-
-    where = f"scenario[{index}]"
-    cfg = MatchConfig()
-    dt = cfg.timing.dt
-    p = spec.play
-    if not (math.isfinite(spec.time_limit) and spec.time_limit > 0):
-        raise ValueError(f"{where}.time_limit: a positive number of seconds, got {spec.time_limit}")
-    if not 0.0 <= spec.min_pass <= 1.0:
-        raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
+def check_rules(p: Play, where: str) -> None:
+    """The `play.rules` keys are RulesParams fields with usable values; counts become ints."""
     known = {f.name: f.type for f in dataclasses.fields(RulesParams)}
     for key, value in p.rules.items():
         if key not in known:
@@ -303,33 +293,54 @@ def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
         if not (math.isfinite(value) and value >= 0) or (known[key] == "int" and value != int(value)):
             raise ValueError(f"{where}.play.rules.{key}: a number >= 0 (a whole one for counts), got {value}")
     p.rules = {k: int(v) if known[k] == "int" else float(v) for k, v in p.rules.items()}
-    steps: list[Step] = []
-    stage, clock, score, attack = "", 0, (0, 0), 1
-    if spec.start is not None:
-        st = spec.start
-        if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
-            raise ValueError(f"{where}.start.stage: FIRST_HALF or SECOND_HALF, got {st.stage!r}")
-        if len(st.score) != 2 or min(st.score) < 0:
-            raise ValueError(f"{where}.start.score: [goals of a, goals of b], got {st.score}")
-        if st.attack_dir_a not in (1, -1):
-            raise ValueError(f"{where}.start.attack_dir_a: 1 or -1, got {st.attack_dir_a}")
-        stage, clock, score, attack = st.stage, int(round(st.clock / dt)), (st.score[0], st.score[1]), st.attack_dir_a
-        steps += start_steps(st, p.robots, f"{where}.start")
-    steps += [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
+
+
+def start_params(spec: ScenarioSpec, dt: float, where: str) -> ScenarioParams:
+    """The engine's and the referee's share of `start` and `step` (time limit, clock, stage, steps)."""
+    p, st = spec.play, spec.start
+    steps = [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
+    ticks = int(round(spec.time_limit / dt))
+    if st is None:
+        return ScenarioParams(ticks=ticks, steps=tuple(steps))
+    if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
+        raise ValueError(f"{where}.start.stage: FIRST_HALF or SECOND_HALF, got {st.stage!r}")
+    if len(st.score) != 2 or min(st.score) < 0:
+        raise ValueError(f"{where}.start.score: [goals of a, goals of b], got {st.score}")
+    if st.attack_dir_a not in (1, -1):
+        raise ValueError(f"{where}.start.attack_dir_a: 1 or -1, got {st.attack_dir_a}")
+    return ScenarioParams(
+        ticks=ticks,
+        clock=int(round(st.clock / dt)),
+        stage=st.stage,
+        score=(st.score[0], st.score[1]),
+        attack_dir_a=st.attack_dir_a,
+        steps=tuple(start_steps(st, p.robots, f"{where}.start") + steps),
+    )
+
+
+def check_expectations(spec: ScenarioSpec, where: str) -> None:
+    from arena.scenarios.expect import check_expect
+
     names = set()
     for i, e in enumerate(spec.expect):
-        check_expect(e, p.robots, f"{where}.expect[{i}]")
+        check_expect(e, spec.play.robots, f"{where}.expect[{i}]")
         if e.name in names:
             raise ValueError(f"{where}.expect[{i}].name: {e.name!r} is used twice")
         names.add(e.name)
-    params = ScenarioParams(
-        ticks=int(round(spec.time_limit / dt)),
-        clock=clock,
-        stage=stage,
-        score=score,
-        attack_dir_a=attack,
-        steps=tuple(steps),
-    )
+
+
+def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
+    """Validate one scenario table (raises ValueError naming the key below `scenario[i]`)."""
+    where = f"scenario[{index}]"
+    dt = MatchConfig().timing.dt
+    p = spec.play
+    if not (math.isfinite(spec.time_limit) and spec.time_limit > 0):
+        raise ValueError(f"{where}.time_limit: a positive number of seconds, got {spec.time_limit}")
+    if not 0.0 <= spec.min_pass <= 1.0:
+        raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
+    check_rules(p, where)
+    params = start_params(spec, dt, where)
+    check_expectations(spec, where)
     names = []
     for side in ("home", "away"):
         try:

@@ -102,7 +102,7 @@ class Outcome:
         return bool(self.verdicts) and self.rate >= self.scenario.spec.min_pass
 
     def describe(self) -> str:
-        """The verdict line, and per failed expectation its name, tick, seed and the replay command."""
+        """The verdict line; for a failed scenario, per failed expectation its name, tick, seed and replay command."""
         n = len(self.verdicts)
         lo, hi = wilson(self.passed_runs, n)
         lines = [
@@ -110,7 +110,7 @@ class Outcome:
             f"{self.passed_runs}/{n} runs passed, {self.rate:.0%} (95 % CI {lo:.0%}-{hi:.0%}), "
             f"min_pass {self.scenario.spec.min_pass:g}"
         ]
-        for v in self.verdicts:
+        for v in self.verdicts if not self.passed else ():
             for f in v.failures:
                 lines.append(f"  seed {v.seed}: expectation {f.name!r} failed at tick {f.tick}: {f.detail}")
             if v.failures:
