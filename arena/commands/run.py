@@ -16,6 +16,8 @@ EXAMPLES = """examples:
   # a secure match (it listens on 0.0.0.0): the credentials file arena match wrote for robot/a/1
   arena run robot --match m7-1234-abcdef --connect tls/192.168.1.10:7447 --team a --robot 1 \\
       --credentials robot-a-1.json5
+  # a robot that plays a learned policy (the match: --home policy:/runs/p.pkl); its own copy of the file
+  arena run robot --match demo --connect tcp/192.168.1.10:7447 --team a --robot 1 --policy p.pkl
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
   arena run router --match demo --listen tls/0.0.0.0:7447 --credentials creds/   # secure: writes creds/*.json5
@@ -39,6 +41,12 @@ def add_parser(sub) -> None:
     r.add_argument("--seed", type=int, metavar="S", help="master seed; must match the match's")
     r.add_argument("--realtime", action="store_true", help="the match runs in real-time mode")
     r.add_argument("--config", metavar="FILE", help="match configuration JSON (default: ask the engine)")
+    r.add_argument(
+        "--policy",
+        metavar="FILE",
+        help="robot, basestation: this computer's copy of the policy file the team plays (its strategy is "
+        "policy:PATH, a path on the computer that started the match; docs/learning.md)",
+    )
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
     r.add_argument(
         "--credentials",
@@ -94,6 +102,13 @@ def run(args: argparse.Namespace) -> int:
             cfg = match_config(args, realtime=args.realtime, tap=bool(args.record))
         if args.record and args.kind not in ("engine", "recorder"):
             raise ConfigError(f"--record does not apply to {args.kind}")
+        policy = None
+        if args.policy:
+            if args.kind not in ("robot", "basestation"):
+                raise ConfigError(f"--policy applies to a robot or a base station, not to {args.kind}")
+            from arena.strategies import registry
+
+            policy = registry.resolve_name(f"policy:{args.policy}")
         if args.port is not None and (args.kind != "viewer" or not 0 <= args.port <= 65535):
             raise ConfigError("--port applies to the viewer only, 0..65535")
         record = runner.record_path(args.record) if args.record and args.kind == "recorder" else None
@@ -116,4 +131,5 @@ def run(args: argparse.Namespace) -> int:
         args.host,
         args.port,
         keyring,
+        policy,
     )

@@ -64,6 +64,8 @@ BAD = [
     ([*R[:3], "m/x", *R[4:]], "bad match id"),
     ([*R, "--record", "x.mcap"], "--record does not apply"),
     ([*R, "--team", "c"], "invalid choice: 'c'"),
+    ([*R, "--policy", "/nonexistent.pkl"], "policy file /nonexistent.pkl not found"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--policy", "p.pkl"], "--policy applies to"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
     (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),

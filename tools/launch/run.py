@@ -195,6 +195,13 @@ def open_until(net: NetConfig, timeout: float, where: str, tell):
             time.sleep(1.0)
 
 
+def with_policy(cfg: MatchConfig, team: str, policy: str) -> MatchConfig:
+    """`cfg` with team `team`'s policy file replaced by `policy` (`policy:PATH`, this computer's copy)."""
+    if not cfg.strategy_of(team).startswith("policy:"):
+        raise ConfigError(f"--policy: team {team} plays {cfg.strategy_of(team)}, not a policy file")
+    return cfg.replace(**{"home" if team == "a" else "away": policy})
+
+
 def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
     """Liveliness knows who is there: a second process with a running one's identity is turned away.
 
@@ -234,8 +241,12 @@ def run(
     host: str = "127.0.0.1",
     port: int | None = None,
     keyring: Keyring | None = None,
+    policy: str | None = None,
 ) -> int:
     """Run one process to the end of its match. Returns the exit code.
+
+    `policy`: a robot's or base station's own copy of the policy file its team plays, as the
+    strategy name `policy:PATH` (the match's names a path on the computer that started it).
 
     `record`: the recorder's output path; it overrides the configuration's
     (which names the path on the machine that started the match).
@@ -283,6 +294,8 @@ def run(
                 extra = {"host": host, "attached": attached}
             if pid not in cfg.processes():
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
+            if policy:
+                cfg = with_policy(cfg, pid.team, policy)
             refuse_duplicate(session, keys, pid)
             tell(
                 f"connected to {where} (zenoh {net.mode}); match {match!r}: {cfg.home} v {cfg.away}, "
