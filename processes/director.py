@@ -32,22 +32,29 @@ class Director:
     def __init__(self, cfg: MatchConfig, physics: Physics):
         self.cfg = cfg
         self.physics = physics
-        self.steps = [s for s in cfg.scenario.steps if any(not isinstance(a, RefereeOverride) for a in s.actions)]
-        self.fired: list[tuple[int, int]] = []  # (tick, index in `steps`)
+        mine = [s for s in cfg.scenario.steps if any(not isinstance(a, RefereeOverride) for a in s.actions)]
+        self.at: dict[int, list[Step]] = {}  # by tick: a replay with substitution has a step every tick
+        for s in mine:
+            if s.at >= 0:
+                self.at.setdefault(s.at, []).append(s)
+        self.waiting = [s for s in mine if s.at < 0 and s.when is not None]  # conditions not yet met
+        self.fired = 0  # steps done
         self.seen: set[str] = set()  # referee commands the engine has applied
 
     def observe(self, frame: Referee) -> None:
         self.seen.update(c.name for c in frame.commands)
 
     def act(self, k: int) -> None:
-        done = {i for _, i in self.fired}
-        for i, step in enumerate(self.steps):
-            if i in done:
-                continue
-            if step.at == k or (step.at < 0 and step.when is not None and self.holds(step.when)):
-                self.fired.append((k, i))
-                for action in step.actions:
-                    self.apply(action)
+        due = self.at.pop(k, [])
+        if self.waiting:
+            met = [s for s in self.waiting if self.holds(s.when)]
+            if met:
+                self.waiting = [s for s in self.waiting if s not in met]
+                due += met
+        for step in due:
+            self.fired += 1
+            for action in step.actions:
+                self.apply(action)
 
     def holds(self, c: Condition) -> bool:
         ph = self.physics

@@ -45,6 +45,12 @@ class Spec(Struct, kw_only=True, forbid_unknown_fields=True):
     """File tables: an unknown key is an error (a typo must not pass silently)."""
 
 
+class Substitute(Spec):
+    team: str
+    recording: str
+    from_: float = msgspec.field(default=0.0, name="from")
+
+
 class Play(Spec):
     home: str = "basic-static"
     away: str = "basic-static"
@@ -54,6 +60,7 @@ class Play(Spec):
     half_time: float = 300.0
     external: list[str] = []
     rules: dict[str, float] = {}
+    substitute: Substitute | None = None
 
 
 class BallSpec(Spec):
@@ -295,19 +302,20 @@ def check_rules(p: Play, where: str) -> None:
     p.rules = {k: int(v) if known[k] == "int" else float(v) for k, v in p.rules.items()}
 
 
-def start_params(spec: ScenarioSpec, dt: float, where: str) -> ScenarioParams:
+def start_params(spec: ScenarioSpec, dt: float, where: str, base: Path = Path(".")) -> ScenarioParams:
     """The engine's and the referee's share of `start` and `step` (time limit, clock, stage, steps)."""
     p, st = spec.play, spec.start
     steps = [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
     ticks = int(round(spec.time_limit / dt))
     if st is None:
-        return ScenarioParams(ticks=ticks, steps=tuple(steps))
+        return ScenarioParams(ticks=ticks, steps=tuple(steps + substitution(spec, ticks, dt, where, base)))
     if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
         raise ValueError(f"{where}.start.stage: FIRST_HALF or SECOND_HALF, got {st.stage!r}")
     if len(st.score) != 2 or min(st.score) < 0:
         raise ValueError(f"{where}.start.score: [goals of a, goals of b], got {st.score}")
     if st.attack_dir_a not in (1, -1):
         raise ValueError(f"{where}.start.attack_dir_a: 1 or -1, got {st.attack_dir_a}")
+    steps += substitution(spec, ticks, dt, where, base)
     return ScenarioParams(
         ticks=ticks,
         clock=int(round(st.clock / dt)),
@@ -316,6 +324,40 @@ def start_params(spec: ScenarioSpec, dt: float, where: str) -> ScenarioParams:
         attack_dir_a=st.attack_dir_a,
         steps=tuple(start_steps(st, p.robots, f"{where}.start") + steps),
     )
+
+
+def substitution(spec: ScenarioSpec, ticks: int, dt: float, where: str, base: Path) -> list[Step]:
+    """Replay with substitution: one team's robots follow their recorded poses, teleported every tick
+    from the recording's tick `from / dt` on; the other team and the ball play live."""
+    sub, robots = spec.play.substitute, spec.play.robots
+    if sub is None:
+        return []
+    from arena.recording.reader import RecordingError, load
+    from arena.schemas.messages import World
+
+    if sub.team not in TEAMS:
+        raise ValueError(f"{where}.play.substitute.team: {sub.team!r} (a or b)")
+    path = base / sub.recording  # relative to the scenario file
+    try:
+        worlds = load(str(path), keep={"world"}).decoded("world", World)
+    except (RecordingError, OSError) as exc:
+        raise ValueError(f"{where}.play.substitute.recording: {exc}") from None
+    first = int(round(sub.from_ / dt))
+    by_tick = {w.tick - first: w for w in worlds if first <= w.tick <= first + ticks}
+    if 0 not in by_tick:
+        raise ValueError(f"{where}.play.substitute.from: the recording has no world frame at {sub.from_} s")
+    steps = []
+    for k, w in sorted(by_tick.items()):
+        acts = [
+            TeleportRobot(
+                team=r.team, robot=r.robot, x=r.x, y=r.y, orientation=r.theta, vx=r.vx, vy=r.vy, omega=r.omega
+            )
+            for r in w.robots
+            if r.team == sub.team and r.robot < robots
+        ]
+        if acts:
+            steps.append(Step(at=k, actions=acts))
+    return steps
 
 
 def check_expectations(spec: ScenarioSpec, where: str) -> None:
@@ -339,7 +381,7 @@ def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
     if not 0.0 <= spec.min_pass <= 1.0:
         raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
     check_rules(p, where)
-    params = start_params(spec, dt, where)
+    params = start_params(spec, dt, where, Path(path).parent)
     check_expectations(spec, where)
     names = []
     for side in ("home", "away"):

@@ -215,3 +215,38 @@ def test_it(arena_scenario):
     result.assert_outcomes(passed=2, failed=1)
     result.stdout.fnmatch_lines(["*FAIL never*", "*expectation 'a scores' failed at tick 30*"])
     assert math.isfinite(1.0)
+
+
+# ------------------------------------------------------ replay with substitution
+def test_a_substituted_team_follows_its_recorded_poses_while_the_rest_plays_live(tmp_path):
+    import msgspec
+
+    from arena.recording.reader import load as read
+    from arena.runtime.config import MatchConfig
+    from arena.tools.launch.inprocess import play_in_process
+
+    play_in_process(
+        MatchConfig(seed=3, home="AD", away="BS", half_time=2.0), watch=(), record=str(tmp_path / "src.mcap")
+    )
+    recorded = {w.tick: w for w in read(str(tmp_path / "src.mcap"), keep={"world"}).decoded("world", World)}
+    path = tmp_path / "sub.scenario.toml"
+    path.write_text(
+        '[[scenario]]\nname = "sub"\ntime_limit = 1.5\n[scenario.play]\nhome = "chase"\naway = "BS"\n'
+        'substitute = { team = "b", recording = "src.mcap", from = 1.0 }\n'
+        "[scenario.start]\nball = { x = 1.0, y = 1.0 }\n"
+    )
+    sc = load(path)
+    _, frames = play_in_process(sc.config(0), watch=("world",))
+    worlds = [msgspec.msgpack.decode(p, type=World) for p in frames["world"]]
+    for w in worlds:
+        want = recorded[w.tick + 50]
+        assert [(r.x, r.y, r.theta) for r in w.robots if r.team == "b"] == [
+            (r.x, r.y, r.theta) for r in want.robots if r.team == "b"
+        ], f"tick {w.tick}"
+    moved_a = {(r.x, r.y) for w in worlds for r in w.robots if (r.team, r.robot) == ("a", 1)}
+    assert len(moved_a) > 10 and any(w.ball_x != recorded[w.tick + 50].ball_x for w in worlds), (
+        "a and the ball are live"
+    )
+    path.write_text(path.read_text().replace("from = 1.0", "from = 9.0"))
+    with pytest.raises(ScenarioError, match=r"scenario\[0\]\.play\.substitute\.from: the recording has no world frame"):
+        load(path)
