@@ -13,11 +13,38 @@ from arena.runtime.config import MAX_HALF_TIME
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse, but errors are one line and exit 2."""
+    """argparse, but errors are one line and exit 2; no abbreviated flags (`--half 5` is not
+    `--half-time 5`); an unknown flag is named by its sub-command, with the closest real one."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)  # sub-commands' parsers are made by add_parser: this class too
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
         raise SystemExit(2)
+
+    def parse_args(self, args=None, namespace=None):  # type: ignore[override]
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            self.unrecognized(parsed, extras)
+        return parsed
+
+    def unrecognized(self, parsed: argparse.Namespace, extras: list[str]) -> NoReturn:
+        """argparse says this from the top (`see arena --help`): say it from the sub-command that was given."""
+        import difflib
+
+        owner: argparse.ArgumentParser = self
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                owner = action.choices.get(getattr(parsed, action.dest, None), owner)
+        flags = [o for a in owner._actions for o in a.option_strings if o.startswith("--")]
+        given = next((e for e in extras if e.startswith("--")), "").split("=", 1)[0]
+        # An abbreviation names the flag it abbreviates; a typo the closest spelling, if one is close.
+        close = [f for f in flags if given and f.startswith(given)][:1] or (
+            difflib.get_close_matches(given, flags, n=1, cutoff=0.8) if given else []
+        )
+        owner.error(f"unrecognized arguments: {' '.join(extras)}" + (f"; did you mean {close[0]}?" if close else ""))
 
 
 def add_command(sub, name: str, help_text: str, examples: str | None = None) -> argparse.ArgumentParser:

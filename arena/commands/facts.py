@@ -33,7 +33,7 @@ def add_parser(sub) -> None:
     )
     fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
     fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
-    fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once (default: up to 2)")
+    fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once; 0 (the default): up to 2")
     fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
     fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
     fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")

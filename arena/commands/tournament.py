@@ -38,7 +38,7 @@ def add_parser(sub) -> None:
     )
     every_match_latency(t)
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
-    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once (default: one per core)")
+    t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
     t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
     t.add_argument(

@@ -54,7 +54,10 @@ BAD = [
     ([*M, "--refbox-follow", "127.0.0.1:28097"], "--refbox-follow needs --realtime"),  # was a silent 0:0
     ([*M, "--record", "/proc/m.mcap"], "cannot write it"),  # the directory exists, nobody may create files in it
     ([*M, "--seed", "-1"], "--seed must be in"),
-    ([*M, "--bogus"], "unrecognized arguments: --bogus"),
+    ([*M, "--bogus"], "arena match: error: unrecognized arguments: --bogus (see arena match --help)"),  # not arena's
+    ([*M, "--half", "5"], "--half 5; did you mean --half-time? (see arena match --help)"),  # was taken as --half-time
+    ([*M, "--halftime", "5"], "did you mean --half-time?"),
+    ([*M, "--seeed=3"], "unrecognized arguments: --seeed=3; did you mean --seed?"),
     # arena run
     (["run", "robot", "--match", "m", "--connect", "foo", "--team", "a", "--robot", "1"], "--connect foo"),
     (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
@@ -76,6 +79,8 @@ BAD = [
     (["up", "{file}"], "not valid YAML"),
     (["up", "compose.yaml", "--timeout", "-5"], "--timeout: '-5'"),
     # arena tournament
+    ([*T, "--leg", "2"], "arena tournament: error: unrecognized arguments: --leg 2; did you mean --legs?"),
+    ([*T, "--job", "2"], "did you mean --jobs? (see arena tournament --help)"),  # was taken as --jobs
     ([*T, "--out", "{file}"], "exists and is not a directory"),
     (
         [*T, "--out", "{tmp}/typo", "--resume"],
@@ -100,12 +105,23 @@ BAD = [
     (["bench", "nav", "--only", "nosuch"], "nosuch"),
     (["bench", "frob"], "invalid choice: 'frob'"),
     # arena facts
+    (["facts", "--worker", "2"], "did you mean --workers? (see arena facts --help)"),
     (["facts", "--half-time", "inf"], "finite number"),
     (["facts", "--seeds", "0"], "must be at least 1"),
     (["facts", "--round-robin", "AD"], "needs at least two different strategies"),
     (["facts", "--home", "nope"], "unknown strategy 'nope'"),
     (["facts", "--perception-latency", "99"], "--perception-latency must be 0..25 ticks, got 99"),
+    # arena scenario
+    (["scenario", "run", "--seeds", "0"], "--seeds: expected a whole number 1..100000"),
+    (
+        ["scenario", "run", "--jbos", "2"],
+        "arena scenario: error: unrecognized arguments: --jbos 2; did you mean --jobs?",
+    ),
     # arena review
+    (
+        ["review", "m.mcap", "--plot", "d"],
+        "arena review: error: unrecognized arguments: --plot d; did you mean --plots?",
+    ),
     (["review", "/nonexistent.mcap"], "cannot read"),
     (["review", "{file}"], "not an MCAP file"),
     (["review", "{file}", "--plots", "{file}"], "exists and is not a directory"),
@@ -223,3 +239,19 @@ def test_a_bad_environment_variable_is_one_line_and_exit_2(env, args, needle):
     assert "Traceback" not in r.stderr and "panicked" not in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and needle in r.stderr, r.stderr
     assert r.returncode == 2
+
+
+def test_no_parser_takes_an_abbreviated_flag():
+    from arena.cli import parser
+
+    top = parser()
+    sub = next(a for a in top._actions if a.dest == "command")
+    assert not top.allow_abbrev
+    assert [name for name, p in sub.choices.items() if p.allow_abbrev] == []
+
+
+def test_a_jobs_of_0_is_said_to_mean_the_default():
+    """`--jobs 0` silently meant "one per core", which no help text said."""
+    for cmd, flag, means in (("tournament", "--jobs", "one per core"), ("facts", "--workers", "up to 2")):
+        out = subprocess.run([sys.executable, "-m", "arena", cmd, "--help"], capture_output=True, text=True).stdout
+        assert f"0 (the default): {means}" in " ".join(out.split()), (cmd, flag)
