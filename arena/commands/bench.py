@@ -17,6 +17,7 @@ EXAMPLES = """examples:
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
+  arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
@@ -26,11 +27,12 @@ def add_parser(sub) -> None:
     b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "throughput", "learn"],
+        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
         "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
-        "on 2 workers vs. 1 (needs the learn extra)",
+        "on 2 workers vs. 1 (needs the learn extra); scenario: 10-s scenario runs per minute in process, "
+        "and the ratio to a plain match of the same length",
     )
     b.add_argument(
         "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
@@ -75,6 +77,10 @@ def run(args: argparse.Namespace) -> int:
         except ImportError as exc:
             raise ConfigError(str(exc)) from None
         return bench_learn(args.runs, args.half_time, args.strategy, args.json)
+    if args.what == "scenario":
+        from arena.scenarios.bench import bench_scenario
+
+        return bench_scenario(args.runs, args.json)
     if args.what == "throughput":
         from arena.tools.experiments import throughput
 

@@ -51,3 +51,15 @@ def test_both_engines_give_the_same_verdicts_and_digests(name):
     for seed in (0, 1):
         a, b = run_one(sc, seed, "inprocess"), run_one(sc, seed, "processes")
         assert (a.passed, a.failures, a.digest, a.score) == (b.passed, b.failures, b.digest, b.score), (seed, a, b)
+
+
+@pytest.mark.slow
+def test_bench_scenario_reports_runs_per_minute_and_the_ratio(capsys):
+    import json
+
+    assert main(["bench", "scenario", "--runs", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["simulated_s_per_run"] == 10.0 and out["runs_per_minute_one_core"] > 0
+    assert out["ratio_to_plain_match"] == pytest.approx(
+        out["run_wall_s_median"] / out["plain_match_wall_s_median"], rel=0.01
+    )
