@@ -23,10 +23,10 @@ from __future__ import annotations
 import functools
 import resource
 import threading
-import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
 
+from arena.runtime.clock import MONOTONIC, Clock
 from arena.runtime.lockstep import Inbound, Waits, Watchdog
 from arena.runtime.transport import Transport
 from arena.schemas.keys import WAITING, Keys
@@ -113,8 +113,8 @@ class Pull:
 
     cooperative = False
 
-    def __init__(self, transport: Transport, timeout: float):
-        self.watchdog: Watchdog | None = Watchdog(transport, timeout)
+    def __init__(self, transport: Transport, timeout: float, clock: Clock = MONOTONIC):
+        self.watchdog: Watchdog | None = Watchdog(transport, timeout, clock=clock)
 
     connect = staticmethod(subscribe)
     cpu_s = staticmethod(own_cpu_s)
@@ -156,8 +156,10 @@ class Reactor:
         timeout: float,
         announce: Callable[[int | None], None] | None = None,
         upstream_waited: Callable[[str, int], float | None] | None = None,
+        clock: Clock = MONOTONIC,
     ):
         self.timeout = timeout
+        self.clock = clock  # wall time, for failure detection only
         # A wait longer than `announce_after` is announced (a liveliness token naming the tick this
         # process is about to act at). A sender owes the frame we miss only since it was last seen
         # announcing a wait of its own at a tick not past that frame (`upstream_waited`: the
@@ -211,7 +213,7 @@ class Reactor:
             if self._waiting is None:
                 self._finish()
             elif self._waiting is not was:
-                self._since = time.monotonic()  # the start of this wait (failure detection only)
+                self._since = self.clock.monotonic()  # the start of this wait
         except BaseException as exc:  # raised again on the main thread by `run`
             self.error = exc
             self._finish()
@@ -231,7 +233,7 @@ class Reactor:
         with self.lock:
             self._steps = steps
             self._advance()
-        while not self.done.wait(0.1):
+        while not self.clock.wait(self.done, 0.1):
             self._look()
         self._set_announced(None)
         if self.error is not None:
@@ -240,14 +242,14 @@ class Reactor:
     def _look(self) -> None:
         """One look from the main thread: announce a long wait, give up on a link silent past the timeout."""
         with self.lock:
-            waited = time.monotonic() - self._since
+            waited = self.clock.monotonic() - self._since
             want = self._waiting[1] if self._waiting is not None and waited >= self.announce_after else None
         self._set_announced(want)
         with self.lock:
             if self._waiting is None:
                 return
             ib, k = self._waiting
-            now = time.monotonic()
+            now = self.clock.monotonic()
             if now - self._since < self.timeout:
                 return
             missing = ib.schedule.first_after(ib.last_seen)
@@ -276,8 +278,9 @@ class WaitBoard:
     tokens), which the `Reactor` blames a silent peer by: a peer that announces waiting
     before acting at a tick owes none of the frames after it yet."""
 
-    def __init__(self, transport: ZenohTransport, keys: Keys, name: str):
+    def __init__(self, transport: ZenohTransport, keys: Keys, name: str, clock: Clock = MONOTONIC):
         self._transport = transport
+        self._clock = clock  # the `Reactor`'s: the times it hands back are compared with its own
         self._keys = keys
         self._name = name
         self._lock = threading.Lock()
@@ -298,7 +301,7 @@ class WaitBoard:
             else:
                 ticks.discard(tick)
                 # Wall time for failure detection only: from here on it may owe its frames.
-                self._waited.setdefault(peer, {})[tick] = time.monotonic()
+                self._waited.setdefault(peer, {})[tick] = self._clock.monotonic()
 
     def upstream_waited(self, peer: str, missing: int) -> float | None:
         """When `peer` was last seen blocked itself, before acting at a tick not past `missing`
@@ -306,7 +309,7 @@ class WaitBoard:
         it took the last one back otherwise, None if it never announced one."""
         with self._lock:
             if any(s <= missing for s in self._waits.get(peer, ())):
-                return time.monotonic()
+                return self._clock.monotonic()
             return max((t for s, t in self._waited.get(peer, {}).items() if s <= missing), default=None)
 
     def announce(self, tick: int | None) -> None:
@@ -319,4 +322,4 @@ class WaitBoard:
 
     def reactor(self, timeout: float) -> Reactor:
         """A `Reactor` that announces its long waits here and blames by what the peers announce."""
-        return Reactor(timeout, self.announce, self.upstream_waited)
+        return Reactor(timeout, self.announce, self.upstream_waited, self._clock)

@@ -39,7 +39,6 @@ import heapq
 import logging
 import math
 import threading
-import time
 from collections import Counter
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
@@ -47,6 +46,7 @@ from typing import Any, Generic, TypeVar
 
 import msgspec
 
+from arena.runtime.clock import MONOTONIC, Clock
 from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.keys import MAX_BATCH, MAX_FRAME_BYTES
@@ -121,9 +121,10 @@ class Watchdog:
     that key's subscription. Cheap: no work on the hot path but two stores.
     """
 
-    def __init__(self, transport: Transport, timeout: float, thread: bool = True):
+    def __init__(self, transport: Transport, timeout: float, thread: bool = True, clock: Clock = MONOTONIC):
         self.transport = transport
         self.timeout = timeout
+        self.clock = clock
         self._key: str | None = None
         self._since = 0.0
         self._stop = threading.Event()
@@ -133,19 +134,19 @@ class Watchdog:
             self._thread.start()
 
     def arm(self, key: str) -> None:
-        self._since = time.monotonic()
+        self._since = self.clock.monotonic()
         self._key = key
 
     def disarm(self) -> None:
         self._key = None
 
     def expired(self) -> bool:
-        return self._key is not None and time.monotonic() - self._since >= self.timeout
+        return self._key is not None and self.clock.monotonic() - self._since >= self.timeout
 
     def _run(self) -> None:
-        while not self._stop.wait(0.1):
+        while not self.clock.wait(self._stop, 0.1):
             key = self._key
-            if key is not None and time.monotonic() - self._since >= self.timeout:
+            if key is not None and self.clock.monotonic() - self._since >= self.timeout:
                 self.transport.wake(key)
 
     def stop(self) -> None:

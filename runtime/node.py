@@ -31,6 +31,7 @@ from collections.abc import Callable, Generator
 from typing import Any, TypeVar
 
 from arena.runtime import seeds
+from arena.runtime.clock import MONOTONIC, Clock
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.drivers import Driver, Pull, Reactor, Wait, own_cpu_s
 from arena.runtime.links import IDEAL, LinkEmulator, resolve
@@ -66,8 +67,9 @@ class Peer:
 
     cooperative = False  # True: played by a cooperative scheduler (runtime/drivers.py `Driver`)
 
-    def __init__(self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys):
+    def __init__(self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys, clock: Clock = MONOTONIC):
         self.pid = pid
+        self.clock = clock  # wall time for the start barrier's bound (runtime/clock.py)
         self.name = str(pid)
         self.cfg = cfg
         self.transport = transport
@@ -143,29 +145,30 @@ class Peer:
         self.transport.watch_alive(self.keys.alive_all(), self._on_alive)
         self.transport.declare_alive(self.keys.alive(self.name))
         expected = set(self.expected_peers())
-        start = time.monotonic()
+        clock = self.clock
+        start = clock.monotonic()
         deadline = start + self.cfg.timing.startup_timeout
         told: list[str] | None = None
         with self._alive_cond:
             while not expected <= self._alive:
                 missing_now = sorted(expected - self._alive)
-                if self.on_waiting is not None and missing_now != told and time.monotonic() - start > 1.0:
+                if self.on_waiting is not None and missing_now != told and clock.monotonic() - start > 1.0:
                     told = missing_now
                     self.on_waiting(missing_now)
-                left = deadline - time.monotonic()
+                left = deadline - clock.monotonic()
                 if left <= 0:
                     missing = ", ".join(sorted(expected - self._alive))
                     raise StartupError(
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )
-                self._alive_cond.wait(min(left, 0.5))
+                clock.wait_on(self._alive_cond, min(left, 0.5))
         if self.tap is not None:
             # Through a router (client mode), a peer's liveliness token can arrive
             # before its subscriber declaration: the first tap batch would be
             # filtered out at the source. Start once the recorder is matched.
             tap_key = self.keys.tap(self.name)
-            while not self.transport.has_subscribers(tap_key) and time.monotonic() < deadline:
-                time.sleep(0.01)
+            while not self.transport.has_subscribers(tap_key) and clock.monotonic() < deadline:
+                clock.sleep(0.01)
         if told is not None and self.on_waiting is not None:
             self.on_waiting([])
 
@@ -295,10 +298,16 @@ class Node(Peer):
     """
 
     def __init__(
-        self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys, driver: Driver | None = None
+        self,
+        pid: ProcessId,
+        cfg: MatchConfig,
+        transport: Transport,
+        keys: Keys,
+        driver: Driver | None = None,
+        clock: Clock = MONOTONIC,
     ):
-        super().__init__(pid, cfg, transport, keys)
-        self.driver: Driver = driver if driver is not None else Pull(transport, cfg.timing.wait_timeout)
+        super().__init__(pid, cfg, transport, keys, clock)
+        self.driver: Driver = driver if driver is not None else Pull(transport, cfg.timing.wait_timeout, clock)
         self.cooperative = self.driver.cooperative
         self.links = resolve(cfg.link, cfg.link_overrides)
         # A recorded match: everything this process sends also goes to its tap

@@ -10,6 +10,7 @@ import time
 
 import pytest
 
+from arena.runtime.clock import MONOTONIC, ManualClock
 from arena.runtime.links import LinkEmulator, LinkModel
 from arena.runtime.lockstep import EVERY_TICK, Inbound, Outbound, Rejections, Schedule, Watchdog
 from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
@@ -43,15 +44,24 @@ class ScriptedLink(LinkEmulator):
         return next(self.script)
 
 
+def until(condition, timeout=5.0):
+    """Wait (real time, bounded) until another thread has got where `condition` says."""
+    end = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < end, "the other thread never got there"
+        time.sleep(0.001)
+
+
 class Harness:
-    def __init__(self, model=None, schedule=EVERY_TICK, lag=1, timeout=5.0, emulator=None):
+    def __init__(self, model=None, schedule=EVERY_TICK, lag=1, timeout=5.0, emulator=None, clock=MONOTONIC):
+        self.clock = clock
         self.bus = MemoryBus()
         self.rx = MemoryTransport(self.bus)
         self.tx = MemoryTransport(self.bus)
         self.rej = Rejections(logging.getLogger("test"))
         self.dead: dict[str, str] = {}
         self.gone: set[str] = set()
-        self.wd = Watchdog(self.rx, timeout)
+        self.wd = Watchdog(self.rx, timeout, clock=clock)
         self.inbound = Inbound(
             key=KEY,
             msg_type=Cmd,
@@ -144,10 +154,16 @@ def test_dropped_frames_are_waited_for_then_discarded():
 
 
 def test_a_silent_sender_is_declared_dead_after_the_timeout():
-    harness = Harness(timeout=0.3)
+    harness = Harness(timeout=0.3, clock=ManualClock())
     try:
-        harness.inbound.sync(1)  # nobody sends tick 0
-        assert "robot/a/1" in harness.dead
+        runner = threading.Thread(target=harness.inbound.sync, args=(1,))  # nobody sends tick 0
+        runner.start()
+        until(lambda: harness.wd._key is not None)  # the wait is armed, at time 0
+        harness.clock.advance(0.2)
+        assert not harness.inbound.dead and runner.is_alive(), "not before the timeout"
+        harness.clock.advance(0.1)
+        runner.join(5.0)
+        assert not runner.is_alive() and "robot/a/1" in harness.dead and "silent for 0.3 s" in harness.dead["robot/a/1"]
         assert harness.inbound.dead
     finally:
         harness.close()
@@ -297,7 +313,7 @@ def test_the_reactor_stops_at_the_first_missing_frame_and_goes_on_when_it_comes(
     for t in range(3):
         reactor.on_frame(a.inbound, _frames([t])[0])
     reactor.on_frame(b.inbound, _frames([0])[0])
-    time.sleep(0.05)
+    until(lambda: reactor._waiting is not None and len(log) == 3)
     assert [k for k, _, _ in log] == [0, 1, 2], "tick 3 needs b's frame sent at 2 (lag 1, period 2)"
     assert not reactor.done.is_set()
     reactor.on_frame(b.inbound, _frames([2])[0])
@@ -312,15 +328,18 @@ def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
 
     a, b = _two_harnesses()
     log: list = []
-    reactor = Reactor(timeout=0.3)
+    clock = ManualClock(autojump=0.005)  # the reactor's own looks move the time on
+    reactor = Reactor(timeout=0.3, clock=clock)
     reactor.on_frame(b.inbound, _frames([0])[0])
     t0 = time.monotonic()
     reactor.run(_two_link_loop(a.inbound, b.inbound, log, last=0))  # a never sends tick... lag 1 needs nothing at 0
     assert log == [(0, [], [])]
-    reactor2 = Reactor(timeout=0.3)
+    clock2 = ManualClock(autojump=0.005)
+    reactor2 = Reactor(timeout=0.3, clock=clock2)
     a2, b2 = _two_harnesses()
     reactor2.run(_two_link_loop(a2.inbound, b2.inbound, [], last=3))  # nobody sends anything
     assert a2.inbound.dead and b2.inbound.dead and "silent" in a2.dead["robot/a/1"]
+    assert 0.6 - 1e-9 <= clock2.monotonic() < 0.8, "each link given up a full timeout after its own wait began"
     assert time.monotonic() - t0 < 5.0
 
     # A vanished sender: its wake-up ends the wait at once, a stale one does not.
@@ -328,8 +347,8 @@ def test_the_reactor_gives_up_on_a_silent_link_and_on_a_vanished_sender():
     reactor3 = Reactor(timeout=30.0)
     runner = threading.Thread(target=reactor3.run, args=(_two_link_loop(a3.inbound, b3.inbound, [], last=2),))
     runner.start()
-    reactor3.on_frame(a3.inbound, WAKE)  # stale: the sender is still there
-    time.sleep(0.05)
+    until(lambda: reactor3._waiting is not None)
+    reactor3.on_frame(a3.inbound, WAKE)  # stale: the sender is still there (looked at before on_frame returns)
     assert not a3.inbound.dead
     a3.gone.add("robot/a/1")
     b3.gone.add("robot/a/1")
@@ -347,6 +366,7 @@ def test_the_reactor_announces_a_long_wait_and_waits_on_while_its_sender_waits_u
     from arena.runtime.drivers import Reactor
 
     h = Harness()
+    clock = ManualClock()
     announced: list = []
     upstream = {"robot/a/1": 0}  # the tick the sender announces it waits before; None: not waiting
     asked: list = []
@@ -354,20 +374,23 @@ def test_the_reactor_announces_a_long_wait_and_waits_on_while_its_sender_waits_u
     def upstream_waited(sender, missing):
         asked.append((sender, missing))
         at = upstream[sender]
-        return time.monotonic() if at is not None and at <= missing else None
+        return clock.monotonic() if at is not None and at <= missing else None
 
     def loop():
         for k in range(3):
             yield h.inbound, k
 
-    reactor = Reactor(timeout=0.3, announce=announced.append, upstream_waited=upstream_waited)
+    reactor = Reactor(timeout=0.3, announce=announced.append, upstream_waited=upstream_waited, clock=clock)
     runner = threading.Thread(target=reactor.run, args=(loop(),))
     runner.start()
-    time.sleep(1.0)  # three timeouts: the sender waits before tick 0, frame 0 is missing, so we wait on
+    clock.until_sleeping(1)  # its main thread looks every 0.1 s of the clock
+    for _ in range(10):  # three timeouts: the sender waits before tick 0, frame 0 is missing, so we wait on
+        clock.advance(0.1)
     assert not h.inbound.dead and runner.is_alive()
     assert announced == [1], "the wait before acting at tick 1 is announced, and stays so while it goes on"
     assert asked and set(asked) == {("robot/a/1", 0)}
     upstream["robot/a/1"] = 5  # it went past tick 0 without sending it: it owes the frame
+    clock.advance(0.1)
     runner.join(5.0)
     assert not runner.is_alive() and h.inbound.dead and "silent" in h.dead["robot/a/1"]
     assert announced[-1] is None, "taken back when the loop ends"
@@ -383,6 +406,7 @@ def test_a_sender_owes_a_frame_only_since_it_stopped_waiting_upstream():
     from arena.runtime.drivers import Reactor
 
     h = Harness()
+    clock = ManualClock()
     timeout = 0.8  # announce_after 0.2: a token taken back would show at the next look, 0.1 s later
     announced: list = []
     took_back: dict = {"at": None}  # when the sender took back its announced wait; None: never announced one
@@ -393,30 +417,39 @@ def test_a_sender_owes_a_frame_only_since_it_stopped_waiting_upstream():
     def loop():
         yield h.inbound, 1
 
-    reactor = Reactor(timeout=timeout, announce=announced.append, upstream_waited=upstream_waited)
+    reactor = Reactor(timeout=timeout, announce=announced.append, upstream_waited=upstream_waited, clock=clock)
     runner = threading.Thread(target=reactor.run, args=(loop(),))
-    t0 = time.monotonic()
+    t0 = clock.monotonic()
     runner.start()
-    time.sleep(timeout - 0.15)
-    took_back["at"] = time.monotonic()  # just before our timeout: it stopped waiting upstream only now
-    time.sleep(0.5)  # our own wait is past the timeout, the sender's debt is not
+    clock.until_sleeping(1)
+    for _ in range(6):
+        clock.advance(0.1)
+    clock.advance(0.05)
+    took_back["at"] = clock.monotonic()  # just before our timeout: it stopped waiting upstream only now
+    for _ in range(5):  # our own wait is past the timeout, the sender's debt is not
+        clock.advance(0.1)
     assert not h.inbound.dead and runner.is_alive()
-    runner.join(5.0)  # nothing comes: it is silent a full timeout after it took its announcement back
+    for _ in range(20):  # nothing comes: it is silent a full timeout after it took its announcement back
+        if not runner.is_alive():
+            break
+        clock.advance(0.1)
+    runner.join(5.0)
     assert not runner.is_alive() and h.inbound.dead and "silent" in h.dead["robot/a/1"]
-    assert time.monotonic() - t0 >= (timeout - 0.15) + timeout
+    assert (timeout - 0.15) + timeout - 1e-9 <= clock.monotonic() - t0 < (timeout - 0.15) + timeout + 0.2
     assert announced == [1, None], "announced once, until it gave up"
     h.close()
 
     # A sender that took its announcement back before we started to wait owes the frame all along.
     h2 = Harness()
-    took_back["at"] = time.monotonic() - 10.0
+    clock2 = ManualClock(autojump=0.005)
+    took_back["at"] = clock2.monotonic() - 10.0
 
     def loop2():
         yield h2.inbound, 1
 
-    t1 = time.monotonic()
-    Reactor(timeout=0.3, upstream_waited=upstream_waited).run(loop2())
-    assert h2.inbound.dead and time.monotonic() - t1 < 1.0
+    t1 = clock2.monotonic()
+    Reactor(timeout=0.3, upstream_waited=upstream_waited, clock=clock2).run(loop2())
+    assert h2.inbound.dead and 0.3 - 1e-9 <= clock2.monotonic() - t1 < 0.5
     h2.close()
 
 
@@ -429,18 +462,20 @@ def test_a_node_remembers_when_a_peer_stopped_waiting_before_each_tick():
         def watch_alive(self, key_expr, on_change):
             self.watched = key_expr
 
-    board = WaitBoard(Tokens(MemoryBus()), Keys("m"), "robot/a/0")
+    clock = ManualClock()
+    board = WaitBoard(Tokens(MemoryBus()), Keys("m"), "robot/a/0", clock)
     assert board._transport.watched == Keys("m").waiting_all()
     key = "arena/m/waiting/{}/{}".format
     assert board.upstream_waited("engine", 4) is None, "never announced a wait"
     board.on_waiting(key("engine", 3), True)
-    before = time.monotonic()
-    assert board.upstream_waited("engine", 4) >= before, "waits now"
+    clock.advance(1.0)
+    assert board.upstream_waited("engine", 4) == clock.monotonic() == 1.0, "waits now"
     assert board.upstream_waited("engine", 2) is None, "before acting at 3, it owes frame 2"
+    clock.advance(1.0)
     board.on_waiting(key("engine", 3), False)
     gone = board.upstream_waited("engine", 4)
-    assert before <= gone <= time.monotonic(), "until the moment it took its token back"
-    time.sleep(0.01)
+    assert gone == 2.0, "until the moment it took its token back"
+    clock.advance(0.01)
     assert board.upstream_waited("engine", 4) == gone
     board.on_waiting(key("engine", 7), True)
     assert board.upstream_waited("engine", 4) == gone, "a wait past the missing frame is no excuse"
