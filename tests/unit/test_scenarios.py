@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 
@@ -250,3 +252,42 @@ def test_a_substituted_team_follows_its_recorded_poses_while_the_rest_plays_live
     path.write_text(path.read_text().replace("from = 1.0", "from = 9.0"))
     with pytest.raises(ScenarioError, match=r"scenario\[0\]\.play\.substitute\.from: the recording has no world frame"):
         load(path)
+
+
+# ------------------------------------------------------------- the documentation
+DOC = Path(__file__).resolve().parents[2] / "docs" / "scenarios.md"
+
+
+def test_every_key_and_kind_is_documented():
+    import msgspec
+
+    from arena.scenarios import model
+    from arena.scenarios.expect import KINDS
+
+    text = DOC.read_text()
+    specs = [model.Play, model.Substitute, model.BallSpec, model.RobotSpec, model.RefereeSpec, model.Start]
+    specs += [model.When, model.StepSpec, model.Expect, model.ScenarioSpec]
+    missing = [
+        f"{cls.__name__}.{f.encode_name}"
+        for cls in specs
+        for f in msgspec.structs.fields(cls)
+        if f"`{f.encode_name}`" not in text
+    ]
+    missing += [f"kind {k}" for k in KINDS if f"`{k}`" not in text]
+    assert not missing, f"not in docs/scenarios.md: {missing}"
+
+
+def test_the_documented_examples_load_and_run(tmp_path):
+    from arena.scenarios import run_one
+
+    blocks = re.findall(r"```toml\n(.*?)```", DOC.read_text(), flags=re.S)
+    whole = [b for b in blocks if "[[scenario]]" in b]
+    parts = [b for b in blocks if "[[scenario]]" not in b and "my-team" not in b]
+    assert whole and len(parts) >= 3
+    for i, text in enumerate(whole):
+        (tmp_path / f"w{i}.scenario.toml").write_text(text)
+        assert run_one(load(tmp_path / f"w{i}.scenario.toml"), 0).ticks > 0
+    composite = '[[scenario]]\nname = "docs"\ntime_limit = 6.0\n' + "\n".join(parts)
+    (tmp_path / "parts.scenario.toml").write_text(composite)
+    v = run_one(load(tmp_path / "parts.scenario.toml"), 0)
+    assert v.ticks == 300 and "engine digest" in {f.name for f in v.failures}
