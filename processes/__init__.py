@@ -3,8 +3,8 @@ basestation, robot, recorder, refbox, viewer), all shaped the same: a `Node` sub
 wiring, `act` and its loops, or for the two that watch from outside the lockstep (`OBSERVERS`)
 an `Observer` with its `observe`; argument parsing stays in arena/commands/. The
 library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
-`arena.strategies`, `arena.runtime`, `arena.schemas`. Only `arena.tools` and
-`arena.cli` import this package."""
+`arena.strategies`, `arena.runtime`, `arena.schemas`. Only the packages above it
+(tools and up) import this package."""
 
 from __future__ import annotations
 

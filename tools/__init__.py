@@ -2,4 +2,4 @@
 `launch` (start, supervise and collect one match, either engine),
 `experiments` (many matches: tournaments, clusters, facts, benchmarks) and
 `review` (looking back at a recorded match). May import every package below
-it; only `arena.cli` and `arena.commands` import it."""
+it; only the packages above it (scenarios, learn, the CLI) import it."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import logging
 import sys
 
 from arena.commands._common import add_command, seconds
@@ -73,63 +72,32 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.runtime.session import NetConfig
-    from arena.tools.launch import run as runner
+    from arena.tools.launch.run import Job, start
 
-    logging.basicConfig(
-        level=args.log_level, format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr
-    )
-    net = NetConfig(
-        mode=args.mode,
+    job = Job(
+        kind=args.kind,
+        match=args.match,
         connect=(args.connect,) if args.connect else (),
         listen=(args.listen,) if args.listen else (),
+        mode=args.mode,
+        team=args.team,
+        robot=args.robot,
+        seed=args.seed,
+        realtime=args.realtime,
+        config=args.config,
+        policy=args.policy,
+        credentials=args.credentials,
+        startup_timeout=args.startup_timeout,
+        log_level=args.log_level,
+        record=args.record,
+        host=args.host,
+        port=args.port,
     )
-    if args.kind == "router":
-        return runner.main_guarded(runner.run_router, args.match, net, args.credentials)
-    keyring = None
-    try:
-        pid = runner.process_id(args.kind, args.team, args.robot)
-        if args.credentials:
-            import dataclasses
-
-            base, mode, keyring = runner.load_credentials(args.credentials, pid, args.match, wait=10.0)
-            net = dataclasses.replace(net, base=base, mode=mode or net.mode)
-        cfg = None
-        if args.config:
-            cfg = runner.load_config(args.config)
-        elif args.kind == "engine":
-            # The engine only needs to know that the match records; the path is the recorder's.
+    cfg = None
+    if args.kind == "engine" and not args.config:
+        try:  # the engine only needs to know that the match records; the path is the recorder's
             cfg = match_config(args, realtime=args.realtime, tap=bool(args.record))
-        if args.record and args.kind not in ("engine", "recorder"):
-            raise ConfigError(f"--record does not apply to {args.kind}")
-        policy = None
-        if args.policy:
-            if args.kind not in ("robot", "basestation"):
-                raise ConfigError(f"--policy applies to a robot or a base station, not to {args.kind}")
-            from arena.strategies import registry
-
-            policy = registry.resolve_name(f"policy:{args.policy}")
-        if args.port is not None and (args.kind != "viewer" or not 0 <= args.port <= 65535):
-            raise ConfigError("--port applies to the viewer only, 0..65535")
-        record = runner.record_path(args.record) if args.record and args.kind == "recorder" else None
-        from arena.schemas.keys import check_match_id
-
-        check_match_id(args.match)
-    except (ConfigError, ValueError) as exc:
-        print(f"arena run: error: {exc}", file=sys.stderr)
-        return 2
-    return runner.main_guarded(
-        runner.run,
-        pid,
-        args.match,
-        net,
-        cfg,
-        args.seed,
-        args.realtime,
-        args.startup_timeout,
-        record,
-        args.host,
-        args.port,
-        keyring,
-        policy,
-    )
+        except (ConfigError, ValueError) as exc:
+            print(f"arena run: error: {exc}", file=sys.stderr)
+            return 2
+    return start(job, cfg)

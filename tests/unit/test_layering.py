@@ -1,5 +1,7 @@
 """Imports never point up. Each package may import only packages of a lower rank
-(and itself); the ranks are the package map of docs/architecture.md."""
+(and itself); the ranks are the package map of docs/architecture.md. Inside
+tools/, the sub-packages are ranked the same way, and the command line
+(arena.cli, arena.commands) is above everything: nothing else imports it."""
 
 from __future__ import annotations
 
@@ -20,12 +22,34 @@ RANK = {
     "tools": 5,
     "scenarios": 6,  # the scenario file, runner, pytest plugin and library: may use tools
     "learn": 7,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
-    "arena": 8,  # arena/cli.py and arena/__main__.py
+    "arena": 8,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
 }
+# arena's own modules: the command line. Nothing outside arena/ may import them.
+COMMAND_LINE = {"cli", "commands", "__main__"}
+# Inside tools/, bottom-up: a module of tools/ itself (console.py), then the sub-packages by concern.
+TOOLS_RANK = {"": 0, "launch": 1, "review": 2, "experiments": 3}
 
 
-def imported_packages(path: Path) -> set[str]:
-    """Every `arena.<pkg>` this file imports, at module level or inside functions."""
+def unit(name: str) -> tuple[str, str] | None:
+    """The (package, tools sub-package or "") that the module `arena.x.y...` belongs to; None for
+    what the layering does not rank (arena's root package itself, e.g. `arena.__version__`)."""
+    parts = name.split(".")
+    if parts[0] != "arena" or len(parts) < 2:
+        return None
+    if parts[1] in COMMAND_LINE:
+        return ("arena", "")
+    if parts[1] not in RANK:
+        return None
+    sub = parts[2] if parts[1] == "tools" and len(parts) > 2 and parts[2] in TOOLS_RANK else ""
+    return (parts[1], sub)
+
+
+def rank(u: tuple[str, str]) -> tuple[int, int]:
+    return (RANK[u[0]], TOOLS_RANK[u[1]])
+
+
+def imported_units(path: Path) -> set[tuple[str, str]]:
+    """Every ranked unit this file imports, at module level or inside functions."""
     out = set()
     for node in ast.walk(ast.parse(path.read_text(), str(path))):
         names = []
@@ -33,26 +57,55 @@ def imported_packages(path: Path) -> set[str]:
             names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
         elif isinstance(node, ast.Import):
             names = [a.name for a in node.names]
-        for name in names:
-            parts = name.split(".")
-            if parts[0] == "arena" and len(parts) > 1 and parts[1] in RANK:
-                out.add(parts[1])
+        out |= {u for u in map(unit, names) if u is not None}
     return out
+
+
+def upward_imports(root: Path) -> list[str]:
+    """Every import in the tree at `root` that points to its own rank or above (its own unit aside)."""
+    bad = []
+    for pkg in RANK:
+        for path in sorted((root / pkg).rglob("*.py")):
+            rel = path.relative_to(root / pkg).parts
+            own = (pkg, rel[0] if pkg == "tools" and len(rel) > 1 and rel[0] in TOOLS_RANK else "")
+            for dep in sorted(imported_units(path) - {own}):
+                if rank(dep) >= rank(own):
+                    name = "the command line" if dep[0] == "arena" else ".".join(("arena", *filter(None, dep)))
+                    bad.append(f"{path.relative_to(root)} imports {name} (rank {rank(dep)} >= {rank(own)})")
+    return bad
 
 
 def test_every_package_is_ranked():
     pkgs = {p.parent.name for p in ROOT.glob("*/__init__.py")} - {"tests", "examples"}
     assert pkgs <= set(RANK), f"unranked packages: {sorted(pkgs - set(RANK))}"
+    subs = {p.parent.name for p in (ROOT / "tools").glob("*/__init__.py")}
+    assert subs <= set(TOOLS_RANK), f"unranked tools sub-packages: {sorted(subs - set(TOOLS_RANK))}"
 
 
 def test_imports_never_point_up():
-    bad = []
-    for pkg, rank in RANK.items():
-        for path in sorted((ROOT / pkg).rglob("*.py")):
-            for dep in imported_packages(path) - {pkg}:
-                if RANK[dep] >= rank:
-                    bad.append(f"{path.relative_to(ROOT)} imports arena.{dep} (rank {RANK[dep]} >= {rank})")
+    bad = upward_imports(ROOT)
     assert not bad, "\n".join(bad)
+
+
+def test_the_check_fails_on_a_planted_upward_import(tmp_path):
+    planted = {
+        "tools/launch/forked.py": "def go():\n    from arena.cli import main\n",
+        "runtime/plugin.py": "from arena import commands\n",
+        "tools/launch/table.py": "from arena.tools.experiments import tournament\n",
+        "tools/experiments/scen.py": "import arena.commands.match\n",
+        "processes/up.py": "from arena.tools.launch.run import start\n",
+        "learn/cmd.py": "from arena.cli import parser\n",
+    }
+    fine = {
+        "tools/review/ok.py": "from arena.tools.launch import launcher\nfrom arena import __version__\n",
+        "arena/commands/ok.py": "from arena.tools.experiments import tournament\nfrom arena.commands import _common\n",
+        "tools/launch/same.py": "from arena.tools.launch import run\nfrom arena.runtime.config import MatchConfig\n",
+    }
+    for rel, text in {**planted, **fine}.items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(text)
+    bad = upward_imports(tmp_path)
+    assert sorted(line.split(" imports ")[0] for line in bad) == sorted(planted), bad
 
 
 def test_every_package_is_installed():

@@ -4,9 +4,10 @@
 eleven interpreters, each importing zenoh, numpy, pymunk and the strategies,
 which took about 1.4 s of a match's wall time on a quiet host and ~2.5 s of
 its CPU. Here the launcher imports every process kind once (`preload`) and
-`os.fork`s one child per process. A child is the same `arena run <kind> ...`
-command (arena/cli.py `main` with the same arguments), so `arena run` stays
-the entry of every process, and the per-process one for hardware in the loop.
+`os.fork`s one child per process. A child runs the same typed entry as
+`arena run <kind> ...` (`arena.tools.launch.run.start` with the launcher's
+`Job`), so every process, and the per-process one for hardware in the loop,
+starts one way; no child parses a command line.
 
 Rules kept:
 * No zenoh session exists in the launcher when it forks (a forked session's
@@ -41,6 +42,10 @@ import threading
 import time
 import traceback
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from arena.tools.launch.run import Job
 
 _PR_SET_PDEATHSIG = 1
 
@@ -58,7 +63,6 @@ def enabled() -> bool:
 
 def preload(kinds: set[str], strategies: set[str]) -> None:
     """Import what the match's processes import (their kinds, its strategies), once, before forking."""
-    from arena import cli  # noqa: F401
     from arena.processes import node_class
     from arena.strategies import registry
     from arena.tools.launch import run  # noqa: F401
@@ -73,20 +77,18 @@ def preload(kinds: set[str], strategies: set[str]) -> None:
 def warm() -> None:
     """Do once, in the parent, what every child did first (profiled: the imports that each child would repeat).
 
-    Each line was on a child's path to the first tick: the CLI parser (~40 ms to
-    build), numpy.random (the engine's sensor noise imports it: ~80 ms), msgspec's
+    Each line was on a child's path to the first tick: numpy.random (the engine's
+    sensor noise imports it: ~80 ms), msgspec's
     type information for the configuration and for each message a node decodes
     (~40 ms in a robot). None of it depends on the match.
     """
     import msgspec
     import numpy.random  # noqa: F401
 
-    from arena import cli
     from arena.runtime.config import MatchConfig
     from arena.schemas import messages
 
     try:  # only ever a head start: whatever fails here, each child does again (and reports) itself
-        cli.parser()
         MatchConfig.from_json(MatchConfig().to_json())
         for value in vars(messages).values():
             if isinstance(value, type) and issubclass(value, messages.Base):
@@ -175,17 +177,17 @@ class Starter:
         gc.freeze()
         self._frozen = True
 
-    def fork(self, argv: list[str], log_path: Path) -> ForkedProcess:
-        """Fork `arena <argv>` (argv as after `python -m arena`), logging to `log_path`."""
+    def fork(self, job: Job, log_path: Path) -> ForkedProcess:
+        """Fork a child that runs `job`, logging to `log_path`."""
         if self._zygote is not None:
             self._count += 1
-            return self._zygote.launch(self._parked.pop(), argv, log_path, self._go_r)
+            return self._zygote.launch(self._parked.pop(), job, log_path, self._go_r)
         sys.stdout.flush()
         sys.stderr.flush()
         parent = os.getpid()
         pid = os.fork()
         if pid == 0:  # the child: never returns
-            _child(argv, log_path, self._go_r, self._go_w, parent)
+            _child(job, log_path, self._go_r, self._go_w, parent)
         self._count += 1
         return ForkedProcess(pid)
 
@@ -257,7 +259,7 @@ def retitle(argv: list[str]) -> None:
         pass
 
 
-def _child(argv: list[str], log_path: Path, go_r: int, go_w: int, parent: int) -> None:
+def _child(job: Job, log_path: Path, go_r: int, go_w: int, parent: int) -> None:
     code = 1
     try:
         if go_w >= 0:
@@ -282,10 +284,10 @@ def _child(argv: list[str], log_path: Path, go_r: int, go_w: int, parent: int) -
             os._exit(1)
         os.close(go_r)
         # Named `arena run ...` only now: whoever sees one (ps, a test) can count on the router being up.
-        retitle(argv)
-        from arena.cli import main
+        retitle(job.argv())
+        from arena.tools.launch.run import start
 
-        code = main(argv)
+        code = start(job)
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else 1
     except KeyboardInterrupt:  # Ctrl-C reached it before it had its own session: the launcher says so

@@ -40,6 +40,7 @@ from arena.schemas.messages import Referee, Summary
 from arena.tools.launch import forkstart
 from arena.tools.launch.faults import VOIDING, exit_reason
 from arena.tools.launch.faults import outcome as match_outcome
+from arena.tools.launch.run import Job
 from arena.tools.launch.witness import Witness
 
 _PR_SET_PDEATHSIG = 1
@@ -211,7 +212,7 @@ def new_match_id(seed: int) -> str:
     return f"m{seed}-{os.getpid()}-{os.urandom(3).hex()}"
 
 
-def run_argv(
+def run_job(
     pid: ProcessId,
     match: str,
     connect: str,
@@ -219,21 +220,24 @@ def run_argv(
     record: str = "",
     host: str = "",
     credentials: str | None = None,
-) -> list[str]:
-    argv = [sys.executable, "-m", "arena", "run", pid.kind, "--match", match, "--connect", connect]
-    if credentials:
-        argv += ["--credentials", credentials]
-    if pid.team:
-        argv += ["--team", pid.team]
-    if pid.kind == "robot":
-        argv += ["--robot", str(pid.robot)]
-    if pid.kind == "recorder" and record:
-        argv += ["--record", record]
-    if pid.kind == "viewer" and host:
-        argv += ["--host", host]
-    if config_path:
-        argv += ["--config", config_path]
-    return argv
+) -> Job:
+    """The job of one of the match's processes (forked, or exec'd as `arena run ...`)."""
+    return Job(
+        kind=pid.kind,
+        match=match,
+        connect=(connect,),
+        credentials=credentials or None,
+        team=pid.team or None,
+        robot=pid.robot if pid.kind == "robot" else None,
+        record=record if pid.kind == "recorder" and record else None,
+        host=host if pid.kind == "viewer" and host else None,
+        config=config_path or None,
+    )
+
+
+def run_argv(job: Job) -> list[str]:
+    """`python -m arena run ...`: the command that runs `job` in a fresh interpreter."""
+    return [sys.executable, "-m", "arena", *job.argv()]
 
 
 def spawn(name: str, pid: ProcessId, argv: list[str], log_dir: Path, env: dict[str, str] | None = None) -> Child:
@@ -707,7 +711,7 @@ def instructions(
     lines = [f"waiting for {n} external process{'es' if n != 1 else ''}; start {'each' if n != 1 else 'it'} with:"]
     for p in external:
         cred = str(credentials[str(p)]) if credentials else None
-        argv = run_argv(p, match, endpoints[0], record=record, credentials=cred)[3:]
+        argv = run_job(p, match, endpoints[0], record=record, credentials=cred).argv()
         if client and not secure:  # a secure match's credentials file says client mode
             argv += ["--mode", "client"]
         lines.append("  arena " + " ".join(argv))
@@ -793,9 +797,9 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
         starter = forkstart.starter(len(local), {p.kind for p in local}, {cfg.home, cfg.away})
         if starter is not None:
             for p in local:
-                argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
+                job = run_job(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
                 log_path = logs / (str(p).replace("/", "_") + ".log")
-                children.append(Child(str(p), p, starter.fork(argv[3:], log_path), log_path))  # type: ignore[arg-type]
+                children.append(Child(str(p), p, starter.fork(job, log_path), log_path))  # type: ignore[arg-type]
         with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
@@ -806,8 +810,8 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
             for p in cfg.processes() if starter is None else ():
                 if p in external:
                     continue
-                argv = run_argv(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
-                children.append(spawn(str(p), p, argv, logs))
+                job = run_job(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
+                children.append(spawn(str(p), p, run_argv(job), logs))
             if cfg.live >= 0 and announce is not None:
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")

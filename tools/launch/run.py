@@ -13,6 +13,7 @@ Where the match configuration comes from:
 
 from __future__ import annotations
 
+import dataclasses
 import faulthandler
 import json
 import logging
@@ -35,8 +36,86 @@ from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys, process_names
+from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.schemas.messages import Referee
+
+
+class Job(msgspec.Struct, frozen=True, omit_defaults=True):
+    """One process of a match to start: what `arena run` parses its flags into, and what a
+    forked or zygote child of `arena match` gets from the launcher, typed (no argv to parse).
+
+    A field left at None means the flag was not given (`argv` leaves it out)."""
+
+    kind: str  # a process kind, or "router"
+    match: str
+    connect: tuple[str, ...] = ()
+    listen: tuple[str, ...] = ()
+    mode: str | None = None  # zenoh mode: peer (default) | client
+    team: str | None = None
+    robot: int | None = None
+    seed: int | None = None
+    realtime: bool = False
+    config: str | None = None  # the match configuration JSON written by `arena match`
+    credentials: str | None = None
+    startup_timeout: float | None = None
+    log_level: str | None = None
+    record: str | None = None
+    host: str | None = None
+    port: int | None = None
+
+    def argv(self) -> list[str]:
+        """The same job as an `arena` command line: `run <kind> --match ...` (exec'd children, hand-started ones)."""
+        out = ["run", self.kind, "--match", self.match]
+        out += [x for ep in self.connect for x in ("--connect", ep)]
+        out += [x for ep in self.listen for x in ("--listen", ep)]
+        for flag, value in (
+            ("--credentials", self.credentials),
+            ("--team", self.team),
+            ("--robot", self.robot),
+            ("--record", self.record),
+            ("--host", self.host),
+            ("--config", self.config),
+            ("--seed", self.seed),
+            ("--mode", self.mode),
+            ("--startup-timeout", self.startup_timeout),
+            ("--log-level", self.log_level),
+            ("--port", self.port),
+        ):
+            if value is not None:
+                out += [flag, str(value)]
+        return out + (["--realtime"] if self.realtime else [])
+
+
+def start(job: Job, cfg: MatchConfig | None = None) -> int:
+    """Run the process `job` names to the end of its match; the exit code (2 for bad input, one line).
+
+    `cfg`: the match an engine hosts when `job.config` names no file (`arena run engine --home ...`)."""
+    logging.basicConfig(
+        level=job.log_level or "WARNING", format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr
+    )
+    net = NetConfig(mode=job.mode or "peer", connect=job.connect, listen=job.listen)
+    if job.kind == "router":
+        return main_guarded(run_router, job.match, net, job.credentials)
+    keyring = None
+    try:
+        pid = process_id(job.kind, job.team, job.robot)
+        if job.credentials:
+            base, mode, keyring = load_credentials(job.credentials, pid, job.match, wait=10.0)
+            net = dataclasses.replace(net, base=base, mode=mode or net.mode)
+        if job.config:
+            cfg = load_config(job.config)
+        if job.record and job.kind not in ("engine", "recorder"):
+            raise ConfigError(f"--record does not apply to {job.kind}")
+        if job.port is not None and (job.kind != "viewer" or not 0 <= job.port <= 65535):
+            raise ConfigError("--port applies to the viewer only, 0..65535")
+        record = record_path(job.record) if job.record and job.kind == "recorder" else None
+        check_match_id(job.match)
+    except (ConfigError, ValueError) as exc:
+        print(f"arena run: error: {exc}", file=sys.stderr)
+        return 2
+    timeout = job.startup_timeout if job.startup_timeout is not None else 60.0
+    host = job.host or "127.0.0.1"
+    return main_guarded(run, pid, job.match, net, cfg, job.seed, job.realtime, timeout, record, host, job.port, keyring)
 
 
 def _sigterm(signum, frame):

@@ -9,7 +9,7 @@ from the second match on it had to start eleven interpreters again.
 The zygote is forked from such a process *before* it opens zenoh. It imports and
 warms everything (`forkstart.preload`), freezes its heap and then, on request,
 prepares children ahead of time: each is parked, already forked, on a socket of
-its own, until the launcher hands it a job (its `arena run <kind> ...` argv, log
+its own, until the launcher hands it a job (the typed `Job` of `arena run <kind> ...`, log
 file, environment, working directory and the match's release pipe). Launching a
 match is then a few messages; the forking happened during the previous match.
 
@@ -40,7 +40,10 @@ import socket
 import sys
 from pathlib import Path
 
+import msgspec
+
 from arena.tools.launch import forkstart
+from arena.tools.launch.run import Job
 
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36
@@ -131,12 +134,12 @@ class Zygote:
         return taken
 
     @staticmethod
-    def launch(child: tuple[int, socket.socket], argv: list[str], log_path: Path, go_r: int) -> forkstart.ForkedProcess:
-        """Give a parked child its job: `arena <argv>`, logging to `log_path`, started by the release pipe."""
+    def launch(child: tuple[int, socket.socket], job: Job, log_path: Path, go_r: int) -> forkstart.ForkedProcess:
+        """Give a parked child its job, logging to `log_path`, started by the release pipe."""
         pid, sock = child
-        job = {"argv": argv, "log": str(log_path), "cwd": os.getcwd(), "env": dict(os.environ)}
+        msg = {"job": msgspec.to_builtins(job), "log": str(log_path), "cwd": os.getcwd(), "env": dict(os.environ)}
         try:
-            socket.send_fds(sock, [json.dumps(job).encode()], [go_r])
+            socket.send_fds(sock, [json.dumps(msg).encode()], [go_r])
         finally:
             sock.close()
         return forkstart.ForkedProcess(pid)
@@ -210,7 +213,7 @@ def _park_one(ctl: socket.socket, launcher: int) -> None:
 
 
 def _parked(sock: socket.socket, launcher: int) -> None:
-    """A parked child: wait for a job, then become `arena <argv>` (forkstart's child)."""
+    """A parked child: wait for a job, then run it (forkstart's child)."""
     code = 1
     try:
         sock.sendall(b"%d" % os.getpid())
@@ -222,7 +225,7 @@ def _parked(sock: socket.socket, launcher: int) -> None:
         os.chdir(job["cwd"])
         os.environ.clear()
         os.environ.update(job["env"])
-        forkstart._child(job["argv"], Path(job["log"]), fds[0], -1, launcher)
+        forkstart._child(msgspec.convert(job["job"], Job), Path(job["log"]), fds[0], -1, launcher)
     except BaseException:
         pass
     os._exit(code)
