@@ -27,6 +27,7 @@ def parsed(job: Job) -> Job:
         seed=a.seed,
         realtime=a.realtime,
         config=a.config,
+        policy=a.policy,
         credentials=a.credentials,
         startup_timeout=a.startup_timeout,
         log_level=a.log_level,

@@ -56,6 +56,7 @@ class Job(msgspec.Struct, frozen=True, omit_defaults=True):
     seed: int | None = None
     realtime: bool = False
     config: str | None = None  # the match configuration JSON written by `arena match`
+    policy: str | None = None  # this computer's copy of the team's policy file
     credentials: str | None = None
     startup_timeout: float | None = None
     log_level: str | None = None
@@ -75,6 +76,7 @@ class Job(msgspec.Struct, frozen=True, omit_defaults=True):
             ("--record", self.record),
             ("--host", self.host),
             ("--config", self.config),
+            ("--policy", self.policy),
             ("--seed", self.seed),
             ("--mode", self.mode),
             ("--startup-timeout", self.startup_timeout),
@@ -106,6 +108,13 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
             cfg = load_config(job.config)
         if job.record and job.kind not in ("engine", "recorder"):
             raise ConfigError(f"--record does not apply to {job.kind}")
+        policy = None
+        if job.policy:
+            if job.kind not in ("robot", "basestation"):
+                raise ConfigError(f"--policy applies to a robot or a base station, not to {job.kind}")
+            from arena.strategies import registry
+
+            policy = registry.resolve_name(f"policy:{job.policy}")
         if job.port is not None and (job.kind != "viewer" or not 0 <= job.port <= 65535):
             raise ConfigError("--port applies to the viewer only, 0..65535")
         record = record_path(job.record) if job.record and job.kind == "recorder" else None
@@ -115,7 +124,9 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
         return 2
     timeout = job.startup_timeout if job.startup_timeout is not None else 60.0
     host = job.host or "127.0.0.1"
-    return main_guarded(run, pid, job.match, net, cfg, job.seed, job.realtime, timeout, record, host, job.port, keyring)
+    return main_guarded(
+        run, pid, job.match, net, cfg, job.seed, job.realtime, timeout, record, host, job.port, keyring, policy
+    )
 
 
 def _sigterm(signum, frame):
