@@ -51,7 +51,20 @@ SYSTEM_RETRIES = 3  # worker or node deaths Ray absorbs per task (not match fail
 # (15) lets every other process on the machine starve the matches: on the
 # shared 2-core development host it made --ray 1.2-1.9x slower than --jobs 2.
 LOCAL_SYSTEM_CONFIG = {"worker_niceness": 0}
-PACKAGES = ("runtime", "processes", "schemas", "tools", "strategies", "navigation", "sim", "rules", "recording")
+PACKAGES = (
+    "runtime",
+    "processes",
+    "schemas",
+    "tools",
+    "strategies",
+    "navigation",
+    "sim",
+    "rules",
+    "recording",
+    "scenarios",
+    "learn",  # policy:PATH strategies; hashed by path, so the learn extra need not be installed
+    "commands",
+)
 INSTALL_HINT = "--ray needs Ray: pip install 'soccer-arena[cluster]'"
 
 
@@ -158,11 +171,12 @@ def fingerprint() -> dict:
 
 def source_hash() -> str:
     """BLAKE2b of every .py file of the `arena` package that this process imports, by module path."""
-    import importlib
+    import importlib.util
 
     h = hashlib.blake2b(digest_size=8)
     for name in ("arena", *(f"arena.{p}" for p in PACKAGES)):
-        for base in map(Path, importlib.import_module(name).__path__):
+        spec = importlib.util.find_spec(name)  # found, not imported: arena.learn needs its extra to import
+        for base in map(Path, spec.submodule_search_locations if spec else []):
             for f in sorted(base.rglob("*.py")):
                 h.update(f"{name}/{f.relative_to(base)}".encode())
                 h.update(f.read_bytes())
