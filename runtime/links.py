@@ -122,10 +122,12 @@ def parse_override(text: str) -> tuple[str, str, float]:
 class LinkEmulator:
     """Decides, frame by frame and in send order, whether a frame is dropped and how late it is."""
 
-    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "_ideal")
+    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "_ideal", "_changes")
 
-    def __init__(self, model: LinkModel, rng: random.Random):
+    def __init__(self, model: LinkModel, rng: random.Random, changes: tuple[tuple[int, LinkModel], ...] = ()):
+        """`changes`: (tick, model) in tick order: a scenario's link steps (`scheduled`), for frames sent from then on."""
         self.model = model
+        self._changes = list(changes)
         self._rng = rng
         self._bad = False
         self._ideal = model.is_ideal()
@@ -133,8 +135,11 @@ class LinkEmulator:
         self.dropped = 0
         self.delays_ms: list[float] = []  # drawn delays of delivered frames (non-ideal links)
 
-    def decide(self) -> float | None:
-        """Delay in ms for the next frame, or None if it is lost."""
+    def decide(self, tick: int = -1) -> float | None:
+        """Delay in ms for the next frame (sent at `tick`), or None if it is lost."""
+        if self._changes and tick >= self._changes[0][0]:
+            self.model = self._changes.pop(0)[1]
+            self._ideal = self.model.is_ideal()
         self.frames += 1
         if self._ideal:
             return 0.0  # no delay statistics to keep: every delay is 0
@@ -152,3 +157,15 @@ class LinkEmulator:
         delay = m.latency_ms + (self._rng.expovariate(1.0 / m.jitter_ms) if m.jitter_ms > 0 else 0.0)
         self.delays_ms.append(delay)
         return delay
+
+
+def scheduled(cfg, link_class: str) -> tuple[tuple[int, LinkModel], ...]:
+    """A scenario's link changes for `link_class` (`SetLink` steps of `cfg.scenario`), as (tick, model)."""
+    from arena.schemas.messages import SetLink
+
+    out = []
+    for step in cfg.scenario.steps:
+        for a in step.actions:
+            if isinstance(a, SetLink) and step.at >= 0:
+                out.append((step.at, resolve(a.preset, a.overrides)[link_class]))
+    return tuple(sorted(out, key=lambda c: c[0]))

@@ -391,7 +391,7 @@ class Inbound(Generic[M]):
         if msg is not None:
             self._prev = msg
         self.last_seen = tick
-        delay = self.emulator.decide()
+        delay = self.emulator.decide(tick)
         if delay is None:
             self._dropped_ticks.append(tick)
             return True

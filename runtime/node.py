@@ -34,7 +34,7 @@ from arena.runtime import seeds
 from arena.runtime.clock import MONOTONIC, Clock
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.drivers import Driver, Pull, Reactor, Wait, own_cpu_s
-from arena.runtime.links import IDEAL, LinkEmulator, resolve
+from arena.runtime.links import IDEAL, LinkEmulator, resolve, scheduled
 from arena.runtime.lockstep import Inbound, Latest, Outbound, Rejections, Schedule, Waits
 from arena.runtime.mac import Keyring
 from arena.runtime.stats import percentile
@@ -359,7 +359,8 @@ class Node(Peer):
         sender = spec.sender_id(team, n)
         key = self.keys.key(name, team, n)
         model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
-        emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name))
+        changes = () if ideal or not self.cfg.scenario.steps else scheduled(self.cfg, spec.link_class)
+        emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name), changes)
         verify = self.keyring.verifier(sender, key) if self.keys.rel(key) in SIGNED_DATA else None
         on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {sender}")
         ib: Inbound[Any] = Inbound(

@@ -30,7 +30,8 @@ from arena.runtime.config import (
     RulesParams,
     ScenarioParams,
 )
-from arena.schemas.messages import Condition, RefereeOverride, Region, Step, TeleportBall, TeleportRobot
+from arena.runtime.links import resolve
+from arena.schemas.messages import Condition, RefereeOverride, Region, SetLink, Step, TeleportBall, TeleportRobot
 from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
 from arena.strategies import registry
 
@@ -111,9 +112,15 @@ class When(Spec):
     possession: str = ""
 
 
+class LinkSpec(Spec):
+    preset: str
+    overrides: dict[str, dict[str, float]] = {}
+
+
 class StepSpec(Spec):
     at: float | None = None
     when: When | None = None
+    link: LinkSpec | None = None
     ball: BallSpec | None = None
     robots: list[RobotSpec] = []
     referee: RefereeSpec | None = None
@@ -252,9 +259,8 @@ def start_steps(st: Start, robots: int, where: str) -> list[Step]:
     return [Step(at=0, actions=actions)]
 
 
-def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
-    if (s.at is None) == (s.when is None):
-        raise ValueError(f"{where}: give exactly one of `at` (seconds) and `when` (a condition)")
+def step_actions(s: StepSpec, robots: int, where: str) -> list:
+    """What a step does, in a fixed order: robots, parked robots, the ball, the referee, the links."""
     actions: list = [robot_action(r, robots, f"{where}.robots[{i}]") for i, r in enumerate(s.robots)]
     for i, name in enumerate(s.park):
         team, n = robot_id(name, robots, f"{where}.park[{i}]")
@@ -265,30 +271,48 @@ def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
         if s.at is None:
             raise ValueError(f"{where}.referee: a referee command needs `at`; the referee does not see `when`")
         actions.append(referee_action(s.referee, robots, f"{where}.referee"))
+    if s.link is not None:
+        if s.at is None:
+            raise ValueError(f"{where}.link: a link change needs `at`; every receiver applies it at that tick")
+        try:
+            resolve(s.link.preset, s.link.overrides)
+        except ConfigError as exc:
+            raise ValueError(f"{where}.link: {exc}") from None
+        actions.append(SetLink(preset=s.link.preset, overrides=s.link.overrides))
     if not actions:
-        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee or park)")
-    if s.at is not None:
-        if not (math.isfinite(s.at) and s.at >= 0):
-            raise ValueError(f"{where}.at: seconds >= 0, got {s.at}")
-        return Step(at=int(round(s.at / dt)), actions=actions)
-    w = s.when
-    assert w is not None
+        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee, park or link)")
+    return actions
+
+
+def condition(w: When, robots: int, where: str) -> Condition:
     if w.robot_in is not None:
-        robot_id(w.robot, robots, f"{where}.when.robot")
+        robot_id(w.robot, robots, f"{where}.robot")
     if w.command and w.command not in REF_COMMANDS:
-        raise ValueError(f"{where}.when.command: {w.command!r} is not an MSL RefBox command")
+        raise ValueError(f"{where}.command: {w.command!r} is not an MSL RefBox command")
     if w.possession not in ("a", "b", ""):
-        raise ValueError(f"{where}.when.possession: {w.possession!r} (a or b)")
+        raise ValueError(f"{where}.possession: {w.possession!r} (a or b)")
     cond = Condition(
-        ball_in=region(w.ball_in, f"{where}.when.ball_in"),
+        ball_in=region(w.ball_in, f"{where}.ball_in"),
         robot=w.robot,
-        robot_in=region(w.robot_in, f"{where}.when.robot_in"),
+        robot_in=region(w.robot_in, f"{where}.robot_in"),
         command=w.command,
         possession=w.possession,
     )
     if cond == Condition():
-        raise ValueError(f"{where}.when: an empty condition")
-    return Step(at=-1, when=cond, actions=actions)
+        raise ValueError(f"{where}: an empty condition")
+    return cond
+
+
+def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
+    if (s.at is None) == (s.when is None):
+        raise ValueError(f"{where}: give exactly one of `at` (seconds) and `when` (a condition)")
+    actions = step_actions(s, robots, where)
+    if s.at is not None:
+        if not (math.isfinite(s.at) and s.at >= 0):
+            raise ValueError(f"{where}.at: seconds >= 0, got {s.at}")
+        return Step(at=int(round(s.at / dt)), actions=actions)
+    assert s.when is not None
+    return Step(at=-1, when=condition(s.when, robots, f"{where}.when"), actions=actions)
 
 
 def check_rules(p: Play, where: str) -> None:

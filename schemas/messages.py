@@ -379,7 +379,17 @@ class RefereeOverride(Base, tag="referee"):
     robot: Annotated[int, Meta(description="cards and REPAIR_OUT: the robot's number; else -1")] = -1
 
 
-Action = TeleportBall | TeleportRobot | RefereeOverride
+class SetLink(Base, tag="link"):
+    """Change the emulated links (runtime/links.py) for every frame sent from this tick on, at every receiver."""
+
+    preset: Annotated[str, Meta(description="link preset: ideal, lan, wifi, congested-wifi")]
+    overrides: Annotated[
+        dict[str, dict[str, float]],
+        Meta(description="per link class (sensor, wifi, wired), LinkModel parameters to change"),
+    ] = {}
+
+
+Action = TeleportBall | TeleportRobot | RefereeOverride | SetLink
 
 
 class Region(Base):

@@ -39,7 +39,7 @@ class ScriptedLink(LinkEmulator):
         super().__init__(LinkModel(latency_ms=1.0), random.Random(0))
         self.script = iter(delays_ms)
 
-    def decide(self):
+    def decide(self, tick: int = -1):
         self.frames += 1
         return next(self.script)
 

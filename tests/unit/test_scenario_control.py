@@ -147,3 +147,28 @@ def test_by_force_pushes_a_robot_from_where_it_stands():
     before, after = robot(at[9], "b", 2), robot(at[10], "b", 2)
     assert (after.x, after.y) == (before.x, before.y), "no jump"
     assert after.vy < -2.0 and abs(after.vx) < abs(after.vy), "moving towards the target"
+
+
+def test_a_link_step_changes_every_receiver_s_links_from_its_tick_on():
+    from arena.schemas.messages import SetLink
+
+    start = Step(at=0, actions=[RefereeOverride(command="START")])
+    lossy = SetLink(preset="wifi", overrides={"wifi": {"loss_good": 0.5}, "sensor": {"loss_good": 0.5}})
+    plain, _, _ = play((start,), ticks=100)
+    late, _, _ = play((start, Step(at=10_000, actions=[lossy])), ticks=100)
+    changed, _, _ = play((start, Step(at=50, actions=[lossy])), ticks=100)
+    assert {k: s.digest for k, s in late.items()} == {k: s.digest for k, s in plain.items()}, (
+        "no effect before its tick"
+    )
+    assert changed["engine"].digest != plain["engine"].digest
+    dropped = sum(s.links.get("wifi", {}).get("dropped", 0) for s in changed.values())
+    assert dropped > 0 and sum(s.links.get("wifi", {}).get("dropped", 0) for s in plain.values()) == 0
+
+
+def test_the_link_emulator_switches_models_at_the_tick():
+    import random
+
+    from arena.runtime.links import LinkEmulator, LinkModel
+
+    e = LinkEmulator(LinkModel(), random.Random(1), changes=((5, LinkModel(loss_good=1.0)),))
+    assert [e.decide(k) for k in range(8)] == [0.0] * 5 + [None] * 3
