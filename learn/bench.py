@@ -7,16 +7,18 @@ fixed pre-drawn actions, one step per tick, reset included). CPU seconds are
 this process's (`time.process_time`), so a loaded host slows both sides alike;
 the ratios are the figures to compare. Then the vector env: `SoccerEnv`s in 1
 and in 2 worker processes (`AsyncVectorEnv`), stepped for the same number of
-steps each; its figure is wall-clock steps per second, since it is about cores.
+steps each: wall-clock steps per second, since it is about cores (a loaded host
+distorts it), and CPU per step of the workers and this process together beside
+one env's in one process (what the worker processes cost, whatever the load).
 """
 
 from __future__ import annotations
 
 import json
 import os
-import resource
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -62,8 +64,7 @@ def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame
     """`workers` SoccerEnvs in their own processes, `steps` vector steps after 20 to warm up.
 
     Returns (wall-clock env steps per second, CPU-seconds per env step of this process and the workers
-    together, forking and every reset included)."""
-    cpu0 = time.process_time() + _children_cpu()
+    together), both over the measured steps only: the workers' start and first match are left out."""
     venv = make_vector_env(
         workers, robot="a/1", home=strategy, away=strategy, half_time=half_time, frame_skip=frame_skip
     )
@@ -72,20 +73,23 @@ def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame
         batch = np.repeat(ACTIONS[:1], workers, axis=0)
         for _ in range(20):  # warm up: the workers are forked and their first match built
             venv.step(batch)
+        pids = [p.pid for p in venv.processes]
+        cpu0 = time.process_time() + sum(_proc_cpu(p) for p in pids)
         t0 = time.perf_counter()
         for i in range(steps):
             batch[:] = ACTIONS[i % len(ACTIONS)]
             venv.step(batch)
         wall = time.perf_counter() - t0
+        cpu = time.process_time() + sum(_proc_cpu(p) for p in pids) - cpu0
     finally:
-        venv.close()  # joins the workers: their CPU time is counted from here
-    cpu = time.process_time() + _children_cpu() - cpu0
-    return workers * steps / wall, cpu / (workers * (steps + 20))
+        venv.close()
+    return workers * steps / wall, cpu / (workers * steps)
 
 
-def _children_cpu() -> float:
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
+def _proc_cpu(pid: int) -> float:
+    """[s] user + system CPU time of process `pid` so far (Linux /proc; clock ticks of 10 ms)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def bench_learn(

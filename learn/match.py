@@ -121,7 +121,10 @@ class SteppedMatch:
 
     @property
     def over(self) -> bool:
-        return all(t.done for t in self.learner_tasks.values())
+        for t in self.learner_tasks.values():
+            if not t.done:
+                return False
+        return True
 
     def advance(self) -> None:
         """Play until every learner waits at its gate or has ended; then read the referee and the ball."""

@@ -219,7 +219,12 @@ def to_cmd(tick: int, action: Any, v: View, discrete: bool = False) -> Cmd:
     """The `Cmd` for an action: vx, vy [m/s] = a0, a1 x max_speed (body frame), omega = a2 x max_omega,
     kick_speed = max(0, a3) x kick_max_speed; each clipped to [-1, 1] first. The dribbler is always on."""
     a = DISCRETE[int(action)][1] if discrete else action
-    vx, vy, om, kick = (min(1.0, max(-1.0, float(x))) for x in a[:4])
+    if isinstance(a, np.ndarray):
+        a = a.tolist()  # Python floats, exactly the array's values (float32 widens without rounding)
+    vx = min(1.0, max(-1.0, float(a[0])))
+    vy = min(1.0, max(-1.0, float(a[1])))
+    om = min(1.0, max(-1.0, float(a[2])))
+    kick = min(1.0, max(-1.0, float(a[3])))
     return Cmd(
         tick=tick,
         vx=vx * v.max_speed,
