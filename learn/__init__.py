@@ -15,6 +15,7 @@ except ImportError:
 from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.rewards import GoalReward, Outcome
 from arena.learn.single import SoccerEnv, make_vector_env
+from arena.learn.vector import SoccerVectorEnv
 from arena.strategies.learned import (
     DISCRETE,
     LinearPolicy,
@@ -32,6 +33,7 @@ __all__ = [
     "RecordedActions",
     "SoccerEnv",
     "SoccerParallelEnv",
+    "SoccerVectorEnv",
     "load_policy",
     "make_vector_env",
     "obs_fields",

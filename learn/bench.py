@@ -6,24 +6,27 @@ ways, interleaved: as an in-process match (`--engine inprocess`), and as a
 fixed pre-drawn actions, one step per tick, reset included). CPU seconds are
 this process's (`time.process_time`), so a loaded host slows both sides alike;
 the ratios are the figures to compare. Then the vector env: `SoccerEnv`s in 1
-and in 2 worker processes (`AsyncVectorEnv`), stepped for the same number of
+and in 2 worker processes (`SoccerVectorEnv`), stepped for the same number of
 steps each: wall-clock steps per second, since it is about cores (a loaded host
 distorts it), and CPU per step of the workers and this process together beside
-one env's in one process (what the worker processes cost, whatever the load).
+one env's in one process (what the worker processes cost, whatever the load),
+and Gymnasium's `AsyncVectorEnv`'s for comparison.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import statistics
 import time
 from pathlib import Path
 
+import gymnasium
 import numpy as np
 
 from arena.learn.parallel import SoccerParallelEnv
-from arena.learn.single import make_vector_env
+from arena.learn.single import SoccerEnv, make_vector_env
 from arena.runtime.config import MatchConfig
 from arena.tools.console import console as make_console
 from arena.tools.launch.inprocess import play_in_process
@@ -60,14 +63,18 @@ def env_rate(cfg: MatchConfig, agents: list[str], frame_skip: int = 1) -> float:
     return n / (time.process_time() - t0)
 
 
-def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1):
+def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1, gym: bool = False):
     """`workers` SoccerEnvs in their own processes, `steps` vector steps after 20 to warm up.
 
     Returns (wall-clock env steps per second, CPU-seconds per env step of this process and the workers
-    together), both over the measured steps only: the workers' start and first match are left out."""
-    venv = make_vector_env(
-        workers, robot="a/1", home=strategy, away=strategy, half_time=half_time, frame_skip=frame_skip
-    )
+    together), both over the measured steps only: the workers' start and first match are left out.
+    `gym`: Gymnasium's `AsyncVectorEnv` instead of `SoccerVectorEnv`."""
+    options = dict(robot="a/1", home=strategy, away=strategy, half_time=half_time, frame_skip=frame_skip)
+    if gym:
+        fns = [functools.partial(SoccerEnv, **options) for _ in range(workers)]
+        venv = gymnasium.vector.AsyncVectorEnv(fns, context="fork")
+    else:
+        venv = make_vector_env(workers, **options)
     try:
         venv.reset(seed=0)
         batch = np.repeat(ACTIONS[:1], workers, axis=0)
@@ -110,6 +117,7 @@ def bench_learn(
     for skip in (1, 5):
         console.print(f"vector env, frame_skip {skip}: 1 worker, then 2, {steps // skip} steps each ...")
         vec[skip] = [vector_rate(w, steps // skip, half_time, strategy, skip) for w in (1, 2)]
+    gym = vector_rate(1, steps, half_time, strategy, 1, gym=True)
     in_process = {
         1: med["env1"],
         5: env_rate(MatchConfig(seed=500, home=strategy, away=strategy, half_time=half_time), ["a/1"], 5),
@@ -129,6 +137,8 @@ def bench_learn(
         # frame_skip -> [1 worker, 2 workers] wall-clock env steps per second, and their ratio
         "vector_steps_per_second": {str(k): [round(v[0][0], 1), round(v[1][0], 1)] for k, v in vec.items()},
         "vector_ratio": {str(k): round(v[1][0] / v[0][0], 3) for k, v in vec.items()},
+        # Gymnasium's AsyncVectorEnv, 1 worker, frame_skip 1: wall steps per second, CPU microseconds per step
+        "gymnasium_async_1_worker": [round(gym[0], 1), round(1e6 * gym[1], 1)],
         # frame_skip -> [1 worker, 2 workers, one env in this process] CPU microseconds per env step
         "cpu_us_per_step": {
             str(k): [round(1e6 * v[0][1], 1), round(1e6 * v[1][1], 1), round(1e6 / in_process[k], 1)]
@@ -151,5 +161,6 @@ def bench_learn(
             f"{v2 / v1:.2f} x (target >= 1.8 on 2 idle cores); CPU per step: {c1:.0f} us with 1 worker, "
             f"{c2:.0f} us with 2, {c0:.0f} us in one process"
         )
+    print(f"gymnasium AsyncVectorEnv, 1 worker: CPU per step {1e6 * gym[1]:.0f} us")
     print(f"host: {out['cpus']} cpus, 1-minute load average {out['loadavg_1min']}")
     return 0

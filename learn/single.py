@@ -40,10 +40,12 @@ class SoccerEnv(gymnasium.Env):
 
 
 def make_vector_env(n: int, asynchronous: bool = True, **options: Any) -> gymnasium.vector.VectorEnv:
-    """`n` `SoccerEnv`s with these options, each in its own worker process (`asynchronous`), or in this one.
+    """`n` `SoccerEnv`s with these options, each in its own worker process (`asynchronous`: a
+    `SoccerVectorEnv`, arena.learn.vector), or all in this one (Gymnasium's `SyncVectorEnv`).
 
     `reset(seed=s)` seeds them s, s + 1, ..., s + n - 1."""
-    fns = [partial(SoccerEnv, **options) for _ in range(n)]
     if asynchronous:
-        return gymnasium.vector.AsyncVectorEnv(fns, context="fork")
-    return gymnasium.vector.SyncVectorEnv(fns)
+        from arena.learn.vector import SoccerVectorEnv
+
+        return SoccerVectorEnv(n, **options)
+    return gymnasium.vector.SyncVectorEnv([partial(SoccerEnv, **options) for _ in range(n)])

@@ -107,6 +107,33 @@ def test_the_vector_env_steps_its_workers_with_their_own_seeds():
     venv.close()
 
 
+def test_the_vector_env_in_worker_processes_plays_what_the_envs_play_here():
+    """Two workers through shared memory against two SoccerEnvs in this process, autoresets included."""
+    opts = dict(robot="a/1", home="AD", away="BS", half_time=0.3)
+    venv = make_vector_env(2, **opts)
+    here = [SoccerEnv(**opts) for _ in range(2)]
+    try:
+        obs, _ = venv.reset(seed=4)
+        for i, env in enumerate(here):
+            assert np.array_equal(obs[i], env.reset(seed=4 + i)[0])
+        rng = np.random.default_rng(0)
+        ends = 0
+        for t in range(70):  # 31 steps an episode: two autoresets each
+            act = rng.uniform(-1, 1, (2, 4)).astype(np.float32)
+            obs, rew, term, trunc, info = venv.step(act)
+            for i, env in enumerate(here):
+                o, r, te, tr, _ = env.step(act[i])
+                if te or tr:
+                    ends += 1
+                    assert info["_final_obs"][i] and np.array_equal(info["final_obs"][i], o), f"step {t}"
+                    o, _ = env.reset()
+                assert np.array_equal(obs[i], o) and (rew[i], term[i], trunc[i]) == (r, te, tr), f"step {t}, env {i}"
+        assert ends == 4
+    finally:
+        venv.close()
+    assert not any(p.is_alive() for p in venv.processes)
+
+
 def test_without_the_extra_the_import_names_it_in_one_line():
     code = "import sys; sys.modules['pettingzoo'] = None; import arena.learn"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
