@@ -139,7 +139,7 @@ def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: 
 
 
 def combined_digest(cfg, digests: dict[str, str]) -> str:
-    """The match digest of `arena match --json` (tools/launch/launcher.py `assemble`): every process's, in order."""
+    """The match digest of `arena match --json` (tools/launch/result.py `assemble`): every process's, in order."""
     combined = hashlib.blake2b(digest_size=16)
     for p in cfg.processes():
         name = str(p)
@@ -170,8 +170,8 @@ def _processes(sc: Scenario, seed: int, record: str):
         rec = load(path, keep={"world", "referee"})
         worlds = rec.decoded("world", World)
         referees = rec.decoded("referee", Referee)
-    digests = {k: v for k, v in result["process_digests"].items() if k != "recorder"}
-    return worlds, referees, digests, result["digest"]
+    digests = {k: v for k, v in result.process_digests.items() if k != "recorder"}
+    return worlds, referees, digests, result.digest
 
 
 def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:

@@ -7,9 +7,12 @@ import argparse
 import json
 import math
 import sys
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from arena.runtime.config import MAX_HALF_TIME
+
+if TYPE_CHECKING:
+    from arena.tools.launch.result import MatchResult
 
 
 class Parser(argparse.ArgumentParser):
@@ -105,7 +108,7 @@ def one_line(text: str) -> str:
     return f"{head} {tail[-1]}; {last}" if tail else f"{head.rstrip(':')}; {last}"
 
 
-def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
+def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> int:
     """Print a match result (arena match, arena up): one JSON object, or the tables.
 
     Faults and keys with two senders are also printed on stderr, one line
@@ -114,6 +117,7 @@ def emit_match(result: dict, as_json: bool, prog: str = "arena match") -> int:
     from arena.tools.launch import faults
     from arena.tools.review import report
 
+    result = match.to_dict()
     if as_json:
         result.pop("referee_log", None)
         print(json.dumps(result, indent=2))

@@ -95,6 +95,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from arena.tools.launch import launcher
+    from arena.tools.launch.children import JoinError, MatchError
 
     cfg, record = full_config(args)
     if args.engine == "inprocess":
@@ -116,9 +117,9 @@ def run(args: argparse.Namespace) -> int:
             credentials=args.credentials,
             record=record,
         )
-    except launcher.MatchError as exc:
+    except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
-        return 2 if isinstance(exc, launcher.JoinError) else 1
+        return 2 if isinstance(exc, JoinError) else 1
     return emit_match(result, args.json)
 
 

@@ -23,7 +23,7 @@ PLAYER = textwrap.dedent(
         if launch == "exec":
             os.environ["ARENA_LAUNCH"] = "exec"
         cfg = MatchConfig(seed=7, home="AD", away="BS", robots=3, half_time=1.0)
-        r = launcher.play_match(cfg)
+        r = launcher.play_match(cfg).to_dict()
         out.append({k: r[k] for k in ("launch", "digest", "process_digests", "outcome", "startup_seconds")})
         out[-1]["pids"] = sorted(p["pid"] for p in r["processes"] if p["pid"])
     print(json.dumps({"zygote": z.pid, "matches": out}))

@@ -25,7 +25,7 @@ class QuitsAtTick20(RobotNode):
 def test_a_node_that_stops_sending_is_a_detected_deadlock_and_the_match_goes_on(monkeypatch):
     monkeypatch.setattr(inprocess, "node_class", lambda kind: QuitsAtTick20 if kind == "robot" else node_class(kind))
     threads = threading.active_count()
-    result = inprocess.play_match(MatchConfig(seed=4, half_time=2.0))
+    result = inprocess.play_match(MatchConfig(seed=4, half_time=2.0)).to_dict()
     assert threading.active_count() == threads, "no thread was started"
     assert result["ticks"] == 200, "the match was played to its end"
     assert result["deadlocks"] and "robot/b/1" in result["deadlocks"][0]
@@ -33,7 +33,7 @@ def test_a_node_that_stops_sending_is_a_detected_deadlock_and_the_match_goes_on(
 
 
 def test_a_clean_match_has_no_deadlock_and_one_pid():
-    r = inprocess.play_match(MatchConfig(seed=4, half_time=1.0))
+    r = inprocess.play_match(MatchConfig(seed=4, half_time=1.0)).to_dict()
     assert r["deadlocks"] == [] and r["dead"] == [] and r["engine"] == "inprocess"
     assert len({p["pid"] for p in r["processes"]}) == 1
 

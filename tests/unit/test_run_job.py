@@ -7,8 +7,7 @@ import msgspec
 import pytest
 
 from arena.runtime.config import ProcessId
-from arena.tools.launch.launcher import run_job
-from arena.tools.launch.run import Job
+from arena.tools.launch.run import Job, run_job
 
 
 def parsed(job: Job) -> Job:

@@ -31,7 +31,7 @@ def bench_match(
     for i in range(runs):
         cfg = MatchConfig(seed=1000 + i, robots=robots, half_time=half_time, link=link)
         console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, {robots}v{robots}, link {link} ...")
-        r = launcher.play_match(cfg)
+        r = launcher.play_match(cfg).to_dict()
         results.append(r)
         console.print(
             f"  rtf {r['rtf']:.1f}x, {1000 * r['play_wall_seconds'] / max(1, r['ticks']):.3f} ms/tick, "
@@ -103,7 +103,7 @@ def bench_record(
             # Alternate which goes first, so that drift in the machine's load favours neither.
             order = [(False, ""), (True, str(path))]
             for rec, record in order if i % 2 == 0 else reversed(order):
-                r = launcher.play_match(base, record=record)
+                r = launcher.play_match(base, record=record).to_dict()
                 (recorded if rec else plain).append(r)
                 console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
             sizes.append(path.stat().st_size)

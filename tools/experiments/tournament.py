@@ -743,7 +743,7 @@ def _worker_init() -> None:
 def _play_inprocess(cfg) -> dict:
     from arena.tools.launch.inprocess import play_match
 
-    return play_match(cfg)
+    return play_match(cfg).to_dict()
 
 
 def default_jobs() -> int:

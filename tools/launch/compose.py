@@ -29,7 +29,10 @@ from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.tools.launch import launcher
+from arena.tools.launch.children import Child, MatchError, spawn, stop_all
+from arena.tools.launch.result import assemble
 from arena.tools.launch.run import load_credentials
+from arena.tools.launch.supervise import Progress, open_collector, supervise
 
 MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
 
@@ -122,21 +125,21 @@ def up(path: str, timeout: float = 600.0) -> dict:
     routers = [n for n, argv in services.items() if _process_of(argv) is None]
     if len(routers) != 1:
         raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
-    children: list[launcher.Child] = []
+    children: list[Child] = []
     keep = False  # a failed match keeps the services' logs (and says where); bad input leaves nothing behind
     try:
         router = routers[0]
-        children.append(launcher.spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
+        children.append(spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
         _wait_for_socket(sock, children[0])
         net, keyring = _collector_net(env, router_argv=services[router], match=match)
         with open_session(net) as session:
             transport = ZenohTransport(session, keyring)
             keys = Keys(match)
             # The configuration (how many robots) comes from the engine later: listen for any.
-            collector = launcher.open_collector(transport, keys, process_names(MAX_ROBOTS))
+            collector = open_collector(transport, keys, process_names(MAX_ROBOTS))
             for name, argv in services.items():
                 if name != router:
-                    children.append(launcher.spawn(name, _process_of(argv), _argv(argv), tmp, env=env))
+                    children.append(spawn(name, _process_of(argv), _argv(argv), tmp, env=env))
             cfg = _fetch(transport, keys, children)
             print(
                 f"arena up: {cfg.home} (a) vs {cfg.away} (b), 2 x {cfg.half_time:g} s simulated, seed {cfg.seed}, "
@@ -156,23 +159,23 @@ def up(path: str, timeout: float = 600.0) -> dict:
             for c in named:
                 c.name = str(c.pid)
             try:
-                got = launcher.supervise(
+                got = supervise(
                     transport,
                     collector,
                     keys,
                     cfg,
                     named,
                     [str(p) for p in cfg.processes()],
-                    launcher.Progress(cfg.total_ticks, False),
+                    Progress(cfg.total_ticks, False),
                     timeout=timeout,
                 )
-            except launcher.MatchError as exc:
+            except MatchError as exc:
                 raise ComposeError(str(exc)) from None
             finally:
                 transport.close()
-        result = launcher.assemble(cfg, got, time.monotonic() - t_start, children)
-        result["services"] = list(services)
-        result["secure"] = "--credentials" in services[router]
+        result = assemble(cfg, got, time.monotonic() - t_start, {c.name: c.popen.pid for c in children})
+        result.services = list(services)
+        result.secure = "--credentials" in services[router]
         return result
     except ComposeError as exc:
         if exc.bad_input:
@@ -180,7 +183,7 @@ def up(path: str, timeout: float = 600.0) -> dict:
         keep = True
         raise ComposeError(f"{exc}\nevery service's log is kept in {tmp}") from None
     finally:
-        launcher.stop_all(children)
+        stop_all(children)
         if not keep:
             shutil.rmtree(tmp, ignore_errors=True)
 
@@ -204,7 +207,7 @@ def _argv(argv: list[str]) -> list[str]:
     return [sys.executable, "-m", "arena", *argv[1:]]
 
 
-def _wait_for_socket(sock: Path, router: launcher.Child, limit: float = 30.0) -> None:
+def _wait_for_socket(sock: Path, router: Child, limit: float = 30.0) -> None:
     deadline = time.monotonic() + limit
     while not sock.exists():
         if router.popen.poll() is not None:
@@ -214,7 +217,7 @@ def _wait_for_socket(sock: Path, router: launcher.Child, limit: float = 30.0) ->
         time.sleep(0.05)
 
 
-def _fetch(transport: ZenohTransport, keys: Keys, children: list[launcher.Child]) -> MatchConfig:
+def _fetch(transport: ZenohTransport, keys: Keys, children: list[Child]) -> MatchConfig:
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline:
         for c in children:

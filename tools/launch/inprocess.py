@@ -20,6 +20,7 @@ from __future__ import annotations
 import gc
 import os
 import time
+from typing import TYPE_CHECKING
 
 from arena.processes import node_class
 from arena.runtime import coop
@@ -27,6 +28,9 @@ from arena.runtime.config import MatchConfig
 from arena.runtime.coop import CoopBus, NodeFailed, Task
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
+
+if TYPE_CHECKING:
+    from arena.tools.launch.result import MatchResult
 
 ENGINE = "inprocess"
 LOCKSTEP_KINDS = {"engine", "referee", "basestation", "robot", "recorder"}  # what this engine can host
@@ -95,9 +99,9 @@ def play_in_process(
     return summaries, frames
 
 
-def play_match(cfg: MatchConfig, record: str = "") -> dict:
-    """Play one match in-process and return the result dict of `arena match --json`; `record`: an MCAP path."""
-    from arena.tools.launch.launcher import Collected, assemble
+def play_match(cfg: MatchConfig, record: str = "") -> MatchResult:
+    """Play one match in-process and return the result of `arena match --json`; `record`: an MCAP path."""
+    from arena.tools.launch.result import Collected, assemble
 
     if cfg.realtime:
         raise InprocessError("--engine inprocess plays in lockstep only (no --realtime)")
@@ -111,11 +115,11 @@ def play_match(cfg: MatchConfig, record: str = "") -> dict:
     summaries, _, play, deadlocks, quit_early = _play(cfg, watch=(), record=record)
     lost = {name: "its loop ended while others still waited for it" for name in quit_early}
     got = Collected(summaries=summaries, started=0.0, ended=play, lost=lost)
-    result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, [], record=record)
-    result["engine"] = ENGINE
-    result["startup_seconds"] = round(summaries["engine"].extra["play_started"] - launched, 3)
-    result["launch"] = ENGINE
-    result["play_started_unix"] = summaries["engine"].extra["play_started"]
-    result["pid"] = os.getpid()
-    result["deadlocks"] = deadlocks
+    result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, record=record)
+    result.engine = ENGINE
+    result.startup_seconds = round(summaries["engine"].extra["play_started"] - launched, 3)
+    result.launch = ENGINE
+    result.play_started_unix = summaries["engine"].extra["play_started"]
+    result.pid = os.getpid()
+    result.deadlocks = deadlocks
     return result

@@ -88,6 +88,29 @@ class Job(msgspec.Struct, frozen=True, omit_defaults=True):
         return out + (["--realtime"] if self.realtime else [])
 
 
+def run_job(
+    pid: ProcessId,
+    match: str,
+    connect: str,
+    config_path: str | None = None,
+    record: str = "",
+    host: str = "",
+    credentials: str | None = None,
+) -> Job:
+    """The job of one of the match's processes (forked, or exec'd as `arena run ...`)."""
+    return Job(
+        kind=pid.kind,
+        match=match,
+        connect=(connect,),
+        credentials=credentials or None,
+        team=pid.team or None,
+        robot=pid.robot if pid.kind == "robot" else None,
+        record=record if pid.kind == "recorder" and record else None,
+        host=host if pid.kind == "viewer" and host else None,
+        config=config_path or None,
+    )
+
+
 def start(job: Job, cfg: MatchConfig | None = None) -> int:
     """Run the process `job` names to the end of its match; the exit code (2 for bad input, one line).
 

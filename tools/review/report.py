@@ -66,7 +66,7 @@ def print_match(result: dict, console: Console | None = None) -> None:
             f"{ignored} ignored, {fo['errors']} malformed"
         )
     rec = result.get("recording")
-    if rec and "error" in rec:  # no recorder Summary (tools/launch/launcher.py)
+    if rec and "error" in rec:  # no recorder Summary (tools/launch/result.py)
         console.print(f"[red]not recorded[/]: {rec['error']} ({rec['path']})")
     elif rec:
         state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"

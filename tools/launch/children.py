@@ -1,0 +1,85 @@
+"""The OS processes of a match the launcher starts: exec'd (`spawn`) or forked
+(tools/launch/forkstart.py), each a `Child` with its log; stopped together."""
+
+from __future__ import annotations
+
+import ctypes
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from arena.runtime.config import ProcessId
+from arena.tools.launch.run import Job
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """Runs in the child before exec: SIGKILL it if the launcher dies."""
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    except OSError:
+        pass
+
+
+class MatchError(RuntimeError):
+    """The match could not be played to the end; the message says why."""
+
+
+class JoinError(MatchError):
+    """An `--external` process never joined (a user's or a network's matter: exit 2)."""
+
+
+@dataclass
+class Child:
+    name: str
+    pid: ProcessId
+    popen: subprocess.Popen
+    log_path: Path
+
+    def tail(self, lines: int = 8) -> str:
+        try:
+            text = self.log_path.read_text(errors="replace").rstrip().splitlines()
+        except OSError:
+            return ""
+        return "\n".join("    " + line for line in text[-lines:])
+
+
+def run_argv(job: Job) -> list[str]:
+    """`python -m arena run ...`: the command that runs `job` in a fresh interpreter."""
+    return [sys.executable, "-m", "arena", *job.argv()]
+
+
+def spawn(name: str, pid: ProcessId, argv: list[str], log_dir: Path, env: dict[str, str] | None = None) -> Child:
+    log_path = log_dir / (name.replace("/", "_") + ".log")
+    fh = open(log_path, "wb")
+    try:
+        popen = subprocess.Popen(
+            argv,
+            stdin=subprocess.DEVNULL,
+            stdout=fh,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # Ctrl-C reaches the launcher only; it stops the group
+            preexec_fn=_die_with_parent,
+            env=env,
+        )
+    finally:
+        fh.close()
+    return Child(name, pid, popen, log_path)
+
+
+def stop_all(children: list[Child], grace: float = 3.0) -> None:
+    for c in children:
+        if c.popen.poll() is None:
+            c.popen.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + grace
+    for c in children:
+        left = max(0.0, deadline - time.monotonic())
+        try:
+            c.popen.wait(timeout=left)
+        except subprocess.TimeoutExpired:
+            c.popen.kill()
+            c.popen.wait()

@@ -1,0 +1,205 @@
+"""The result of one match, either engine: what `arena match --json` prints.
+
+`assemble` builds a `MatchResult` out of the processes' `Summary`s (and what
+the launcher saw of them, `Collected`); `MatchResult.to_dict()` is the JSON
+object, whose keys README.md's table lists.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+import msgspec
+from msgspec import UNSET, UnsetType
+
+from arena.runtime.config import MatchConfig
+from arena.runtime.stats import percentile
+from arena.schemas.messages import Summary
+from arena.tools.launch.faults import outcome as match_outcome
+
+
+@dataclass
+class Collected:
+    summaries: dict[str, Summary] = field(default_factory=dict)
+    pids: dict[str, int] = field(default_factory=dict)
+    forged: Counter = field(default_factory=Counter)  # rejected summaries per key
+    started: float = 0.0
+    ended: float = 0.0
+    crashed: dict[str, str] = field(default_factory=dict)  # name -> why (exit code)
+    lost: dict[str, str] = field(default_factory=dict)  # liveliness gone before the summary
+    missing: dict[str, str] = field(default_factory=dict)  # no summary within the bound
+    void: str = ""  # why the match is void, found while supervising
+
+
+class MatchResult(msgspec.Struct, kw_only=True):
+    """One match's result. Its fields, in order, are the keys of `arena match --json`
+    (README.md, "What a match prints"); those after `referee_log` are set by the
+    engine that played it, and a field left UNSET is not printed."""
+
+    outcome: str  # completed | void (tools/launch/faults.py)
+    void: bool
+    outcome_reasons: list[str]
+    home: str
+    away: str
+    score: list[int]
+    seed: int
+    robots: int
+    half_time: float
+    link: str
+    realtime: bool
+    engine: str  # processes | inprocess
+    ticks: int
+    sim_seconds: float
+    wall_seconds: float
+    play_wall_seconds: float
+    rtf: float
+    digest: str
+    process_digests: dict[str, str]
+    processes: list[dict[str, Any]]
+    links: dict[str, dict[str, Any]]
+    events: dict[str, int]
+    distance_m: dict[str, Any]
+    parked: dict[str, Any]
+    sent_off: list[Any]
+    rejected: int
+    rejected_reasons: dict[str, int]
+    dead: list[str]
+    faults: list[dict[str, Any]]
+    conflicts: list[Any]
+    forged_summaries: dict[str, int]
+    sent_by_key: dict[str, int]
+    recording: dict[str, Any] | None
+    refbox: dict[str, Any] | None
+    refbox_follow: dict[str, Any] | None
+    referee_log: list[dict[str, Any]]
+    services: list[str] | UnsetType = UNSET  # arena up
+    secure: bool | UnsetType = UNSET  # processes, arena up
+    digests_verified: list[str] | UnsetType = UNSET  # processes
+    startup_seconds: float | None | UnsetType = UNSET  # processes, inprocess
+    launch: str | UnsetType = UNSET  # processes: exec | fork | zygote; inprocess
+    play_started_unix: float | None | UnsetType = UNSET  # processes, inprocess
+    pid: int | UnsetType = UNSET  # inprocess
+    deadlocks: list[Any] | UnsetType = UNSET  # inprocess
+    logs: str | UnsetType = UNSET  # processes: where a failed match's logs are kept
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object of `arena match --json` (values as they are; UNSET fields left out)."""
+        return {f: v for f in self.__struct_fields__ if (v := getattr(self, f)) is not UNSET}
+
+
+def assemble(
+    cfg: MatchConfig, got: Collected, wall_total: float, pids: dict[str, int] | None = None, record: str = ""
+) -> MatchResult:
+    """The match result (what `arena match --json` prints)."""
+    # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
+    # what the teams sent (no process's input): the digest is the same with or without them.
+    order = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "refbox", "viewer")]
+    sums = got.summaries
+    combined = hashlib.blake2b(digest_size=16)
+    for name in order:
+        if name in sums:
+            combined.update(name.encode() + b"=" + sums[name].digest.encode() + b";")
+    referee = sums.get("referee")
+    engine = sums.get("engine")
+    links: dict[str, dict] = {}
+    for name in order:
+        s = sums.get(name)
+        if s is None:
+            continue
+        for cls, agg in s.links.items():
+            acc = links.setdefault(cls, {"sent": 0, "dropped": 0, "_delays": []})
+            acc["sent"] += int(agg["frames"])
+            acc["dropped"] += int(agg["dropped"])
+            acc["_delays"].extend(s.delays_ms.get(cls, []))
+    for acc in links.values():
+        d = sorted(acc.pop("_delays"))
+        acc["drop_rate"] = round(acc["dropped"] / acc["sent"], 5) if acc["sent"] else 0.0
+        acc["delay_ms_mean"] = round(sum(d) / len(d), 3) if d else 0.0
+        acc["delay_ms_p95"] = round(percentile(d, 95), 3)
+    rejected = Counter()
+    for s in sums.values():
+        rejected.update(s.rejected_reasons)
+    if got.forged:
+        rejected["forged"] += sum(got.forged.values())
+    pid_of = pids or {}
+    processes = []
+    for p in cfg.processes():
+        name = str(p)
+        s = sums.get(name)
+        processes.append(
+            {
+                "kind": p.kind,
+                "team": p.team or None,
+                "robot": p.robot if p.kind == "robot" else None,
+                "pid": s.pid if s is not None else pid_of.get(name),
+                "external": p.short in cfg.external or name in cfg.external,
+                "tick_us_median": round(s.tick_us[0], 1) if s and s.tick_us else None,
+                "tick_us_p95": round(s.tick_us[1], 1) if s and s.tick_us else None,
+                "cpu_s": round(sum(s.cpu_s), 3) if s and s.cpu_s else None,
+            }
+        )
+    score = list(referee.extra.get("score", [0, 0])) if referee else [0, 0]
+    sent_by_key: dict[str, int] = {}
+    for name in order:
+        if name in sums:
+            for key, n in sums[name].sent_by_key.items():
+                sent_by_key[key] = sent_by_key.get(key, 0) + n
+    recorder = sums.get("recorder")
+    ticks = engine.tick if engine else 0
+    sim_seconds = ticks * cfg.timing.dt
+    # Simulation speed is measured by the engine from its start barrier to its
+    # last tick; process start-up is reported apart (wall_seconds).
+    play = max(1e-9, engine.wall_s if engine and engine.wall_s > 0 else got.ended - got.started)
+    honest = match_outcome(cfg, sums, got.crashed, got.lost, got.missing, got.void)
+    recording = recorder.extra if recorder else None
+    if cfg.tap and recorder is None:
+        why = next((f["reason"] for f in honest["faults"] if f["process"] == "recorder"), "no summary")
+        recording = {"path": record, "complete": False, "error": f"the recorder failed: {why}"}
+    return MatchResult(
+        outcome=honest["outcome"],
+        void=honest["void"],
+        outcome_reasons=honest["outcome_reasons"],
+        home=cfg.home,
+        away=cfg.away,
+        score=score,
+        seed=cfg.seed,
+        robots=cfg.robots,
+        half_time=cfg.half_time,
+        link=cfg.link,
+        realtime=cfg.realtime,
+        engine="processes",  # tools/launch/inprocess.py says "inprocess"
+        ticks=ticks,
+        sim_seconds=round(sim_seconds, 3),
+        wall_seconds=round(wall_total, 3),
+        play_wall_seconds=round(play, 3),
+        rtf=round(sim_seconds / play, 2),
+        digest=combined.hexdigest(),
+        process_digests={name: sums[name].digest for name in order if name in sums},
+        processes=processes,
+        links=links,
+        events=dict(sorted(referee.extra.get("events", {}).items())) if referee else {},
+        distance_m=engine.extra.get("distance_m", {}) if engine else {},
+        parked=engine.extra.get("parked", {}) if engine else {},
+        sent_off=engine.extra.get("sent_off", []) if engine else [],  # cards and REPAIR_OUT (docs/rules.md)
+        rejected=sum(rejected.values()),
+        rejected_reasons=dict(rejected),
+        dead=honest["dead"],
+        faults=honest["faults"],
+        conflicts=honest["conflicts"],
+        forged_summaries=dict(sorted(got.forged.items())),
+        sent_by_key=dict(sorted(sent_by_key.items())),
+        recording=recording,
+        refbox=sums["refbox"].extra if "refbox" in sums else None,
+        refbox_follow=referee.extra.get("refbox_follow") if referee else None,
+        referee_log=referee.extra.get("log", []) if referee else [],
+    )
+
+
+def startup_seconds(summaries: dict[str, Summary], launched: float) -> float | None:
+    """Launch (`play_match` called) to the engine's first tick, from the engine's Summary."""
+    engine = summaries.get("engine")
+    started = engine.extra.get("play_started", 0.0) if engine is not None else 0.0
+    return round(started - launched, 3) if started else None
