@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 
-from arena.rules.refbox_follow import ViaRefbox
+from arena.refbox.follow import ViaRefbox
 from arena.rules.referee_box import check_referee
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node

@@ -25,7 +25,7 @@ collisions, and the referee gets a ROBOT_DEAD event (docs/architecture.md,
 "Faults").
 
 A RED_CARD, DOUBLE_YELLOW or REPAIR_OUT parks its robot the same way, but its
-process plays on (`Restarts.sent_off`); PENALTY places the robots for it.
+process plays on (rules/setpieces.py `Restarts.sent_off`); PENALTY places the robots for it.
 
 Inputs are validated on the way in: a `cmd` with non-finite numbers or the
 wrong number of wheel speeds for the robot model, and a `referee` frame with
@@ -41,16 +41,15 @@ import time
 import numpy as np
 
 from arena.processes.director import Director, referee_steps
-from arena.rules import setpieces
 from arena.rules.referee_box import check_referee
+from arena.rules.setpieces import Restarts
 from arena.runtime import seeds
-from arena.runtime.config import TEAMS, MatchConfig
+from arena.runtime.config import TEAMS
 from arena.runtime.drivers import Reactor
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
-from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, RefCommand, Referee, encode
-from arena.schemas.vocabulary import SEND_OFF
+from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee, encode
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics, StuckWatch
 from arena.sim.sensors import NormalStream, sense_every
@@ -76,75 +75,6 @@ def check_cmd(cmd: Cmd, wheels: int) -> str | None:
     if not all(math.isfinite(w) for w in cmd.wheels):
         return "a wheel speed is not finite"
     return None
-
-
-class Restarts:
-    """Applies referee commands to the physics: stoppages, ball spots, legal positions.
-
-    Shared by the engine process and in-process rule tests. `placed` lists
-    every robot moved at a START as (tick, team, n, x, y).
-    """
-
-    def __init__(self, cfg: MatchConfig, physics: Physics):
-        self.cfg = cfg
-        self.physics = physics
-        self.pending: RefCommand | None = None  # the set piece waiting for its START
-        self.placed: list[tuple[int, str, int, float, float]] = []
-        self.sent_off: list[tuple[int, str, int, str]] = []  # (tick, team, robot, command)
-
-    def apply_frame(self, frame: Referee) -> None:
-        self.physics.attack_dir_a = frame.attack_dir_a
-        for c in frame.commands:
-            self.apply_command(c)
-
-    def apply_command(self, c: RefCommand) -> None:
-        ph = self.physics
-        if c.name in setpieces.SET_PIECES:
-            ph.stop_play()
-            if c.name == "KICKOFF":
-                ph.kickoff_positions(c.team)
-            ph.pin_ball(c.x, c.y)
-            if c.name == "PENALTY":
-                self.penalty_positions(c)
-            self.pending = c
-        elif c.name == "START":
-            if self.pending is not None:
-                self.enforce_distance(self.pending)
-                if self.pending.name == "PENALTY":
-                    self.penalty_positions(self.pending)
-            self.pending = None
-            ph.start_play()
-        elif c.name in ("STOP", "HALF_TIME", "END_GAME", "PARK", "GAMEOVER"):
-            ph.stop_play()
-        elif c.name in SEND_OFF and c.team in TEAMS and 0 <= c.robot < self.cfg.robots:
-            if (c.team, c.robot) not in ph.parked():
-                ph.park_robot(c.team, c.robot)  # sent off: beyond the fence, no collisions; its process plays on
-                self.sent_off.append((ph.tick, c.team, c.robot, c.name))
-
-    def penalty_positions(self, c: RefCommand) -> None:
-        """The penalty procedure: keeper on its line, taker behind the mark, the rest out of the area."""
-        ph = self.physics
-        parked = set(ph.parked())
-        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states() if (t, n) not in parked}
-        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
-        for t, n, x, y, th in setpieces.penalty_positions(robots, c.team, (c.x, c.y), ph.attack_dir_a, self.cfg):
-            ph.place_robot(t, n, x, y, poses[(t, n)][2] if math.isnan(th) else th)
-            self.placed.append((ph.tick, t, n, x, y))
-
-    def enforce_distance(self, c: RefCommand) -> None:
-        """Move every robot too close to the ball spot of `c` to the nearest legal place."""
-        ph = self.physics
-        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states()}
-        spot = (c.x, c.y)
-        rule = setpieces.keep_away(c.name, c.team, self.cfg)
-        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
-        for t, n in setpieces.too_close(robots, c.name, c.team, spot, ph.attack_dir_a, self.cfg):
-            x, y, th = poses[(t, n)]
-            others = [(ox, oy) for r, (ox, oy, _) in poses.items() if r != (t, n)]
-            nx, ny = setpieces.legal_spot(x, y, spot, rule.distance, others, self.cfg)
-            ph.place_robot(t, n, nx, ny, th)
-            poses[(t, n)] = (nx, ny, th)
-            self.placed.append((ph.tick, t, n, nx, ny))
 
 
 class EngineNode(Node):

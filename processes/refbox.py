@@ -8,7 +8,7 @@ The bridge is a listener only. Nobody in the match waits for it after the
 start, and nothing it sends is an input of another process, so it cannot
 change a lockstep digest; `arena match` leaves its digest out of the match
 digest, as the recorder's (its content depends on what the teams send). The
-TCP server (rules/refbox_server.py) runs on its own thread: a slow or silent
+TCP server (refbox/server.py) runs on its own thread: a slow or silent
 base station never holds up the referee frames, and the match never waits for
 a TCP client, unless `--refbox-wait N` holds the start until N base stations
 are connected.
@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import time
 
+from arena.refbox.server import BridgeServer
 from arena.rules import refbox_protocol as rp
-from arena.rules.refbox_server import BridgeServer
 from arena.rules.referee_box import check_referee
 from arena.runtime.config import TEAMS
 from arena.runtime.lockstep import Waits

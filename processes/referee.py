@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 
 from arena.processes.director import referee_steps
-from arena.rules.refbox_follow import Follower
+from arena.refbox.follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node

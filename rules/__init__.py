@@ -1,10 +1,12 @@
 """The laws of the game: the referee box, a pure `process(state, change)`
 state machine that turns ball events into MSL RefBox commands
 (referee_box.py), and where each set piece puts the ball and the robots
-(setpieces.py), and the MSL RefBox's own wire, so real base stations can
-join a match: the protocol (refbox_protocol.py) and the bridge's TCP server
-(refbox_server.py). May import `arena.runtime` and `arena.schemas`; imported by
-strategies, processes and tools.
+(setpieces.py, with `Restarts`, which carries the referee's commands out on
+the field), and the MSL RefBox's own wire as pure functions: the protocol
+(refbox_protocol.py) and following a real RefBox's commands (refbox_follow.py).
+Pure: no socket, no thread, no clock; the RefBox's sockets and threads are
+`arena.refbox`. May import `arena.runtime` and `arena.schemas`; imported by
+strategies, refbox, processes and tools.
 
 The referee's vocabulary (command and stage names as `Literal` types, the set
 pieces, `other_team`) is defined once in `arena.schemas.vocabulary`, because

@@ -36,15 +36,23 @@ A goalkeeper (robot 0) inside its own penalty area is exempt, so that a free
 kick near its goal does not pull it out. When the positioning time is over
 (START) the engine moves every robot still too close to the nearest free spot
 just outside the distance (`legal_spot`); the robot keeps its heading.
-A penalty has its own positions (`penalty_positions`)."""
+A penalty has its own positions (`penalty_positions`).
+
+`Restarts` carries the referee's commands out on the engine's physics (any
+`Pitch`): it stops play, pins the ball on its spot, places the robots for a
+kick-off or a penalty and, at START, moves the ones still too close. The
+strategies' side of a set piece (how a team positions itself for it) is
+strategies/iris/setpieces.py."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 from arena.runtime.config import TEAMS, MatchConfig
-from arena.schemas.vocabulary import SET_PIECES, other_team
+from arena.schemas.messages import RefCommand, Referee
+from arena.schemas.vocabulary import SEND_OFF, SET_PIECES, other_team
 
 PLACE_MARGIN = 0.05  # [m] a placed robot stands this much beyond the distance it must keep
 RING_STEP = 0.5  # [m] next ring of candidate spots when a whole ring is taken
@@ -244,3 +252,90 @@ def penalty_positions(
         pos[(t, n)] = (nx, ny)
         moves.append((t, n, nx, ny, math.nan))  # nan: keeps its heading
     return moves
+
+
+class Pitch(Protocol):
+    """What `Restarts` needs of the engine's physics (sim/physics/ `Physics`)."""
+
+    tick: int
+    attack_dir_a: int
+
+    def stop_play(self) -> None: ...
+    def start_play(self) -> None: ...
+    def kickoff_positions(self, team: str) -> None: ...
+    def pin_ball(self, x: float, y: float) -> None: ...
+    def parked(self) -> list[tuple[str, int]]: ...
+    def park_robot(self, team: str, n: int) -> object: ...
+    def robot_states(self) -> list[tuple]: ...
+    def place_robot(self, team: str, n: int, x: float, y: float, theta: float) -> None: ...
+
+
+class Restarts:
+    """Carries the referee's commands out on the field: stoppages, ball spots, legal positions.
+
+    The engine process (processes/engine.py) applies every referee frame with
+    it, on its physics (sim/physics/, any `Pitch`). `placed` lists every robot
+    moved at a START as (tick, team, n, x, y); `sent_off` every robot parked by
+    a RED_CARD, DOUBLE_YELLOW or REPAIR_OUT as (tick, team, n, command).
+    """
+
+    def __init__(self, cfg: MatchConfig, physics: Pitch):
+        self.cfg = cfg
+        self.physics = physics
+        self.pending: RefCommand | None = None  # the set piece waiting for its START
+        self.placed: list[tuple[int, str, int, float, float]] = []
+        self.sent_off: list[tuple[int, str, int, str]] = []  # (tick, team, robot, command)
+
+    def apply_frame(self, frame: Referee) -> None:
+        self.physics.attack_dir_a = frame.attack_dir_a
+        for c in frame.commands:
+            self.apply_command(c)
+
+    def apply_command(self, c: RefCommand) -> None:
+        ph = self.physics
+        if c.name in SET_PIECES:
+            ph.stop_play()
+            if c.name == "KICKOFF":
+                ph.kickoff_positions(c.team)
+            ph.pin_ball(c.x, c.y)
+            if c.name == "PENALTY":
+                self.place_for_penalty(c)
+            self.pending = c
+        elif c.name == "START":
+            if self.pending is not None:
+                self.enforce_distance(self.pending)
+                if self.pending.name == "PENALTY":
+                    self.place_for_penalty(self.pending)
+            self.pending = None
+            ph.start_play()
+        elif c.name in ("STOP", "HALF_TIME", "END_GAME", "PARK", "GAMEOVER"):
+            ph.stop_play()
+        elif c.name in SEND_OFF and c.team in TEAMS and 0 <= c.robot < self.cfg.robots:
+            if (c.team, c.robot) not in ph.parked():
+                ph.park_robot(c.team, c.robot)  # sent off: beyond the fence, no collisions; its process plays on
+                self.sent_off.append((ph.tick, c.team, c.robot, c.name))
+
+    def place_for_penalty(self, c: RefCommand) -> None:
+        """The penalty procedure: keeper on its line, taker behind the mark, the rest out of the area."""
+        ph = self.physics
+        parked = set(ph.parked())
+        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states() if (t, n) not in parked}
+        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
+        for t, n, x, y, th in penalty_positions(robots, c.team, (c.x, c.y), ph.attack_dir_a, self.cfg):
+            ph.place_robot(t, n, x, y, poses[(t, n)][2] if math.isnan(th) else th)
+            self.placed.append((ph.tick, t, n, x, y))
+
+    def enforce_distance(self, c: RefCommand) -> None:
+        """Move every robot too close to the ball spot of `c` to the nearest legal place."""
+        ph = self.physics
+        poses = {(t, n): (x, y, th) for t, n, x, y, th, *_ in ph.robot_states()}
+        spot = (c.x, c.y)
+        rule = keep_away(c.name, c.team, self.cfg)
+        robots = [(t, n, x, y) for (t, n), (x, y, _) in poses.items()]
+        for t, n in too_close(robots, c.name, c.team, spot, ph.attack_dir_a, self.cfg):
+            x, y, th = poses[(t, n)]
+            others = [(ox, oy) for r, (ox, oy, _) in poses.items() if r != (t, n)]
+            nx, ny = legal_spot(x, y, spot, rule.distance, others, self.cfg)
+            ph.place_robot(t, n, nx, ny, th)
+            poses[(t, n)] = (nx, ny, th)
+            self.placed.append((ph.tick, t, n, nx, ny))

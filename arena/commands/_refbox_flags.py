@@ -54,8 +54,8 @@ def warn_unreachable_refbox(endpoint: str) -> None:
     """Said before the match starts, not only in its report: the referee keeps trying while it plays."""
     import sys
 
+    from arena.refbox.client import unreachable
     from arena.rules import refbox_protocol as rp
-    from arena.rules.refbox_client import unreachable
 
     host, port = rp.parse_endpoint(endpoint)
     if why := unreachable(host, port):
@@ -76,7 +76,7 @@ def refbox_params(args: argparse.Namespace):
     changes: dict[str, object] = {}
     try:
         if args.refbox:
-            from arena.rules.refbox_server import check_listen
+            from arena.refbox.server import check_listen
 
             check_listen(args.refbox)
             changes["listen"] = args.refbox

@@ -3,6 +3,11 @@
 * referee: stands still on STOP-like commands, positions for set pieces
   (own team: one robot goes behind the ball; opponents keep `setpiece_distance`
   from the spot) and plays on START;
+
+This is a team's side of a set piece. The rules' side (where the ball is put,
+the distances each team keeps, where the engine moves a robot that did not, and
+`Restarts`, which carries the referee's commands out) is rules/setpieces.py;
+the table of rules is docs/rules.md.
 """
 
 from __future__ import annotations

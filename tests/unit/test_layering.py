@@ -18,6 +18,7 @@ RANK = {
     "rules": 2,
     "recording": 2,
     "strategies": 3,
+    "refbox": 3,  # the RefBox protocol's sockets and threads, over the pure rules
     "processes": 4,
     "tools": 5,
     "scenarios": 6,  # the scenario file, runner, pytest plugin and library: may use tools
@@ -119,3 +120,19 @@ def test_every_package_is_installed():
             rel = init.parent.relative_to(ROOT / pkg).parts
             found.add(".".join(("arena",) if pkg == "arena" else ("arena", pkg, *rel)))
     assert found <= listed, f"not in pyproject.toml packages: {sorted(found - listed)}"
+
+
+def test_rules_stay_pure():
+    """rules/ is the laws of the game and the RefBox wire as pure functions: no socket, thread or clock
+    (those are arena.refbox, processes and runtime)."""
+    impure = {"socket", "selectors", "threading", "queue", "time", "subprocess", "asyncio"}
+    bad = []
+    for path in sorted((ROOT / "rules").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            names = []
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [node.module]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            bad += [f"{path.relative_to(ROOT)} imports {n}" for n in names if n.split(".")[0] in impure]
+    assert not bad, "\n".join(bad)

@@ -8,7 +8,7 @@ import socket
 import time
 
 from arena.recording.analysis.worldstates import score_team
-from arena.rules.refbox_server import BridgeServer
+from arena.refbox.server import BridgeServer
 from arena.runtime.config import RefboxParams, RefboxTeam
 from arena.schemas.messages import RobotState, World, Worldstate
 

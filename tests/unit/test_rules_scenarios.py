@@ -1,7 +1,7 @@
-"""The rules end to end on the real engine physics: Physics + the engine's Restarts + RefereeBox.
+"""The rules end to end on the real engine physics: Physics + the rules' Restarts + RefereeBox.
 
 No robots think here: the test moves them and the ball, the physics reports
-ball events, the referee box decides, and the engine's `Restarts` applies the
+ball events, the referee box decides, and `Restarts` (rules/setpieces.py) applies the
 commands (ball spots, stoppages, legal positions at START), in the engine's
 order: every referee period the box sees the events so far and its frame is
 applied before the next physics step.
@@ -13,8 +13,8 @@ import math
 
 import pytest
 
-from arena.processes.engine import Restarts
 from arena.rules.referee_box import RefereeBox
+from arena.rules.setpieces import Restarts
 from arena.runtime.config import MatchConfig, RulesParams
 from arena.schemas.messages import BallEvent, Cmd, RefCommand
 from arena.sim.physics import Physics, StuckWatch

@@ -26,8 +26,8 @@ import time
 from collections import Counter
 from dataclasses import dataclass, field
 
+from arena.refbox.follow import VIA_TEAMS
 from arena.rules import refbox_protocol as rp
-from arena.rules.refbox_follow import VIA_TEAMS
 from arena.runtime.config import RefboxParams
 
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
