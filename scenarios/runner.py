@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import math
 import shlex
+import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -166,7 +167,9 @@ def _processes(sc: Scenario, seed: int, record: str):
 
     with tempfile.TemporaryDirectory(prefix="arena-scenario-") as tmp:
         path = record or str(Path(tmp) / "run.mcap")
-        result = play_match(sc.config(seed), record=path, strict=True)
+        # An --external process is started by hand: the launcher says the command to type there.
+        announce = lambda text: print(text, file=sys.stderr, flush=True)
+        result = play_match(sc.config(seed), record=path, strict=True, announce=announce)
         rec = load(path, keep={"world", "referee"})
         worlds = rec.decoded("world", World)
         referees = rec.decoded("referee", Referee)
@@ -175,7 +178,12 @@ def _processes(sc: Scenario, seed: int, record: str):
 
 
 def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:
-    """Play `sc` at `seed` on `engine` and judge every expectation. `record`: write the MCAP there."""
+    """Play `sc` at `seed` on `engine` and judge every expectation. `record`: write the MCAP there.
+
+    A scenario with `--external` robots plays on the processes engine only (ValueError otherwise).
+    """
+    if sc.spec.play.external and engine != "processes":
+        raise ValueError(f"{sc.path}: scenario {sc.name!r} has external processes: it needs --engine processes")
     play = _inprocess if engine == "inprocess" else _processes
     worlds, referees, digests, total = play(sc, seed, record)
     trace = _trace(sc, worlds, referees, digests)

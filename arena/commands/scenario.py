@@ -79,34 +79,43 @@ def _job(item):
     return run_one(sc, seed, engine, record)
 
 
-def run(args: argparse.Namespace) -> int:
-    from arena.scenarios import Outcome, ScenarioError, discover, load_all
-    from arena.scenarios.junit import write_junit
-    from arena.scenarios.library import LIBRARY
+def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
+    """The scenarios and seeds the flags name; ScenarioError (one line) for a bad file or flag."""
+    from arena.scenarios import ScenarioError, discover, load_all
 
-    prog = "arena scenario"
-    if args.action == "library":
-        print(LIBRARY)
-        return 0
     if not args.target:
-        print(f"{prog}: error: run needs a FILE or DIR", file=sys.stderr)
-        return 2
-    try:
-        scenarios = [sc for path in discover(args.target) for sc in load_all(path)]
-    except ScenarioError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
+        raise ScenarioError("run needs a FILE or DIR")
+    scenarios = [sc for path in discover(args.target) for sc in load_all(path)]
     if args.name:
         scenarios = [sc for sc in scenarios if sc.name == args.name]
         if not scenarios:
-            print(f"{prog}: error: {args.target}: no scenario named {args.name!r}", file=sys.stderr)
-            return 2
+            raise ScenarioError(f"{args.target}: no scenario named {args.name!r}")
     if not scenarios:
-        print(f"{prog}: error: {args.target}: no *.scenario.toml files", file=sys.stderr)
-        return 2
+        raise ScenarioError(f"{args.target}: no *.scenario.toml files")
+    external = [sc for sc in scenarios if sc.spec.play.external]
+    if external and args.engine != "processes":
+        raise ScenarioError(
+            f"{external[0].path}: {external[0].name!r} has external processes (play.external): "
+            "run it with --engine processes"
+        )
     seeds = [args.seed] if args.seed is not None else list(range(args.seeds))
     if args.record and (len(scenarios) != 1 or len(seeds) != 1):
-        print(f"{prog}: error: --record needs one scenario (--name) and one seed (--seed)", file=sys.stderr)
+        raise ScenarioError("--record needs one scenario (--name) and one seed (--seed)")
+    return scenarios, seeds
+
+
+def run(args: argparse.Namespace) -> int:
+    from arena.scenarios import Outcome, ScenarioError
+    from arena.scenarios.junit import write_junit
+    from arena.scenarios.library import LIBRARY
+
+    if args.action == "library":
+        print(LIBRARY)
+        return 0
+    try:
+        scenarios, seeds = chosen(args)
+    except ScenarioError as exc:
+        print(f"arena scenario: error: {exc}", file=sys.stderr)
         return 2
     items = [(sc, s, args.engine, args.record or "") for sc in scenarios for s in seeds]
     if args.jobs > 1 and len(items) > 1:

@@ -291,3 +291,22 @@ def test_the_documented_examples_load_and_run(tmp_path):
     (tmp_path / "parts.scenario.toml").write_text(composite)
     v = run_one(load(tmp_path / "parts.scenario.toml"), 0)
     assert v.ticks == 300 and "engine digest" in {f.name for f in v.failures}
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["scenario", "run"], "run needs a FILE or DIR"),
+        (["scenario", "run", "EXT"], "'ext' has external processes (play.external): run it with --engine processes"),
+        (["scenario", "run", "DIR", "--record", "x.mcap"], "--record needs one scenario (--name) and one seed"),
+        (["scenario", "run", "DIR", "--name", "nobody"], "no scenario named 'nobody'"),
+        (["scenario", "run", "DIR", "--seeds", "0"], "expected a whole number 1..100000"),
+    ],
+)
+def test_bad_flags_are_one_line_and_exit_2(files, tmp_path_factory, capsys, argv, message):
+    ext = tmp_path_factory.mktemp("ext") / "ext.scenario.toml"
+    ext.write_text('[[scenario]]\nname = "ext"\ntime_limit = 1.0\n[scenario.play]\nexternal = ["a/1"]\n')
+    argv = [str(ext) if a == "EXT" else str(files) if a == "DIR" else a for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1, err
