@@ -9,12 +9,15 @@ pipe carries one byte each way per step. An episode that ends is reset in the
 same step (Gymnasium's `AutoresetMode.SAME_STEP`): the observation returned is
 the next episode's first, the last one is in `infos["final_obs"]` (rows where
 `infos["_final_obs"]` is true). Worker i plays seeds seed + i, then the next
-seed of its own env at every autoreset. Flat `Box` observations only.
+seed of its own env at every autoreset, with the options of the last `reset`
+(`{"scenario": PATH}`: every episode of that scenario, a curriculum step).
+Flat `Box` observations only.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
+import pickle
 import struct
 from typing import Any
 
@@ -40,6 +43,7 @@ def _arrays(buffers: dict[str, Any], n: int, obs_dim: int, act_shape: tuple[int,
 def _worker(i: int, conn, buffers, n: int, obs_dim: int, act_shape, act_dtype, options: dict) -> None:
     a = _arrays(buffers, n, obs_dim, act_shape, act_dtype)
     env = SoccerEnv(**options)
+    reset_options = None
     try:
         while True:
             msg = conn.recv_bytes()
@@ -49,11 +53,12 @@ def _worker(i: int, conn, buffers, n: int, obs_dim: int, act_shape, act_dtype, o
                 a["flags"][i] = (term, trunc, term or trunc)
                 if term or trunc:
                     a["final"][i] = obs
-                    obs, _ = env.reset()
+                    obs, _ = env.reset(options=reset_options)
                 a["obs"][i] = obs
             elif msg[:1] == _RESET:
                 (seed,) = struct.unpack("<q", msg[1:9])
-                obs, _ = env.reset(seed=None if seed < 0 else seed)
+                reset_options = pickle.loads(msg[9:])
+                obs, _ = env.reset(seed=None if seed < 0 else seed, options=reset_options)
                 a["obs"][i] = obs
             else:
                 conn.send_bytes(b"k")
@@ -115,15 +120,15 @@ class SoccerVectorEnv(VectorEnv):
                 raise RuntimeError(f"soccer env worker {i} failed: {got[1:].decode()}")
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
-        if options:
-            raise ValueError("SoccerVectorEnv.reset takes no options (a scenario: use AsyncVectorEnv)")
+        """Every worker's env, seeded seed + i; `options` (e.g. {"scenario": PATH}) hold for its autoresets too."""
         if seed is None:
             seeds = [-1] * self.num_envs
         elif isinstance(seed, int):
             seeds = [seed + i for i in range(self.num_envs)]
         else:
             seeds = [-1 if s is None else s for s in seed]
-        self._all([_RESET + struct.pack("<q", s) for s in seeds])
+        opts = pickle.dumps(options)
+        self._all([_RESET + struct.pack("<q", s) + opts for s in seeds])
         return self._a["obs"].copy(), {}
 
     def step(self, actions):

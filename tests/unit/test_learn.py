@@ -280,3 +280,20 @@ def test_a_learner_that_pushes_gets_the_foul(tmp_path):
     while env.agents:
         env.step({"a/1": np.array([1.0, 0, 0, 0], np.float32)})
     assert ("FREEKICK", "b") in seen, seen  # it drove into b's keeper
+
+
+def test_the_vector_envs_autoresets_keep_playing_the_scenario_it_was_reset_to(tmp_path):
+    path = tmp_path / "shoot.scenario.toml"
+    path.write_text(SHOT)
+    venv = make_vector_env(2, robot="a/1", robots=2, frame_skip=5)
+    try:
+        venv.reset(seed=1, options={"scenario": str(path)})
+        shoot = np.tile(np.array([0.6, 0, 0, 1], np.float32), (2, 1))
+        goals = 0
+        for _ in range(60):  # a goal in under 30 steps each episode: at least two episodes each
+            _, rew, term, _, _ = venv.step(shoot)
+            goals += int(term.sum())
+            assert (rew[term] == 1.0).all()
+        assert goals >= 4
+    finally:
+        venv.close()
