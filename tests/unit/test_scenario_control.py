@@ -172,3 +172,18 @@ def test_the_link_emulator_switches_models_at_the_tick():
 
     e = LinkEmulator(LinkModel(), random.Random(1), changes=((5, LinkModel(loss_good=1.0)),))
     assert [e.decide(k) for k in range(8)] == [0.0] * 5 + [None] * 3
+
+
+def test_conditions_on_a_command_a_robot_and_possession():
+    corner = Step(at=0, actions=[RefereeOverride(command="CORNER", team="a")])
+    on_corner = Step(when=Condition(command="CORNER"), actions=[TeleportRobot(team="b", robot=2, x=-1.0, y=-1.0)])
+    on_robot = Step(
+        when=Condition(robot="b/2", robot_in=Region(x0=-1.1, y0=-1.1, x1=-0.9, y1=-0.9)),
+        actions=[TeleportRobot(team="b", robot=1, x=-2.0, y=-2.0)],
+    )
+    never = Step(when=Condition(possession="b"), actions=[TeleportBall(x=-5.0, y=0.0)])
+    _, worlds, _ = play((corner, on_corner, on_robot, never), ticks=20)
+    first = {w.tick for w in worlds if (robot(w, "b", 2).x, robot(w, "b", 2).y) == (-1.0, -1.0)}
+    second = {w.tick for w in worlds if (robot(w, "b", 1).x, robot(w, "b", 1).y) == (-2.0, -2.0)}
+    assert first and second and min(second) == min(first) + 1, (first, second)
+    assert all(w.ball_x != -5.0 for w in worlds), "nobody of b held the ball: that step never fired"
