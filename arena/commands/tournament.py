@@ -65,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
     from arena.tools.experiments import tournament
+    from arena.tools.experiments.tournament_report import print_summary
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ConfigError(f"--out {args.out} exists and is not a directory")
@@ -110,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
-        tournament.print_summary(summary)
+        print_summary(summary)
     if interrupted:
         print("arena tournament: interrupted; finished matches are kept (continue with --resume)", file=sys.stderr)
         return 130

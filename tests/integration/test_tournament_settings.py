@@ -9,7 +9,9 @@ import subprocess
 import pytest
 
 from arena.runtime.config import ConfigError
-from arena.tools.experiments.tournament import Result, TournamentOptions, check_resume, report, settings
+from arena.tools.experiments.fixtures import Result
+from arena.tools.experiments.tournament import TournamentOptions, check_resume, settings
+from arena.tools.experiments.tournament_report import report
 from tests.integration.helpers import ARENA
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--seed", "5", "--jobs", "1")

@@ -14,7 +14,7 @@ import pytest
 
 from arena.runtime.config import ConfigError
 from arena.tools.experiments import cluster
-from arena.tools.experiments.tournament import Fixture
+from arena.tools.experiments.fixtures import Fixture
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -4,19 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from arena.tools.experiments.tournament import (
-    Result,
-    bradley_terry,
-    charts,
-    coverage,
-    print_summary,
-    ratings,
-    replay_odds,
-    report,
-    schedule,
-    standings,
-    table1_rows,
-)
+from arena.tools.experiments.fixtures import Result, schedule
+from arena.tools.experiments.ratings import bradley_terry, coverage, ratings, replay_odds, standings
+from arena.tools.experiments.tournament_report import charts, print_summary, report, table1_rows
 
 AD, AS, BD, BS = "advance-dynamic", "advance-static", "basic-dynamic", "basic-static"
 
@@ -153,7 +143,8 @@ def test_table1_lists_each_pairings_score_first_named_team_first():
 
 
 def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_path):
-    from arena.tools.experiments.tournament import report, void_reason
+    from arena.tools.experiments.fixtures import void_reason
+    from arena.tools.experiments.tournament_report import report
 
     assert void_reason({"outcome": "void", "outcome_reasons": ["referee exited with code -9 (SIGKILL)"]}) == (
         "void: referee exited with code -9 (SIGKILL)"

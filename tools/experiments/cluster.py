@@ -302,9 +302,10 @@ def _shutdown(ray) -> None:
 def _play(opts: TournamentOptions, runner, todo: list, on_result):
     """(ray, interrupted); Ray is shut down here only if this raises."""
     from arena.tools.experiments import tournament as T
+    from arena.tools.experiments.matches import default_jobs
 
     cpus = task_cpus(opts.engine)
-    jobs = opts.jobs or T.default_jobs()
+    jobs = opts.jobs or default_jobs()
     address = parse_address(opts.ray)
     ray = connect(address, jobs * cpus, parse_runtime_env(opts.ray_runtime_env))
     if threading.current_thread() is threading.main_thread():
@@ -358,7 +359,7 @@ def _play(opts: TournamentOptions, runner, todo: list, on_result):
 
 def finish(runner, fx, attempt: int, got: dict):
     """The Result of one attempt, written to --out; None if the match is to be played again."""
-    from arena.tools.experiments.tournament import Result, void_reason, write_atomic
+    from arena.tools.experiments.fixtures import Result, void_reason, write_atomic
 
     log = runner.logs_dir / f"{fx.id}.log"
     reason = got.get("reason", "")

@@ -71,7 +71,7 @@ def round_robin(
 ) -> tuple[list, list[MatchFacts]]:
     """Every pairing `legs` times, home and away alternating, in-process; returns (Results, facts)."""
     from arena.runtime import seeds
-    from arena.tools.experiments.tournament import Result
+    from arena.tools.experiments.fixtures import Result
 
     fixtures = []
     for first, second in combinations(strategies, 2):

@@ -30,7 +30,7 @@ import sys
 import time
 
 from arena.tools.console import console as make_console
-from arena.tools.experiments.tournament import default_jobs
+from arena.tools.experiments.matches import default_jobs
 
 ENGINES = ("processes", "inprocess")
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
