@@ -394,7 +394,11 @@ class Node(Peer):
         if self.cfg.realtime and not self.cooperative:
             self.loop_realtime()
             return
-        yield from self.driver.drive(self.lockstep(), self.batch_flusher())
+        steps = self.lockstep()
+        stop = killed_at(self.cfg, self.name)
+        if stop >= 0:  # a scenario's `kill` step: the loop ends before acting at that tick
+            steps = until(steps, stop)
+        yield from self.driver.drive(steps, self.batch_flusher())
 
     def lockstep(self) -> Waits:
         """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""
@@ -434,3 +438,22 @@ class Observer(Peer):
     def observe(self) -> None:
         """Watch the match until it is over (or this process is stopped)."""
         raise NotImplementedError
+
+
+def killed_at(cfg: MatchConfig, name: str) -> int:
+    """The tick of a scenario's `KillProcess` step for process `name`, or -1."""
+    if not cfg.scenario.steps:
+        return -1
+    from arena.schemas.messages import KillProcess
+
+    ticks = [s.at for s in cfg.scenario.steps for a in s.actions if isinstance(a, KillProcess) and a.process == name]
+    return min(ticks) if ticks else -1
+
+
+def until(steps: Waits, stop: int) -> Waits:
+    """`steps` up to the first wait at tick `stop` or later: the loop ends there, as a process that died."""
+    for wait in steps:
+        if wait[1] >= stop:
+            steps.close()
+            return
+        yield wait

@@ -31,7 +31,16 @@ from arena.runtime.config import (
     ScenarioParams,
 )
 from arena.runtime.links import resolve
-from arena.schemas.messages import Condition, RefereeOverride, Region, SetLink, Step, TeleportBall, TeleportRobot
+from arena.schemas.messages import (
+    Condition,
+    KillProcess,
+    RefereeOverride,
+    Region,
+    SetLink,
+    Step,
+    TeleportBall,
+    TeleportRobot,
+)
 from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
 from arena.strategies import registry
 
@@ -121,6 +130,7 @@ class StepSpec(Spec):
     at: float | None = None
     when: When | None = None
     link: LinkSpec | None = None
+    kill: list[str] = []
     ball: BallSpec | None = None
     robots: list[RobotSpec] = []
     referee: RefereeSpec | None = None
@@ -279,9 +289,25 @@ def step_actions(s: StepSpec, robots: int, where: str) -> list:
         except ConfigError as exc:
             raise ValueError(f"{where}.link: {exc}") from None
         actions.append(SetLink(preset=s.link.preset, overrides=s.link.overrides))
+    actions += kill_actions(s, robots, where)
     if not actions:
-        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee, park or link)")
+        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee, park, link or kill)")
     return actions
+
+
+def kill_actions(s: StepSpec, robots: int, where: str) -> list:
+    out = []
+    for i, name in enumerate(s.kill):
+        try:
+            pid = ProcessId.parse(name)
+        except ConfigError:
+            pid = None
+        if pid is None or pid.kind not in ("robot", "basestation") or pid.robot >= robots:
+            raise ValueError(f"{where}.kill[{i}]: {name!r} is not a robot or base station of this match")
+        if s.at is None:
+            raise ValueError(f"{where}.kill: killing a process needs `at`; the process itself stops at that tick")
+        out.append(KillProcess(process=str(pid)))
+    return out
 
 
 def condition(w: When, robots: int, where: str) -> Condition:

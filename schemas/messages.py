@@ -389,7 +389,13 @@ class SetLink(Base, tag="link"):
     ] = {}
 
 
-Action = TeleportBall | TeleportRobot | RefereeOverride | SetLink
+class KillProcess(Base, tag="kill"):
+    """Stop a team's process at this tick, as if it had died: its loop ends before acting at the tick."""
+
+    process: Annotated[str, Meta(description="robot/<team>/<n> or basestation/<team>")]
+
+
+Action = TeleportBall | TeleportRobot | RefereeOverride | SetLink | KillProcess
 
 
 class Region(Base):

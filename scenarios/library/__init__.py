@@ -1,6 +1,6 @@
 """The scenario library shipped with the project (docs/scenarios.md, "The library").
 
-`rules/`: one scenario per rule row of docs/rules.md (but 19 and 20, see
+`rules/`: one scenario per rule row of docs/rules.md (but 20, see
 docs/scenarios.md), each asserting the referee's decision and the ball's spot. `behaviour/`: the paper's strategies at
 work, each with the pass rate measured over seeds and the `min_pass` set from it.
 """

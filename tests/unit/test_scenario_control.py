@@ -187,3 +187,18 @@ def test_conditions_on_a_command_a_robot_and_possession():
     second = {w.tick for w in worlds if (robot(w, "b", 1).x, robot(w, "b", 1).y) == (-2.0, -2.0)}
     assert first and second and min(second) == min(first) + 1, (first, second)
     assert all(w.ball_x != -5.0 for w in worlds), "nobody of b held the ball: that step never fired"
+
+
+def test_a_killed_robot_process_is_found_dead_parked_and_repaired_out():
+    from arena.schemas.messages import KillProcess
+
+    steps = (
+        Step(at=0, actions=[RefereeOverride(command="START")]),
+        Step(at=50, actions=[KillProcess(process="robot/b/1")]),
+    )
+    summaries, worlds, _ = play(steps, ticks=100)
+    assert summaries["robot/b/1"].tick < 50 <= summaries["robot/b/2"].tick
+    assert "robot/b/1" in summaries["engine"].dead and "b/1" in summaries["engine"].extra["parked"]
+    log = [(e["command"], e.get("robot")) for e in summaries["referee"].extra["log"]]
+    assert ("REPAIR_OUT", 1) in log
+    assert abs(robot(worlds[-1], "b", 1).x) > 7
