@@ -147,8 +147,7 @@ class SoccerParallelEnv(ParallelEnv):
         if m is None or not self.agents:
             raise RuntimeError("step() before reset(), or after the episode ended")
         for a in self.agents:
-            act = actions[a]
-            self.recorded[a].append(act)
+            self.recorded[a].append(np.array(actions[a]))  # a copy: callers may reuse one array
         m.act(actions)
         m.advance()
         ga = m.score[0] - self._last_score[0]
@@ -192,8 +191,8 @@ class SoccerParallelEnv(ParallelEnv):
         """A policy file that replays this episode's actions of `team`'s learners, the rest of the team
         by its strategy: `arena match --home policy:PATH` (team a) plays this episode again."""
         mine = {int(a.split("/")[1]): RecordedActions(self.recorded[a]) for a in self.recorded if a[0] == team}
-        base = self.cfg.strategy_of(team)
-        return str(save_policy(path, mine, base, self.frame_skip, self.discrete, self.cfg.robots))
+        cfg = self.match.cfg if self.match is not None else self.cfg  # a scenario names its own strategies
+        return str(save_policy(path, mine, cfg.strategy_of(team), self.frame_skip, self.discrete, cfg.robots))
 
     def observe(self, agent: str) -> Any:
         return self._shape(observe(*self.match.seen(agent), self._views[agent]))

@@ -41,8 +41,10 @@ def play(env, seed: int, actions_seed: int = 0) -> tuple[dict, list]:
     rng = np.random.default_rng(actions_seed)
     obs, _ = env.reset(seed=seed)
     seen = []
+    acts = {a: np.zeros(4, np.float32) for a in env.agents}  # one array per agent, rewritten every step
     while env.agents:
-        acts = {a: rng.uniform(-1, 1, 4).astype(np.float32) for a in env.agents}
+        for a in env.agents:
+            acts[a][:] = rng.uniform(-1, 1, 4)
         obs, *_ = env.step(acts)
         seen.append(np.concatenate([obs[a] for a in sorted(obs)]))
     return env.digests(), seen
