@@ -330,7 +330,7 @@ def load_policy(path: str | Path) -> PolicyFile:
         data = pickle.loads(Path(path).read_bytes())
     except FileNotFoundError:
         raise ConfigError(f"policy file {path} not found") from None
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as exc:
+    except Exception as exc:  # anything a file that is not a pickle of ours makes pickle raise
         raise ConfigError(f"policy file {path} cannot be read: {type(exc).__name__}: {exc}") from None
     if not isinstance(data, PolicyFile):
         raise ConfigError(f"policy file {path} is not an arena policy (write it with arena.learn.save_policy)")

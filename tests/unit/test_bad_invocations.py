@@ -134,6 +134,8 @@ BAD = [
     (["config", "--check", "/nonexistent.toml"], "cannot read"),
     (["config", "--check", "{file}"], "not valid TOML"),
     (["match", "--config", "{file}"], "not valid TOML"),
+    (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
+    (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     # arena strategies
     (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
