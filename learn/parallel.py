@@ -23,9 +23,10 @@ stops at half time); it is truncated when that ends, and terminated at a goal
 (`end_on_goal`). The reward is `reward(agent, Outcome)` (`arena.learn.rewards`),
 by default +1 a goal scored, -1 a goal conceded.
 
-`reset(seed=s)` plays the match of seed s: the same seed and actions give the
-same match, digest for digest (`digests()`), as `arena match` would with the
-policy's actions (`arena.learn.deploy`).
+`reset(seed=s)` plays the match of seed s, and `reset(seed=s, options={"scenario":
+PATH})` that scenario's run, judged at its end. The same seed and actions give the
+same match, digest for digest (`digests()`), as `arena match` gives when the robots
+play those actions from the file `save_actions` writes (`policy:PATH`).
 """
 
 from __future__ import annotations
