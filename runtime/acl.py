@@ -5,16 +5,16 @@ receives it. From that alone, each principal (one per process, plus the
 read-only `viewer`) gets a zenoh `access_control` policy, matched on its
 `transport/auth/usrpwd` user name, default permission deny:
 
-* `put` (ingress) only on the keys it sends, its own `summary/<p>` and `tap/<p>`;
-* `declare_subscriber` (ingress) only on the keys it receives and its own
-  `ack/<p>` (the recorder: `tap/**` and `summary/**`);
+* `put` (ingress) only on the keys it sends, its own `summary/<p>` and `tap/<p>`; `declare_subscriber`
+  (ingress) only on the keys it receives and its own `ack/<p>` (the recorder: `tap/**`, `summary/**`);
 * `put` (egress) only on the keys it may read, so the router never forwards
   a frame to a principal that may not read it; subscriber declarations
   (egress) on the whole match, so a sender learns of every matching
   subscriber, wildcards included (who listens is no secret);
 * its own liveliness token `alive/<p>`, and reading `alive/**` and the
   collector's token (the start barrier and dead-peer detection);
-* querying the engine's `config` queryable (the engine: serving it);
+* querying the engine's `config` queryable (the engine: serving it), and the
+  router for its identity (`claim/<p>`, with its token `claim/<p>/*`);
 * the robots' `report`s and the base stations' `order`s are also served
   (`SERVED`): their senders answer the viewer's queries with the last frame;
 * the viewer: reading `world`, `referee`, `field`, `engine/events` and the
@@ -22,9 +22,8 @@ read-only `viewer`) gets a zenoh `access_control` policy, matched on its
   base station believes), and the live viewer's `control` (pause, step,
   pace) to the engine.
 
-The router (hosted by `arena match` / `arena run router`) enforces it for
-every process, since in a secure match every process is a client of it
-(runtime/credentials.py says why).
+The router (hosted by `arena match` / `arena run router`) enforces it for every process,
+since in a secure match every process is a client of it (runtime/credentials.py says why).
 """
 
 from __future__ import annotations
@@ -32,6 +31,7 @@ from __future__ import annotations
 from arena.schemas.keys import (
     ACK,
     ALIVE,
+    CLAIM,
     COLLECTOR,
     CONFIG,
     CONTROL,
@@ -108,6 +108,9 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         perms["query/ingress"] = [*config, *asked]
         perms["reply/egress"] = [*config, *asked]
         perms["declare_queryable/egress"] = [*config, *asked]
+    claim = f"{prefix}{CLAIM}/{principal}"  # its identity, asked of the router (tools/launch/claims.py)
+    for what, key in (("liveliness_token/ingress", f"{claim}/*"), ("query/ingress", claim), ("reply/egress", claim)):
+        perms[what] = [*perms[what], key]
     return {k: v for k, v in perms.items() if v}
 
 

@@ -9,11 +9,13 @@ address. The file is plain JSON (valid JSON5), readable by the owner only:
      "transport": {"auth": {"usrpwd": {"user": ..., "password": ...}},
                    "link": {"tls": {"root_ca_certificate_base64": ...,
                                     "verify_name_on_connect": false}}},
-     "metadata": {"arena": {"match": ..., "process": ..., "keys": {process: hex}}}}
+     "metadata": {"arena": {"credentials": ..., "process": ..., "keys": {process: hex}}}}
 
 `metadata` is free-form in zenoh's configuration and stays local (zenoh shows
 it only in the session's own admin space, off by default); `keys` holds the
-process's own MAC key and the keys of the senders it verifies (runtime/mac.py).
+process's own MAC key and the keys of the senders it verifies (runtime/mac.py);
+`credentials` names the set the file belongs to: a fresh one per match, or a
+directory provisioned once (runtime/provision.py), whose files work in every match.
 
 Why clients through the router in secure mode: zenoh enforces access control
 on the node that receives a message, by the user name its transport
@@ -22,9 +24,9 @@ password (to authenticate the others) and would enforce only its own ACL, and
 a team's robot computer is not ours to trust. So every process is a client of
 the router, which holds the only dictionary and the only ACL.
 
-TLS: the CA is made fresh for every match (EC P-256, the `cryptography`
-package), signs exactly one certificate, the router's, and its private key is
-dropped at once. A client that trusts only this CA can talk only to this
+TLS: the CA is made fresh for every match, or once for a provisioned directory
+(EC P-256, the `cryptography` package), signs exactly one certificate, the
+router's, and its private key is dropped at once. A client that trusts only this CA can talk only to this
 match's router, so the host name check adds nothing and is off (the router's
 address is often an IP from a venue's DHCP).
 """
@@ -42,7 +44,16 @@ from pathlib import Path
 
 from arena.runtime.acl import COLLECTOR_PRINCIPAL, VIEWER, access_control, principals, user_of
 
-__all__ = ["COLLECTOR_PRINCIPAL", "Secrets", "load_fragment", "loopback_only", "make_tls", "secure_endpoint"]
+__all__ = [
+    "COLLECTOR_PRINCIPAL",
+    "Secrets",
+    "load_fragment",
+    "loopback_only",
+    "make_tls",
+    "private_directory",
+    "secure_endpoint",
+    "write_private",
+]
 from arena.runtime.mac import Keyring, new_key
 
 OFFICIAL_VERIFIES = {"engine": ["referee"], "referee": ["engine"], "viewer": ["engine", "referee"]}
@@ -71,6 +82,7 @@ class Secrets:
     router_cert_pem: bytes = b""
     router_key_pem: bytes = b""
     viewer_zid: str = ""  # secure: the viewer's zenoh id, which the router serves with DROP
+    set_id: str = field(default_factory=lambda: secrets.token_hex(4))  # metadata.arena.credentials
 
     @classmethod
     def new(cls, match: str, robots: int, processes: list[str], secure: bool, tls: bool = False) -> Secrets:
@@ -103,27 +115,32 @@ class Secrets:
                 frag["transport"]["link"] = {"tls": tls | {"verify_name_on_connect": False}}
             if principal == VIEWER and self.viewer_zid:
                 frag["id"] = self.viewer_zid  # `router_settings`: the router serves this id with DROP
-        keys = {p: k.hex() for p, k in ring.keys.items()}
-        frag["metadata"] = {"arena": {"match": self.match, "process": principal, "keys": keys}}
+        keys = {p: k.hex() for p, k in sorted(ring.keys.items())}
+        frag["metadata"] = {"arena": {"credentials": self.set_id, "process": principal, "keys": keys}}
         return frag
 
-    def write(self, directory: Path, more: dict[str, dict] | None = None) -> dict[str, Path]:
+    def write(self, directory: Path, more: dict[str, dict] | None = None, launched=()) -> dict[str, Path]:
         """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
 
         `more`: zenoh settings added to some principals' fragments (top-level keys),
-        e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`)."""
-        directory.mkdir(parents=True, exist_ok=True)
+        e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`).
+        `launched`: the principals `arena match` starts itself, whose identity it holds for them
+        (`metadata.arena.launched`: they claim none, tools/launch/claims.py)."""
+        private_directory(directory, create=True)
         out = {}
         for p in principals(self.processes):
             path = directory / f"{user_of(p)}.json5"
-            _write_private(path, json.dumps(self.fragment(p) | (more or {}).get(p, {}), indent=2) + "\n")
+            frag = self.fragment(p) | (more or {}).get(p, {})
+            if p in launched:
+                frag["metadata"]["arena"]["launched"] = True
+            write_private(path, json.dumps(frag, indent=2) + "\n")
             out[p] = path
         return out
 
     def router_settings(self, directory: Path) -> list[tuple[str, str]]:
         """(json5 path, json5 value) for the router's zenoh configuration (secure matches)."""
         dictionary = directory / "router-users.txt"
-        _write_private(dictionary, "".join(f"{user_of(p)}:{pw}\n" for p, pw in self.passwords.items()))
+        write_private(dictionary, "".join(f"{user_of(p)}:{pw}\n" for p, pw in self.passwords.items()))
         acl = access_control(f"arena/{self.match}/", self.robots, self.processes)
         items = [
             ("transport/auth/usrpwd/dictionary_file", json.dumps(str(dictionary))),
@@ -167,13 +184,94 @@ def secure_endpoint(endpoint: str) -> tuple[str, bool]:
     return endpoint, proto in ("tls", "quic")
 
 
-def _write_private(path: Path, text: str) -> None:
-    """Mode 0600, and whole or not at all (a process may be waiting to read it)."""
-    part = path.with_name(path.name + ".part")
-    fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(part, path)
+def write_private(path: Path, text: str) -> None:
+    """Mode 0600, and whole or not at all (a process may be waiting to read it).
+
+    Written to a new file of a random name (O_EXCL | O_NOFOLLOW: a file or symlink put there
+    beforehand makes it fail, never redirects it) and renamed over `path` (which replaces a
+    symlink at `path` instead of following it)."""
+    part = path.with_name(f".{path.name}.{secrets.token_hex(8)}.part")
+    fd = os.open(part, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(part, path)
+    except BaseException:
+        part.unlink(missing_ok=True)
+        raise
+
+
+def private_directory(directory: Path, create: bool = False) -> None:
+    """`directory` must be ours and writable by nobody else (mode 0700 when made here); ConfigError if not."""
+    from arena.runtime.config import ConfigError
+
+    try:
+        if create and not directory.exists():
+            directory.mkdir(parents=True, mode=0o700)
+        st = os.lstat(directory)
+    except OSError as exc:
+        raise ConfigError(f"cannot make credentials directory {directory}: {exc.strerror}") from None
+    import stat
+
+    if not stat.S_ISDIR(st.st_mode):
+        raise ConfigError(f"credentials directory {directory} is not a directory (or is a symlink)")
+    if st.st_uid != os.getuid() or st.st_mode & 0o022:
+        raise ConfigError(
+            f"credentials directory {directory} is writable by others or not yours: chmod 700 it, or use another"
+        )
+
+
+OWNER = "owner"  # in a match's temp dir: "<pid> <start time>" of the process that made it
+
+
+def _started(pid: int) -> str:
+    """The start time of process `pid` (Linux: /proc), to tell it from a later one with its pid."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError):
+        return ""
+
+
+def match_directory(prefix: str = "arena-") -> Path:
+    """A private temp dir for one match's secrets, sockets and logs, marked with its owner.
+
+    Its maker removes it on every exit it survives; `sweep` removes those of makers that were
+    killed (kill -9, power loss), so no password outlives the next start."""
+    import tempfile
+
+    sweep(prefix)
+    tmp = Path(tempfile.mkdtemp(prefix=prefix))
+    (tmp / OWNER).write_text(f"{os.getpid()} {_started(os.getpid())}\n")
+    return tmp
+
+
+def sweep(prefix: str = "arena-") -> list[Path]:
+    """Remove the temp dirs `match_directory` made for processes that no longer exist; returns them."""
+    import shutil
+    import tempfile
+
+    gone = []
+    for d in Path(tempfile.gettempdir()).glob(prefix + "*"):
+        try:
+            if d.is_symlink() or d.stat().st_uid != os.getuid():
+                continue
+            pid_text, _, started = (d / OWNER).read_text().strip().partition(" ")
+            pid = int(pid_text)
+        except (OSError, ValueError):
+            continue  # not made by match_directory
+        if Path(f"/proc/{pid}").exists() and _started(pid) == started:
+            continue
+        if not Path("/proc/self").exists():
+            try:
+                os.kill(pid, 0)
+                continue
+            except ProcessLookupError:
+                pass
+            except PermissionError:
+                continue
+        shutil.rmtree(d, ignore_errors=True)
+        gone.append(d)
+    return gone
 
 
 def load_fragment(path: str) -> dict:
@@ -190,7 +288,7 @@ def load_fragment(path: str) -> dict:
     return data
 
 
-def make_tls(hosts: tuple[str, ...] = ("127.0.0.1", "localhost")) -> tuple[bytes, bytes, bytes]:
+def make_tls(hosts: tuple[str, ...] = ("127.0.0.1", "localhost"), days: int = 2) -> tuple[bytes, bytes, bytes]:
     """A fresh CA and the router's certificate signed by it: (ca_pem, cert_pem, key_pem)."""
     from cryptography import x509
     from cryptography.hazmat.primitives import hashes, serialization
@@ -207,7 +305,7 @@ def make_tls(hosts: tuple[str, ...] = ("127.0.0.1", "localhost")) -> tuple[bytes
         .public_key(ca_key.public_key())
         .serial_number(x509.random_serial_number())
         .not_valid_before(now - datetime.timedelta(minutes=5))
-        .not_valid_after(now + datetime.timedelta(days=2))
+        .not_valid_after(now + datetime.timedelta(days=days))
         .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
         .sign(ca_key, hashes.SHA256())
     )
@@ -225,7 +323,7 @@ def make_tls(hosts: tuple[str, ...] = ("127.0.0.1", "localhost")) -> tuple[bytes
         .public_key(key.public_key())
         .serial_number(x509.random_serial_number())
         .not_valid_before(now - datetime.timedelta(minutes=5))
-        .not_valid_after(now + datetime.timedelta(days=2))
+        .not_valid_after(now + datetime.timedelta(days=days))
         .add_extension(x509.SubjectAlternativeName(names), critical=False)
         .sign(ca_key, hashes.SHA256())
     )

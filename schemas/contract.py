@@ -18,6 +18,7 @@ from arena.schemas import messages as m
 from arena.schemas.keys import (
     ACK,
     ALIVE,
+    CLAIM,
     COLLECTOR,
     CONFIG,
     CONTROL,
@@ -213,7 +214,7 @@ tests/integration/readme_robot.py is a robot written from this section alone
 command that starts the missing process, with the match id (`--match`), the
 router's endpoint (`--connect`) and its credentials file (`--credentials`,
 see "Security" below). Open a zenoh session in `client` mode to that endpoint
-(scouting off), then, in this order: subscribe to the keys you receive
+(scouting off), then, in this order: claim your identity (below), subscribe to the keys you receive
 (`field` included: the engine also serves it as a queryable, so a late joiner
 gets it with a `get` on `arena/<match>/field`), watch liveliness on
 `arena/<match>/alive/**` and `arena/<match>/{COLLECTOR}`, and declare your own
@@ -221,6 +222,16 @@ liveliness token `arena/<match>/{ALIVE}/<process>` (e.g. `alive/robot/a/1`).
 The engine starts tick 0 once every process's token is present. The match
 configuration is the JSON answer of a `get` on `arena/<match>/{CONFIG}` (see
 "Configuration" below).
+
+**Claiming the identity** (one process per identity). Declare a liveliness
+token `arena/<match>/{CLAIM}/<process>/<nonce>` (a nonce of your choice, e.g. 16
+hex digits) and keep it while you run; then `get` `arena/<match>/{CLAIM}/<process>`
+with the JSON payload `{{"nonce": ..., "host": ..., "pid": ..., "mac": ...}}`,
+`mac` being the hex of the MAC (below, "Message authentication") of the nonce's
+bytes under the key expression `arena/<match>/{CLAIM}/<process>`. The answer
+is `{{"ok": true}}`, or `{{"ok": false, "reason": "..."}}`: then exit with the
+reason (another process holds the identity, or your key is not this match's).
+No answer within a few seconds: the router gives out no identities; go on.
 
 **A robot's schedule** (lockstep). The configuration's
 `timing.perception_latency` L (ticks) is the model's perception latency: a
@@ -383,7 +394,8 @@ authentication, access control and TLS.
 **Credentials file.** `arena match` writes one file per principal,
 `<process with / as ->.json5` (`robot-b-1.json5`, `basestation-a.json5`,
 `referee.json5`, `engine.json5`, `viewer.json5`, ...), into `--credentials
-DIR` or the match's private temp dir, mode 0600. It is a zenoh configuration
+DIR` (provisioned once: kept from match to match, `arena credentials`) or the
+match's private temp dir, mode 0600. It is a zenoh configuration
 fragment in plain JSON (so valid JSON5): load it as your session's
 configuration (zenoh-c `zc_config_from_file`, zenoh-cpp `Config::from_file`,
 Rust `Config::from_file`) and add only the router's endpoint
@@ -397,13 +409,15 @@ Rust `Config::from_file`) and add only the router's endpoint
     "link": {{"tls": {{"root_ca_certificate_base64": "...",             // secure match on TCP only
                      "verify_name_on_connect": false}}}}
   }},
-  "metadata": {{"arena": {{"match": "<match>", "process": "robot/b/1",
+  "metadata": {{"arena": {{"credentials": "<set id>", "process": "robot/b/1",
                          "keys": {{"robot/b/1": "<{MAC_KEY_BYTES} bytes, hex>"}}}}}}
 }}
 ```
 
 Without `--secure` the file holds `metadata` only: your zenoh settings are
-yours, the MAC key is what the file is for. `metadata` is free-form in zenoh's
+yours, the MAC key is what the file is for. A file provisioned once holds the
+secure parts too: against a router that is not secure, leave `transport/auth`
+out (`arena run` does), since such a router refuses a user and password. `metadata` is free-form in zenoh's
 configuration and is never sent on the wire.
 
 **Secure match** (`arena match --secure`, the default when `--listen` is not
@@ -416,7 +430,8 @@ default deny: a principal may put only on the keys it sends, declare
 subscribers only on the keys it receives (the referee state is readable by
 all), plus its own `{ALIVE}/<process>` and `{WAITING}/<process>/*` tokens,
 `{SUMMARY}/<process>`, `{TAP}/<process>`, `{ACK}/<process>` and reading
-`{ALIVE}/**`, `{WAITING}/**`, `{COLLECTOR}` and `{CONFIG}`. A put or a subscription outside that is dropped silently by the
+`{ALIVE}/**`, `{WAITING}/**`, `{COLLECTOR}` and `{CONFIG}`, and asking for its identity
+(`{CLAIM}/<process>`, below). A put or a subscription outside that is dropped silently by the
 router. `viewer` is read-only: it may put nothing but the live `control`.
 
 **Message authentication** (every match, with or without `--secure`). The

@@ -241,6 +241,9 @@ CONFIG = "config"  # queryable: the match configuration as JSON
 ACK = "ack"  # arena/<m>/ack/<process id>: a collector acknowledges a summary
 COLLECTOR = "collector"  # liveliness token of a summary collector (arena match, arena up)
 REFUSED = "refused"  # arena/<m>/refused/<process id>: a second process with that identity was turned away
+# arena/<m>/claim/<process id>: queryable of the match's router, which gives each identity to one process;
+# arena/<m>/claim/<process id>/<nonce>: the claimant's liveliness token, held while it runs
+CLAIM = "claim"
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
 CONTROL = "control"  # arena/<m>/control: Control frames, viewer -> engine, live lockstep matches only
 TAP_PERIOD = 50  # [ticks] one tap batch per process every 1 s of simulated time (at 20 ms ticks)
@@ -295,6 +298,15 @@ class Keys:
 
     def refused_all(self) -> str:
         return f"{self.prefix}{REFUSED}/**"
+
+    def claim(self, process: str) -> str:
+        return f"{self.prefix}{CLAIM}/{process}"
+
+    def claim_token(self, process: str, nonce: str) -> str:
+        return f"{self.prefix}{CLAIM}/{process}/{nonce}"
+
+    def claim_all(self) -> str:
+        return f"{self.prefix}{CLAIM}/**"
 
     def collector(self) -> str:
         return f"{self.prefix}{COLLECTOR}"

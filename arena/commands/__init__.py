@@ -12,7 +12,20 @@ from __future__ import annotations
 import pkgutil
 
 # The order of `arena --help`; a command module not listed here follows, by name.
-ORDER = ("match", "run", "up", "tournament", "bench", "facts", "review", "replay", "config", "strategies", "schemas")
+ORDER = (
+    "match",
+    "run",
+    "credentials",
+    "up",
+    "tournament",
+    "bench",
+    "facts",
+    "review",
+    "replay",
+    "config",
+    "strategies",
+    "schemas",
+)
 
 
 def names() -> list[str]:

@@ -79,8 +79,9 @@ def add_parser(sub) -> None:
     m.add_argument(
         "--credentials",
         metavar="DIR",
-        help="write every principal's credentials file (DIR/robot-b-1.json5, ..., viewer.json5) here "
-        "(default: the match's private temp dir)",
+        help="every principal's credentials file (DIR/robot-b-1.json5, ..., viewer.json5), provisioned once: "
+        "what DIR holds is kept, only what is missing is made (arena credentials; default: the match's "
+        "private temp dir, gone with it)",
     )
     m.add_argument(
         "--strict",

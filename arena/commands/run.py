@@ -50,9 +50,9 @@ def add_parser(sub) -> None:
     r.add_argument(
         "--credentials",
         metavar="FILE",
-        help="this process's credentials file from arena match (a zenoh config fragment: user, password, "
-        "TLS root, MAC key); a secure match needs it. router: make the match secure and write every "
-        "process's credentials file into this directory",
+        help="this process's credentials file from arena match or arena credentials (a zenoh config fragment: "
+        "user, password, TLS root, MAC key); every match that made one for it needs it. router: make the match "
+        "secure with the credentials directory DIR (provisioned once: kept, what is missing made)",
     )
     r.add_argument(
         "--startup-timeout", type=seconds, default=60.0, metavar="S", help="wait this long [s] for the match (60)"

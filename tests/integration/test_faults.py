@@ -14,6 +14,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import msgspec
 import pytest
@@ -83,6 +84,10 @@ def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path):
     parked = result["parked"]["b/1"]
     assert fault["tick"] <= parked["tick"] <= fault["tick"] + 1
     assert result["distance_m"]["b/2"] > 5, "its team plays on"
+    # A fault's logs are kept for the user to read, but no secret is left with them (issue 36).
+    kept = Path(result["logs"])
+    assert (kept / "robot_b_1.log").exists(), sorted(kept.iterdir())
+    assert not (kept / "credentials").exists() and not (kept / "router-users.txt").exists(), sorted(kept.iterdir())
 
     # The ground truth in the recording: from its parking on, robot b/1 stands still
     # beyond the fence, and neither the ball nor any robot ever comes near it.

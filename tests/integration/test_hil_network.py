@@ -93,7 +93,7 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     assert "robot/a/1 is already running in match 'lan'" in twin.stderr.strip().splitlines()[-1]
     out, err = match.communicate(timeout=240)
     assert match.returncode == 0, err
-    assert "refused a second robot/a/1" in err
+    assert "refused robot/a/1 from " in err and ": robot/a/1 is already running in match 'lan'" in err
     r_out, r_err = robot.communicate(timeout=30)
     assert robot.returncode == 0, r_err
     assert f"connected to {printed.split('--connect ')[1].split()[0]} (zenoh client)" in r_err, r_err
@@ -117,3 +117,80 @@ def test_an_external_robot_that_never_comes_is_named(tmp_path):
     assert r.returncode == 2, r.stderr
     last = r.stderr.strip().splitlines()[-1]
     assert last.startswith("arena match: error: external robot/a/1 did not join within 3 s"), r.stderr
+
+
+def test_a_robot_provisioned_once_plays_two_matches_and_each_wrong_set_up_says_its_cause(two_hosts, reap, tmp_path):
+    """Issue 34: one copy of the robot's file, two matches with two ids; every mistake its own line."""
+    laptop, robot_host = two_hosts
+    py = [sys.executable, "-m", "arena"]
+    creds, other, on_robot = tmp_path / "creds", tmp_path / "other", tmp_path / "robot"
+    for d in (creds, other):
+        init = subprocess.run([*py, "credentials", "init", str(d), "--robots", "2"], capture_output=True, text=True)
+        assert init.returncode == 0, init.stderr
+    on_robot.mkdir()
+    shutil.copy(creds / "robot-a-1.json5", on_robot / "robot-a-1.json5")  # copied once, over a trusted channel
+    copied = (on_robot / "robot-a-1.json5").read_bytes()
+    tls = f"tls/{NET}.1:7447"
+    robot = [*py, "run", "robot", "--team", "a", "--robot", "1", "--startup-timeout", "4"]
+
+    def match(match_id: str) -> subprocess.Popen:
+        proc = _in(
+            laptop,
+            *py,
+            *("match", "--home", "BS", "--away", "BS", "--half-time", "3", "--seed", "3", "--robots", "2"),
+            *("--external", "a/1", "--match", match_id, "--listen", "tcp/0.0.0.0:7447"),
+            *("--credentials", str(creds), "--json"),
+        )
+        reap.append(proc)
+        return proc
+
+    # Monday: while the match waits for its robot, each wrong set-up on the robot's computer is
+    # told its own cause, exit 2.
+    monday = match("monday")
+    assert "external" in wait_for(lambda: monday.stderr.readline(), 60, "the instructions")
+    mine = str(on_robot / "robot-a-1.json5")
+    wrong = {
+        "no credentials": ([*robot, "--match", "monday", "--connect", tls], f"the router at {tls} is a secure match's: it needs"),
+        "plain tcp": ([*robot, "--match", "monday", "--connect", f"tcp/{NET}.1:7447", "--credentials", mine], f"the router at tcp/{NET}.1:7447 speaks TLS"),
+        "another set": ([*robot, "--match", "monday", "--connect", tls, "--credentials", str(other / "robot-a-1.json5")], "its TLS certificate is not signed by that file's CA"),
+        "another robot": ([*robot, "--match", "monday", "--connect", tls, "--credentials", str(creds / "robot-a-0.json5")], "is robot/a/0's, not robot/a/1's"),
+        "no such match": ([*robot, "--match", "someday", "--connect", tls, "--credentials", mine], "gave up after 4 s waiting for match 'someday' to start"),
+        "no router": ([*robot, "--match", "monday", "--connect", f"tls/{NET}.1:7448", "--credentials", mine], f"gave up after 4 s: no router at tls/{NET}.1:7448"),
+    }  # fmt: skip
+    said = {k: _in(robot_host, *argv) for k, (argv, _) in wrong.items()}
+    for k, proc in said.items():
+        reap.append(proc)
+        err = proc.communicate(timeout=90)[1]
+        assert proc.returncode == 2, (k, err)
+        assert wrong[k][1] in err.strip().splitlines()[-1], (k, err)
+        assert "forged" not in err and "Traceback" not in err, (k, err)
+    # Then the robot, started twice at the same moment: one plays, the other is refused.
+    twins = [
+        _in(robot_host, *robot[:-1], "60", "--match", "monday", "--connect", tls, "--credentials", mine) for _ in "ab"
+    ]
+    reap.extend(twins)
+    errs = [t.communicate(timeout=240)[1] for t in twins]
+    assert sorted(t.returncode for t in twins) == [0, 2], errs
+    assert any("robot/a/1 is already running in match 'monday'" in e.strip().splitlines()[-1] for e in errs), errs
+    out, err = monday.communicate(timeout=240)
+    assert monday.returncode == 0, err
+    result = json.loads(out)
+    assert result["outcome"] == "completed" and result["rejected"] == 0, result["rejected_reasons"]
+    assert [r["process"] for r in result["refused_starts"]] == ["robot/a/1"], result["refused_starts"]
+
+    # Tuesday: another match id, the same file, untouched on both sides; the robot is started
+    # first, before the match exists: it waits, then joins.
+    early = _in(robot_host, *robot[:-1], "60", "--match", "tuesday", "--connect", tls, "--credentials", mine)
+    reap.append(early)
+    assert "waiting: no router at" in early.stderr.readline()
+    tuesday = match("tuesday")
+    assert "external" in wait_for(lambda: tuesday.stderr.readline(), 60, "the instructions")
+    printed = tuesday.stderr.readline().strip()
+    assert f"--credentials {creds / 'robot-a-1.json5'}" in printed, printed
+    late = early.communicate(timeout=240)[1]
+    assert early.returncode == 0, late
+    assert "match over at tick 300 (END_GAME)" in late, late
+    out, err = tuesday.communicate(timeout=240)
+    assert tuesday.returncode == 0, err
+    assert json.loads(out)["outcome"] == "completed"
+    assert (on_robot / "robot-a-1.json5").read_bytes() == copied == (creds / "robot-a-1.json5").read_bytes()

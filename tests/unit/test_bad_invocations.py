@@ -58,6 +58,15 @@ BAD = [
     ([*M, "--half", "5"], "--half 5; did you mean --half-time? (see arena match --help)"),  # was taken as --half-time
     ([*M, "--halftime", "5"], "did you mean --half-time?"),
     ([*M, "--seeed=3"], "unrecognized arguments: --seeed=3; did you mean --seed?"),
+    ([*M, "--listen", "tcp/0.0.0.0:{busy}"], "cannot listen on tcp/0.0.0.0:"),  # was named as tls/0.0.0.0:P
+    ([*M, "--credentials", "{file}"], "is not a directory"),
+    # arena credentials
+    (["credentials", "show", "{tmp}"], "holds no credentials: arena credentials init"),
+    (["credentials", "rotate", "{tmp}"], "holds no credentials"),
+    (["credentials", "init", "{file}"], "is not a directory"),
+    (["credentials", "show", "{tmp}", "robot/a/1"], "PRINCIPAL applies to rotate only"),
+    (["credentials", "init", "{tmp}", "--robots", "9"], "--robots must be between 1 and 6"),
+    (["credentials", "burn", "{tmp}"], "invalid choice: 'burn'"),
     # arena run
     (["run", "robot", "--match", "m", "--connect", "foo", "--team", "a", "--robot", "1"], "--connect foo"),
     (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
@@ -69,6 +78,8 @@ BAD = [
     ([*R, "--team", "c"], "invalid choice: 'c'"),
     ([*R, "--policy", "/nonexistent.pkl"], "policy file /nonexistent.pkl not found"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--policy", "p.pkl"], "--policy applies to"),
+    ([*R, "--credentials", "{file}"], "is not a credentials file"),
+    ([*R, "--credentials", "/tmp/arena-gone/credentials/robot-a-1.json5"], "a match's temp dir is gone with its match"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
     (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),

@@ -36,7 +36,9 @@ def test_robot_a1_puts_only_on_its_cmd_and_report():
         "ack/robot/a/1",
     }
     # its liveliness, and the tokens that announce its long lockstep waits (runtime/drivers.py Reactor)
-    assert _rel(perms["liveliness_token/ingress"]) == {"alive/robot/a/1", "waiting/robot/a/1/*"}
+    # ... and the token that holds its identity (one process per identity: tools/launch/claims.py)
+    assert _rel(perms["liveliness_token/ingress"]) == {"alive/robot/a/1", "waiting/robot/a/1/*", "claim/robot/a/1/*"}
+    assert "claim/robot/a/1" in _rel(perms["query/ingress"]) and "claim/robot/a/2" not in _rel(perms["query/ingress"])
 
 
 def test_team_b_never_reads_team_a_nor_the_world():

@@ -196,7 +196,7 @@ def _collector_net(env: dict[str, str], router_argv: list[str], match: str):
         return net, None
     path = str(Path(router_argv[router_argv.index("--credentials") + 1]) / f"{COLLECTOR_PRINCIPAL}.json5")
     try:
-        base, _, keyring = load_credentials(path, COLLECTOR_PRINCIPAL, match, wait=30.0)
+        base, _, keyring = load_credentials(path, COLLECTOR_PRINCIPAL, wait=30.0)
     except ConfigError as exc:
         raise ComposeError(f"the router service's credentials: {exc}") from None
     return dataclasses.replace(net, base=base), keyring

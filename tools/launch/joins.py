@@ -75,11 +75,10 @@ class Joins:
         else:
             self.alive.discard(name)
 
-    def _on_refused(self, sample) -> None:
+    def _on_refused(self, sample) -> None:  # said by a newcomer that found no identity to claim (run.py)
         name = str(sample.key_expr).split("/refused/", 1)[-1]
-        self.announce(
-            f"refused a second {name}: one is already running ({sample.payload.to_bytes().decode(errors='replace')})"
-        )
+        newcomer = sample.payload.to_bytes().decode(errors="replace")
+        self.announce(f"refused a second {name} (the newcomer on {newcomer}): one is already running")
 
     def missing(self) -> list[str]:
         return sorted(self.external - self.alive)

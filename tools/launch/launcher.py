@@ -18,17 +18,27 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
+from arena.runtime.acl import user_of
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.credentials import Secrets, drop_puts_towards, loopback_only, new_zid, secure_endpoint
-from arena.runtime.session import NetConfig, open_session
+from arena.runtime.credentials import (
+    OWNER,
+    Secrets,
+    drop_puts_towards,
+    loopback_only,
+    match_directory,
+    new_zid,
+    secure_endpoint,
+)
+from arena.runtime.provision import provision
+from arena.runtime.session import EndpointError, NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, routes
 from arena.tools.launch import forkstart
 from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all
+from arena.tools.launch.claims import Claims
 from arena.tools.launch.joins import Joins, instructions
 from arena.tools.launch.result import MatchResult, assemble, startup_seconds
 from arena.tools.launch.run import run_job
@@ -126,6 +136,17 @@ def relay_safe(router_zid: str, peer: str, match: str, robots: int, external: se
     return {"qos": {"network": rule}}
 
 
+def open_router(net: NetConfig, listen: str | None):
+    """The match's router session; an endpoint that cannot be used is named as the user gave it."""
+    try:
+        return open_session(net)
+    except EndpointError as exc:
+        said = net.listen[0]
+        if listen and said != listen:  # a secure match listens with TLS where --listen said tcp
+            raise EndpointError(str(exc).replace(said, f"{listen} (as {said}: a secure match)", 1)) from None
+        raise
+
+
 def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect are one sequence
     cfg: MatchConfig,
     *,
@@ -147,8 +168,9 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
     `--external` processes.
     `secure`: authenticated principals, access control and TLS (runtime/acl.py,
     runtime/credentials.py); None means on whenever `listen` is not loopback.
-    `credentials`: the directory for every principal's credentials file
-    (default: the match's private temp dir).
+    `credentials`: a credentials directory provisioned once (runtime/provision.py): what it
+    holds is kept, what is missing made; the externals' files are named from it (default: a
+    fresh set in the match's private temp dir, gone with it).
     A failed process is a fault in the result (`outcome`, `faults`: see
     tools/launch/faults.py); with `strict`, it raises MatchError instead, as does a
     match that cannot start.
@@ -159,45 +181,55 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
     cfg = cfg.replace(tap=bool(record))
     match = match or new_match_id(cfg.seed)
     keys = Keys(match)
-    tmp = Path(tempfile.mkdtemp(prefix="arena-"))
-    endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
     secure = (not loopback_only(listen)) if secure is None else secure
-    tls = False
-    if secure:
-        endpoint, tls = secure_endpoint(endpoint)
-    connect = endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
-    cfg_path = tmp / "config.json"
-    cfg_path.write_text(cfg.to_json())
-    logs = Path(log_dir) if log_dir else tmp
-    logs.mkdir(parents=True, exist_ok=True)
     names = [str(p) for p in cfg.processes()]
-    secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
-    external = {ProcessId.parse(e) for e in cfg.external}
-    if secure:  # the viewer is served with DROP (Secrets.router_settings)
-        more: dict[str, dict] = {}
-        router_extra = tuple(secrets.router_settings(tmp))
+    tls = secure and secure_endpoint(listen or "unixsock-stream/")[1]
+    if credentials:  # provisioned once: what DIR holds is kept (runtime/provision.py)
+        secrets, _ = provision(Path(credentials), names, cfg.robots, match)
+        secrets.secure = secure
     else:
-        router_zid = new_zid()
-        ext = {str(e) for e in external}
-        more = {
-            str(p): relay_safe(router_zid, str(p), match, cfg.robots, ext) for p in cfg.processes() if p not in external
-        }
-        router_extra = (("id", json.dumps(router_zid)), *SPECTATOR_SAFE)
-    cred_paths = secrets.write(Path(credentials) if credentials else tmp / "credentials", more)
+        secrets = Secrets.new(match, cfg.robots, names, secure, tls=tls)
+    external = {ProcessId.parse(e) for e in cfg.external}
+    local = [p for p in cfg.processes() if p not in external]
+    tmp = match_directory()
+    try:  # whatever fails from here on, the temp dir goes (the `finally` below covers the rest)
+        endpoint = listen or f"unixsock-stream/{tmp}/router.sock"
+        if secure:
+            endpoint = secure_endpoint(endpoint)[0]
+        connect = endpoint.replace("0.0.0.0", "127.0.0.1").replace("[::]", "[::1]")
+        cfg_path = tmp / "config.json"
+        cfg_path.write_text(cfg.to_json())
+        logs = Path(log_dir) if log_dir else tmp
+        logs.mkdir(parents=True, exist_ok=True)
+        if secure:  # the viewer is served with DROP (Secrets.router_settings)
+            more: dict[str, dict] = {}
+            router_extra = tuple(secrets.router_settings(tmp))
+        else:
+            router_zid = new_zid()
+            ext = {str(e) for e in external}
+            more = {str(p): relay_safe(router_zid, str(p), match, cfg.robots, ext) for p in local}
+            router_extra = (("id", json.dumps(router_zid)), *SPECTATOR_SAFE)
+        # This match's own processes get theirs in the private temp dir (with this match's settings);
+        # an external process's is in DIR, unchanged from match to match.
+        cred_paths = secrets.write(tmp / "credentials", more, launched={str(p) for p in local})
+        if credentials:
+            cred_paths |= {str(p): Path(credentials) / f"{user_of(str(p))}.json5" for p in external}
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     children: list[Child] = []
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     starter = None
     try:
         # Fork the processes before any zenoh session exists here (tools/launch/forkstart.py);
         # they open theirs once the router is up.
-        local = [p for p in cfg.processes() if p not in external]
         starter = forkstart.starter(len(local), {p.kind for p in local}, {cfg.home, cfg.away})
         if starter is not None:
             for p in local:
                 job = run_job(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
                 log_path = logs / (str(p).replace("/", "_") + ".log")
                 children.append(Child(str(p), p, starter.fork(job, log_path), log_path))  # type: ignore[arg-type]
-        with open_session(NetConfig(mode="router", listen=(endpoint,), extra=router_extra)) as session:
+        with open_router(NetConfig(mode="router", listen=(endpoint,), extra=router_extra), listen) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
             # An external's digest is recomputed from the frames it puts (tools/launch/witness.py).
@@ -213,6 +245,8 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
             joins = Joins(session, keys, external, announce)
+            mine = f"started by arena match, pid {os.getpid()}"
+            claims = Claims(session, keys, secrets.keyring("launcher"), {str(p): mine for p in local}, announce)
             if external and announce is not None:
                 announce(instructions(sorted(external), match, endpoint, record, cred_paths, secure))
             try:
@@ -233,6 +267,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 )
             finally:
                 joins.close()
+                claims.close()
                 transport.close()
         dead = {d for s in got.summaries.values() for d in s.dead} | set(got.lost) | set(got.missing)
         for c in children:
@@ -244,6 +279,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 pass
         result = assemble(cfg, got, time.monotonic() - t_start, {c.name: c.popen.pid for c in children}, record)
         result.secure = secure
+        result.refused_starts = claims.refused  # second starts of one identity, wrong credentials
         result.digests_verified = witness.verified()
         result.startup_seconds = startup_seconds(got.summaries, launched)
         result.launch = "exec" if starter is None else starter.how
@@ -262,5 +298,8 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
         if starter is not None:
             starter.close()  # children still waiting on the router read end-of-file and exit
         stop_all(children)
-        if not keep:
+        if keep:  # the logs stay for the user to read; the secrets go now, and the owner mark
+            for secret in (tmp / "credentials", tmp / "router-users.txt", tmp / OWNER):  # (`sweep` keeps it)
+                shutil.rmtree(secret, ignore_errors=True) if secret.is_dir() else secret.unlink(missing_ok=True)
+        else:
             shutil.rmtree(tmp, ignore_errors=True)

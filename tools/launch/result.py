@@ -78,6 +78,7 @@ class MatchResult(msgspec.Struct, kw_only=True):
     services: list[str] | UnsetType = UNSET  # arena up
     secure: bool | UnsetType = UNSET  # processes, arena up
     digests_verified: list[str] | UnsetType = UNSET  # processes
+    refused_starts: list[dict] | UnsetType = UNSET  # processes: turned away at connect (tools/launch/claims.py)
     startup_seconds: float | None | UnsetType = UNSET  # processes, inprocess
     launch: str | UnsetType = UNSET  # processes: exec | fork | zygote; inprocess
     play_started_unix: float | None | UnsetType = UNSET  # processes, inprocess

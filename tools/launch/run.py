@@ -18,10 +18,11 @@ import faulthandler
 import json
 import logging
 import os
+import secrets
+import shutil
 import signal
 import socket
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -29,15 +30,19 @@ import msgspec
 import zenoh
 
 from arena.processes import OBSERVERS, node_class
+from arena.runtime.acl import user_of
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.credentials import COLLECTOR_PRINCIPAL, Secrets, load_fragment, secure_endpoint
+from arena.runtime.credentials import COLLECTOR_PRINCIPAL, load_fragment, match_directory, secure_endpoint
 from arena.runtime.drivers import Driver, Pull, WaitBoard
 from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
+from arena.runtime.provision import load, provision
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.schemas.messages import Referee
+from arena.tools.launch.claims import Claims
+from arena.tools.launch.connect import why_refused
 
 
 class Job(msgspec.Struct, frozen=True, omit_defaults=True):
@@ -115,9 +120,7 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     """Run the process `job` names to the end of its match; the exit code (2 for bad input, one line).
 
     `cfg`: the match an engine hosts when `job.config` names no file (`arena run engine --home ...`)."""
-    logging.basicConfig(
-        level=job.log_level or "WARNING", format="%(asctime)s %(name)s %(levelname)s %(message)s", stream=sys.stderr
-    )
+    configure_logging(job.log_level or "WARNING", by_hand=job.config is None)
     net = NetConfig(mode=job.mode or "peer", connect=job.connect, listen=job.listen)
     if job.kind == "router":
         return main_guarded(run_router, job.match, net, job.credentials)
@@ -125,7 +128,7 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     try:
         pid = process_id(job.kind, job.team, job.robot)
         if job.credentials:
-            base, mode, keyring = load_credentials(job.credentials, pid, job.match, wait=10.0)
+            base, mode, keyring = load_credentials(job.credentials, pid, wait=10.0)
             net = dataclasses.replace(net, base=base, mode=mode or net.mode)
         if job.config:
             cfg = load_config(job.config)
@@ -148,7 +151,20 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     timeout = job.startup_timeout if job.startup_timeout is not None else 60.0
     host = job.host or "127.0.0.1"
     return main_guarded(
-        run, pid, job.match, net, cfg, job.seed, job.realtime, timeout, record, host, job.port, keyring, policy
+        run,
+        pid,
+        job.match,
+        net,
+        cfg,
+        job.seed,
+        job.realtime,
+        timeout,
+        record,
+        host,
+        job.port,
+        keyring,
+        policy,
+        job.credentials,
     )
 
 
@@ -172,13 +188,22 @@ def process_id(kind: str, team: str | None, robot: int | None) -> ProcessId:
     return ProcessId(kind)
 
 
-def load_credentials(path: str, pid: ProcessId | str, match: str, wait: float = 0.0) -> tuple[str, str | None, Keyring]:
+def load_credentials(path: str, pid: ProcessId | str, wait: float = 0.0) -> tuple[str, str | None, Keyring]:
     """(fragment JSON, zenoh mode it asks for, keyring) from `--credentials FILE`, checked against who we are.
 
-    `wait`: the file may not be there yet (a router service writes it as it starts): wait this long."""
+    The file is not tied to a match: one provisioned once (`--credentials DIR`) serves every match
+    that uses its directory. `wait`: the file may not be there yet (a router service writes it as
+    it starts): wait this long."""
     deadline = time.monotonic() + wait
-    while not Path(path).exists() and time.monotonic() < deadline:
+    # A directory that is still there may be about to get it (a router service); a gone one will not.
+    near = Path(path).parent.is_dir() or Path(path).parent.parent.is_dir()
+    while not Path(path).exists() and near and time.monotonic() < deadline:
         time.sleep(0.1)
+    if not Path(path).exists():
+        raise ConfigError(
+            f"cannot read --credentials {path}: no such file (a match's temp dir is gone with its match: "
+            "provision once with arena match --credentials DIR, or arena credentials init DIR)"
+        )
     try:
         frag = load_fragment(path)
         arena = frag["metadata"]["arena"]
@@ -186,11 +211,26 @@ def load_credentials(path: str, pid: ProcessId | str, match: str, wait: float = 
     except ValueError as exc:
         raise ConfigError(str(exc)) from None
     if arena["process"] != str(pid):
-        raise ConfigError(f"--credentials {path} belongs to {arena['process']}, not {pid}")
-    if arena.get("match") != match:
-        raise ConfigError(f"--credentials {path} belongs to match {arena.get('match')!r}, not {match!r}")
+        raise ConfigError(f"--credentials {path} is {arena['process']}'s, not {pid}'s: give {user_of(str(pid))}.json5")
     mode = frag.get("mode")
     return json.dumps(frag), mode if mode in ("peer", "client") else None, keyring
+
+
+class _Said(logging.Formatter):
+    """A log record as one of `arena run`'s own lines: `arena run: robot/a/1: warning: ...`."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = f"arena run: {record.name.removeprefix('arena.')}: {record.levelname.lower()}: {record.getMessage()}"
+        return text + ("\n" + self.formatException(record.exc_info) if record.exc_info else "")
+
+
+def configure_logging(level: str, by_hand: bool, stream=None) -> None:
+    """stderr logging: a process started by hand (no --config) says its lines as `arena run` says
+    everything else; one started by `arena match` writes its log file with times."""
+    handler = logging.StreamHandler(stream or sys.stderr)
+    fmt = "%(asctime)s %(name)s %(levelname)s %(message)s"
+    handler.setFormatter(_Said() if by_hand else logging.Formatter(fmt))
+    logging.basicConfig(level=level, handlers=[handler], force=True)
 
 
 def load_config(path: str) -> MatchConfig:
@@ -235,10 +275,21 @@ def refused_by(connect: tuple[str, ...]) -> str | None:
     return next((ep for ep in connect if listening(ep)), None)
 
 
-def refusal(ep: str) -> ConfigError:
-    return ConfigError(
-        f"refused by {ep}: authentication failed (a secure match needs this process's own --credentials file)"
-    )
+def refusal(ep: str, net: NetConfig, credentials: str | None, pid: str) -> ConfigError:
+    """The refusal of the router at `ep`, with its cause (tools/launch/connect.py)."""
+    fragment = json.loads(net.base) if net.base else None
+    return ConfigError(why_refused(ep, fragment, credentials, user_of(pid)))
+
+
+def without_password(net: NetConfig) -> NetConfig | None:
+    """`net` without the user and password of its credentials (None if it has none): a file
+    provisioned once is a secure match's, and a plain match's router refuses a password."""
+    fragment = json.loads(net.base) if net.base else {}
+    auth = fragment.get("transport", {}).get("auth")
+    if not auth or any(ep.startswith(("tls/", "quic/")) for ep in net.connect):
+        return None
+    del fragment["transport"]["auth"]
+    return dataclasses.replace(net, base=json.dumps(fragment))
 
 
 def fetch_config(
@@ -249,10 +300,12 @@ def fetch_config(
     where: str = "",
     tell=None,
     connect: tuple[str, ...] = (),
+    refused=None,
 ) -> MatchConfig:
     """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
     deadline = time.monotonic() + timeout
     state = ""
+    ep = None
     refused_since: float | None = None  # a router listens, and we are still not connected to it
     while time.monotonic() < deadline:
         payload = transport.query(keys.config(), timeout=1.0)
@@ -260,28 +313,36 @@ def fetch_config(
             return MatchConfig.from_json(payload.decode())
         if session is not None:
             connected = bool(list(session.info.routers_zid()) or list(session.info.peers_zid()))
-            ep = None if connected else refused_by(connect)
-            if ep is None:
+            probe = None if connected else refused_by(connect)
+            if connected:
                 refused_since = None
-            elif refused_since is None:
-                refused_since = time.monotonic()
-            elif time.monotonic() - refused_since > REFUSED_AFTER:
-                raise refusal(ep)
-            now = f"a router at {where}, but no match {keys.match!r} there" if connected else f"no router at {where}"
-            if now != state and tell is not None:
-                tell(f"waiting: {now} (retrying for up to {timeout:g} s)")
+            elif probe is not None:  # (a probe that fails on a loaded host proves nothing)
+                ep = probe
+                refused_since = refused_since or time.monotonic()
+                if time.monotonic() - refused_since > REFUSED_AFTER:
+                    raise refused(ep) if refused is not None else ConfigError(f"refused by {ep}")
+            # A router that listens and has not taken us yet is told apart within REFUSED_AFTER.
+            now = f"waiting for match {keys.match!r} to start at {where}" if connected else f"no router at {where}"
+            if now != state and tell is not None and (connected or refused_since is None):
+                tell(f"{now if connected else 'waiting: ' + now} (up to {timeout:g} s)")
             state = now
         time.sleep(0.2)
+    if refused_since is not None and refused is not None and ep is not None:
+        raise refused(ep)  # a router listens there and never took us: say why, not "no router"
     raise StartupError(
-        f"gave up after {timeout:g} s: {state}"
+        f"gave up after {timeout:g} s{' ' if state.startswith('waiting') else ': '}{state}"
         if state
         else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
         f"{keys.match!r} running and reachable on the given endpoint?"
     )
 
 
-def open_until(net: NetConfig, timeout: float, where: str, tell):
-    """Open the session; a client retries until `timeout` while no router answers at its endpoint."""
+def open_until(net: NetConfig, timeout: float, where: str, tell, refused):
+    """Open the session; a client retries until `timeout` while no router answers at its endpoint.
+
+    A router that listens and refuses us twice, 1 s apart (not one still starting), is a
+    refusal with its cause (`refused(ep)`), unless it takes us without the password of a
+    credentials file provisioned once (a plain match's router)."""
     for ep in net.connect:
         check_endpoint("--connect", ep)
     deadline = time.monotonic() + timeout
@@ -290,20 +351,29 @@ def open_until(net: NetConfig, timeout: float, where: str, tell):
     while True:
         try:
             return open_session(net)
-        except EndpointError as exc:
+        except EndpointError:
             if net.mode != "client" or not net.connect:
                 raise
             ep = refused_by(net.connect)
             if ep is not None:
+                plain = without_password(net)
+                if plain is not None:
+                    try:
+                        session = open_session(plain)
+                    except EndpointError:
+                        pass
+                    else:
+                        tell(f"{ep} is not a secure match's router: connected without the password")
+                        return session
                 if refused_once:  # twice in a row, 1 s apart: not a router still starting
-                    raise refusal(ep) from None
+                    raise refused(ep) from None
                 refused_once = True
             else:
                 refused_once = False
             if time.monotonic() + 1.0 > deadline:
                 raise StartupError(f"gave up after {timeout:g} s: no router at {where}") from None
-            if not told:
-                tell(f"waiting: no router at {where} ({exc}; retrying for up to {timeout:g} s)")
+            if not told and ep is None:
+                tell(f"waiting: no router at {where} (retrying for up to {timeout:g} s)")
                 told = True
             time.sleep(1.0)
 
@@ -315,6 +385,49 @@ def with_policy(cfg: MatchConfig, team: str, policy: str) -> MatchConfig:
     return cfg.replace(**{"home" if team == "a" else "away": policy})
 
 
+def claim(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, timeout: float = 3.0):
+    """Ask the match's router for this identity (tools/launch/claims.py); ConfigError with the
+    router's reason if refused. Returns the liveliness token that holds it (keep it while running),
+    or None if nobody answers (a router that gives out no identities)."""
+    name = str(pid)
+    nonce = secrets.token_hex(8)
+    token = session.liveliness().declare_token(keys.claim_token(name, nonce))
+    sign = keyring.signer(keys.claim(name)) if keyring is not None else None
+    ask = {"nonce": nonce, "host": socket.gethostname(), "pid": os.getpid()}
+    if sign is not None:
+        ask["mac"] = sign(nonce.encode()).hex()
+    for reply in session.get(keys.claim(name), payload=json.dumps(ask).encode(), timeout=timeout):
+        if reply.ok is None:
+            continue
+        try:
+            answer = json.loads(reply.ok.payload.to_bytes())
+        except ValueError:
+            continue
+        if answer.get("ok"):
+            return token
+        token.undeclare()
+        raise ConfigError(f"refused by match {keys.match!r}: {answer.get('reason')}")
+    token.undeclare()
+    return None
+
+
+def hold_identity(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, net: NetConfig):
+    """This process's identity in the match, or ConfigError with the reason it is someone else's.
+    `arena match` holds its own processes' for them; a router that gives out none leaves the
+    liveliness check. Returns what holds it (None: nothing to keep)."""
+    if launched(net):
+        return None
+    held = claim(session, keys, pid, keyring)
+    if held is None:
+        refuse_duplicate(session, keys, pid)
+    return held
+
+
+def launched(net: NetConfig) -> bool:
+    """Started by `arena match`, which holds this process's identity for it (its credentials say so)."""
+    return bool(net.base and json.loads(net.base).get("metadata", {}).get("arena", {}).get("launched"))
+
+
 def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
     """Liveliness knows who is there: a second process with a running one's identity is turned away.
 
@@ -323,7 +436,7 @@ def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
     name = str(pid)
     if not any(r.ok is not None for r in session.liveliness().get(keys.alive(name), timeout=1.0)):
         return
-    session.put(keys.refused(name), f"from {socket.gethostname()}, pid {os.getpid()}".encode())
+    session.put(keys.refused(name), f"{socket.gethostname()}, pid {os.getpid()}".encode())
     time.sleep(0.2)  # let the put leave before the session closes
     raise ConfigError(
         f"{name} is already running in match {keys.match!r}: a second one is refused (check --team and --robot)"
@@ -355,6 +468,7 @@ def run(
     port: int | None = None,
     keyring: Keyring | None = None,
     policy: str | None = None,
+    credentials: str | None = None,
 ) -> int:
     """Run one process to the end of its match. Returns the exit code.
 
@@ -380,36 +494,26 @@ def run(
 
     where = ", ".join(net.connect or net.listen)
     last_ref: list[bytes] = []
-    with open_until(net, startup_timeout, where, tell) as session:
+
+    def refused(ep: str) -> ConfigError:
+        return refusal(ep, net, credentials, str(pid))
+
+    with open_until(net, startup_timeout, where, tell, refused) as session:
         transport = ZenohTransport(session, keyring)
         ref_sub = None
         try:
             if cfg is None:
-                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell, net.connect)
+                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell, net.connect, refused)
             if seed is not None and seed != cfg.seed:
                 raise ConfigError(f"--seed {seed} differs from the match's seed {cfg.seed}")
             if realtime and not cfg.realtime:
                 raise ConfigError("--realtime given, but the match runs in lockstep")
-            if pid.kind == "recorder":
-                if not cfg.tap:
-                    raise ConfigError(f"match {match!r} does not record: start it with --record FILE.mcap")
-                if not record:
-                    raise ConfigError("arena run recorder needs --record FILE.mcap")
-            extra: dict[str, object] = {}
-            if pid.kind == "recorder":
-                extra = {"path": record}  # the path reaches the recorder only
-            if pid.kind == "viewer":
-                # A viewer attached by hand to a match started without --live watches
-                # only (the engine has no pacer to pause) and nobody waits for it.
-                attached = cfg.live < 0
-                live = port if port is not None else (8765 if attached else cfg.live)
-                cfg = cfg.replace(live=live)
-                extra = {"host": host, "attached": attached}
+            cfg, extra = observer_settings(pid, cfg, match, record, host, port)
             if pid not in cfg.processes():
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
             if policy:
                 cfg = with_policy(cfg, pid.team, policy)
-            refuse_duplicate(session, keys, pid)
+            held = hold_identity(session, keys, pid, keyring, net)  # noqa: F841 - kept while it runs
             tell(
                 f"connected to {where} (zenoh {net.mode}); match {match!r}: {cfg.home} v {cfg.away}, "
                 f"{cfg.robots} robots per team, 2 x {cfg.half_time:g} s"
@@ -434,6 +538,25 @@ def run(
     return 0
 
 
+def observer_settings(
+    pid: ProcessId, cfg: MatchConfig, match: str, record: str | None, host: str, port: int | None
+) -> tuple[MatchConfig, dict[str, object]]:
+    """The recorder's and the viewer's own settings: (the configuration as they see it, their extra arguments)."""
+    if pid.kind == "recorder":
+        if not cfg.tap:
+            raise ConfigError(f"match {match!r} does not record: start it with --record FILE.mcap")
+        if not record:
+            raise ConfigError("arena run recorder needs --record FILE.mcap")
+        return cfg, {"path": record}  # the path reaches the recorder only
+    if pid.kind == "viewer":
+        # A viewer attached by hand to a match started without --live watches
+        # only (the engine has no pacer to pause) and nobody waits for it.
+        attached = cfg.live < 0
+        live = port if port is not None else (8765 if attached else cfg.live)
+        return cfg.replace(live=live), {"host": host, "attached": attached}
+    return cfg, {}
+
+
 def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
     if not last_ref:
         return "match over (no referee message seen: the score is in the match's output)"
@@ -453,26 +576,32 @@ def secure_router(match: str, net: NetConfig, directory: str, private: Path) -> 
     and TLS certificate in its config."""
     if len(net.listen) != 1:
         raise ConfigError("arena run router --credentials needs one --listen endpoint")
-    endpoint, tls = secure_endpoint(net.listen[0])
+    endpoint, _ = secure_endpoint(net.listen[0])
     names = [*process_names(ROUTER_ROBOTS), "refbox", COLLECTOR_PRINCIPAL]
-    secrets = Secrets.new(match, ROUTER_ROBOTS, names, secure=True, tls=tls)
-    try:
-        secrets.write(Path(directory))
+    try:  # provisioned once: what DIR holds is kept (runtime/provision.py)
+        creds, _ = provision(Path(directory), names, ROUTER_ROBOTS, match)
     except OSError as exc:
         raise ConfigError(f"cannot write --credentials {directory}: {exc.strerror}") from None
     return NetConfig(
-        mode="router", listen=(endpoint,), connect=net.connect, extra=(*net.extra, *secrets.router_settings(private))
+        mode="router", listen=(endpoint,), connect=net.connect, extra=(*net.extra, *creds.router_settings(private))
     )
 
 
 def run_router(match: str, net: NetConfig, credentials: str | None = None) -> int:
     """A zenoh router for one match; exits when every process of the match has left."""
     signal.signal(signal.SIGTERM, _sigterm)  # SystemExit: the password dictionary goes too
-    with tempfile.TemporaryDirectory(prefix="arena-router-") as private:
-        return _route(match, secure_router(match, net, credentials, Path(private)) if credentials else net)
+    private = match_directory("arena-router-")  # removed below, or by the next start if we are killed
+    try:
+        if not credentials:
+            return _route(match, net, None)
+        net = secure_router(match, net, credentials, private)
+        held = load(Path(credentials))  # just provisioned: every principal's key, to check claims with
+        return _route(match, net, held.keyring("launcher") if held is not None else None)
+    finally:
+        shutil.rmtree(private, ignore_errors=True)
 
 
-def _route(match: str, net: NetConfig) -> int:
+def _route(match: str, net: NetConfig, keyring: Keyring | None) -> int:
     keys = Keys(match)
     alive: set[str] = set()
     seen = [False]
@@ -487,10 +616,13 @@ def _route(match: str, net: NetConfig) -> int:
 
     with open_session(NetConfig(mode="router", listen=net.listen, connect=net.connect, extra=net.extra)) as session:
         sub = session.liveliness().declare_subscriber(keys.alive_all(), on_change, history=True)
+        said = lambda text: print(f"arena run: router: {text}", file=sys.stderr, flush=True)
+        claims = Claims(session, keys, keyring, {}, said)  # one process per identity (tools/launch/claims.py)
         try:
             while not (seen[0] and not alive):
                 time.sleep(0.2)
         finally:
+            claims.close()
             sub.undeclare()
     return 0
 

@@ -1,0 +1,139 @@
+"""Issues 34 and 36: one identity, one process; a robot without its file is refused at connect, not
+told it forged; no secret outlives a killed launcher."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.integration.helpers import ARENA, descendants, free_port, spawn, wait_for
+
+GAME = ("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--seed", "2", "--json")
+
+
+def _printed(match: subprocess.Popen) -> list[str]:
+    """The command the match prints for its one external process."""
+    assert "external" in wait_for(lambda: match.stderr.readline(), 60, "the instructions")
+    return match.stderr.readline().split()
+
+
+def test_a_robot_started_before_the_match_without_its_file_is_refused_at_connect(tmp_path, reap):
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    early = subprocess.Popen(
+        [*ARENA, "run", "robot", "--match", "early", "--team", "a", "--robot", "1", "--connect", sock],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    reap.append(early)
+    assert "waiting: no router at" in early.stderr.readline()
+    match = spawn(*GAME, "--external", "a/1", "--match", "early", "--listen", sock)
+    reap.append(match)
+    command = _printed(match)
+    err = early.communicate(timeout=60)[1]
+    assert early.returncode == 2, err
+    assert err.strip().splitlines()[-1] == (
+        "arena run: error: refused by match 'early': match 'early' needs robot/a/1's own --credentials file "
+        "(every frame of its processes is authenticated): start it with the command arena match printed"
+    )
+    robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
+    assert robot.returncode == 0, robot.stderr
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    result = json.loads(out)
+    assert result["outcome"] == "completed" and result["rejected"] == 0, result["rejected_reasons"]
+    assert result["forged_summaries"] == {} and "forged" not in err, err
+    [refused] = result["refused_starts"]
+    assert refused["process"] == "robot/a/1" and refused["from"].endswith(f"pid {early.pid}"), refused
+
+
+def test_the_next_match_removes_what_a_killed_launcher_left(tmp_path, reap):
+    env = {**os.environ, "TMPDIR": str(tmp_path)}  # its own temp dir: only this test's matches there
+    port = free_port()
+    match = subprocess.Popen(
+        [*ARENA, *GAME, "--external", "a/1", "--secure", "--listen", f"tcp/127.0.0.1:{port}"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    reap.append(match)
+    command = _printed(match)
+    left = Path(command[command.index("--credentials") + 1]).parents[1]
+    assert (left / "router-users.txt").exists() and (left / "credentials" / "robot-a-1.json5").exists()
+    for pid in [*descendants(match.pid), match.pid]:
+        os.kill(pid, signal.SIGKILL)
+    match.communicate(timeout=30)
+    time.sleep(0.5)
+    assert (left / "router-users.txt").exists(), "kill -9 leaves it (nothing can run after it)"
+    nxt = subprocess.run([*ARENA, *GAME, "--half-time", "1"], capture_output=True, text=True, timeout=120, env=env)
+    assert nxt.returncode == 0, nxt.stderr
+    assert not left.exists(), sorted(left.iterdir())
+    assert list(tmp_path.glob("arena-*")) == [], "and the next match left nothing either"
+
+
+def _twins(kind: list[str], secure: bool, tmp_path, reap, run: int) -> dict:
+    """A match with one external process, started twice at the same moment; the match's result."""
+    listen = (
+        ["--secure", "--listen", f"tcp/127.0.0.1:{free_port()}"]
+        if secure
+        else ["--listen", f"unixsock-stream/{tmp_path}/r{run}.sock"]
+    )
+    external = "a/1" if kind[0] == "robot" else "basestation/b"
+    match = spawn(*GAME, "--external", external, "--match", f"twins{run}", *listen)
+    reap.append(match)
+    command = _printed(match)
+    twins = [subprocess.Popen([*ARENA, *command[1:]], stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    reap.extend(twins)
+    errs = [t.communicate(timeout=120)[1] for t in twins]
+    codes = sorted(t.returncode for t in twins)
+    assert codes == [0, 2], errs
+    loser = errs[[t.returncode for t in twins].index(2)]
+    assert "is already running in match" in loser.strip().splitlines()[-1], loser
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    return json.loads(out)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("secure", [False, True], ids=["plain", "secure"])
+@pytest.mark.parametrize("kind", [["robot"], ["basestation"]])
+def test_of_two_simultaneous_starts_exactly_one_plays(kind, secure, tmp_path, reap):
+    """5 runs per kind and mode (issue 36: before, both robots played in 4 of 4 runs)."""
+    for run in range(5):
+        result = _twins(kind, secure, tmp_path, reap, run)
+        assert result["outcome"] == "completed" and result["rejected"] == 0, (run, result["rejected_reasons"])
+        assert len(result["refused_starts"]) == 1, (run, result["refused_starts"])
+
+
+def test_a_second_engine_started_by_hand_is_refused(tmp_path, reap):
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    match = spawn(*GAME, "--external", "a/1", "--match", "one", "--listen", sock)
+    reap.append(match)
+    command = _printed(match)
+    engine = subprocess.run(
+        [*ARENA, "run", "engine", "--match", "one", "--connect", sock, "--home", "BS", "--away", "BS"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert engine.returncode == 2, engine.stderr
+    assert "engine is already running in match 'one' (started by arena match, pid" in engine.stderr, engine.stderr
+    robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
+    assert robot.returncode == 0, robot.stderr
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0 and json.loads(out)["outcome"] == "completed", err
+
+
+def test_a_match_that_cannot_start_leaves_no_temp_dir(tmp_path):
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    r = subprocess.run(
+        [*ARENA, *GAME, "--secure", "--logs", "/proc/no-logs-here"], capture_output=True, text=True, env=env, timeout=60
+    )
+    assert r.returncode == 2 and "/proc/no-logs-here" in r.stderr, r.stderr
+    assert list(tmp_path.glob("arena-*")) == [], "its secrets stayed behind"
