@@ -10,15 +10,23 @@ the tick's frames are published). The engine applies the step's teleports
 its `RefereeOverride`s (rules/referee_box.py `Forced`), which is why those
 need a tick `at`. Their effect is in every frame sent after the tick, so in
 the digest; a plain match has no steps and plays exactly as before.
+
+The same messages drive a live session (`--realtime` or `--live`): `arena
+operator` puts `Operator` frames, and the engine and the referee take them at
+their next tick (`OperatorInbox`) and log what they applied, with the tick.
 """
 
 from __future__ import annotations
 
 import math
 
+import msgspec
+
 from arena.runtime.config import MatchConfig
-from arena.schemas.messages import Condition, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot
+from arena.schemas.messages import Condition, Operator, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot
 from arena.sim.physics import Physics
+
+_OPERATOR = msgspec.msgpack.Decoder(Operator)
 
 
 def referee_steps(steps: tuple[Step, ...]) -> list[tuple[int, RefereeOverride]]:
@@ -115,3 +123,35 @@ class Director:
         pose = (x, y, th0 if a.orientation is None else a.orientation)
         twist = (vx0 if a.vx is None else a.vx, vy0 if a.vy is None else a.vy, w0 if a.omega is None else a.omega)
         ph.teleport_robot(a.team, a.robot, pose, twist)
+
+
+class OperatorInbox:
+    """A live session's `operator` frames: taken at each tick, the wanted kinds kept and logged."""
+
+    def __init__(self, node, kinds: tuple[type, ...]):
+        self.key = node.keys.operator()
+        self.channel = node.transport.subscribe(self.key)
+        self.rejections = node.rejections
+        self.kinds = kinds
+        self.log: list[dict[str, object]] = []  # {tick, seq, action}: what was applied, for the summary
+
+    def take(self, k: int) -> list:
+        out = []
+        while (raw := self.channel.try_recv()) is not None:
+            try:
+                msg = _OPERATOR.decode(raw)
+            except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+                self.rejections.reject(self.key, "malformed", str(exc))
+                continue
+            for a in msg.actions:
+                if isinstance(a, self.kinds):
+                    out.append(a)
+                    self.log.append({"tick": k, "seq": msg.seq, "action": msgspec.to_builtins(a)})
+        return out
+
+
+def operator_inbox(node, kinds: tuple[type, ...]) -> OperatorInbox | None:
+    """The node's operator inbox in a live session (`--realtime`, `--live`); None in a lockstep match,
+    which stays a pure function of its configuration and seed."""
+    cfg = node.cfg
+    return OperatorInbox(node, kinds) if cfg.realtime or cfg.live >= 0 else None

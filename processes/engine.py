@@ -40,7 +40,7 @@ import time
 
 import numpy as np
 
-from arena.processes.director import Director, referee_steps
+from arena.processes.director import Director, operator_inbox, referee_steps
 from arena.rules.referee_box import check_referee
 from arena.rules.setpieces import Restarts
 from arena.runtime import seeds
@@ -49,7 +49,7 @@ from arena.runtime.drivers import Reactor
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
-from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee, encode
+from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee, TeleportBall, TeleportRobot, encode
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics, StuckWatch
 from arena.sim.sensors import NormalStream, sense_every
@@ -89,6 +89,7 @@ class EngineNode(Node):
         self.restarts = Restarts(cfg, self.physics)
         # A scenario's steps (processes/director.py); its teleports at tick 0 are its start.
         self.director = Director(cfg, self.physics) if cfg.scenario.active else None
+        self.operator = operator_inbox(self, (TeleportBall, TeleportRobot))  # live sessions: `arena operator`
         if any(t == 0 and o.command == "START" for t, o in referee_steps(cfg.scenario.steps)):
             self.physics.start_play()  # the ball is in play from tick 0, before the referee's frame arrives
         self.wheels = Drive(cfg.robot).wheels  # wheel speeds a `cmd` in mode "wheels" must carry
@@ -180,6 +181,11 @@ class EngineNode(Node):
                 )
         if self.director is not None:
             self.director.act(k)
+        if self.operator is not None:
+            for action in self.operator.take(k):
+                if self.director is None:
+                    self.director = Director(self.cfg, self.physics)
+                self.director.apply(action)
 
     def publish(self, k: int) -> None:
         ph, sp = self.physics, self.cfg.sensor
@@ -300,4 +306,4 @@ class EngineNode(Node):
             "placed": len(self.restarts.placed),
             "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
             "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
-        }
+        } | ({"operator": self.operator.log} if self.operator is not None else {})

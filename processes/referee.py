@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import time
 
-from arena.processes.director import referee_steps
+from arena.processes.director import operator_inbox, referee_steps
 from arena.refbox.follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
+from arena.schemas.messages import RefereeOverride
 
 
 class RefereeNode(Node):
@@ -30,14 +31,18 @@ class RefereeNode(Node):
         self.decide = self.follower.step if self.follower else self.box.step
         # A scenario's referee overrides (processes/director.py), each forced at the first referee tick >= its own.
         self.forced = referee_steps(self.cfg.scenario.steps)
+        self.operator = operator_inbox(self, (RefereeOverride,))  # live sessions: `arena operator`
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
         events = [ev for frame in self.events_in.take(k) for ev in frame.events]
+        due: tuple = ()
         if self.forced and self.forced[0][0] <= k:
             due = tuple(o for at, o in self.forced if at <= k)
             self.forced = [(at, o) for at, o in self.forced if at > k]
-            self.ref_out.send(self.box.frame(k, self.box.step(k, events, due)))
+        live = tuple(self.operator.take(k)) if self.operator is not None else ()
+        if due or live:
+            self.ref_out.send(self.box.frame(k, self.box.step(k, events, due, live)))
         else:
             self.ref_out.send(self.box.frame(k, self.decide(k, events)))
         self.last_tick = k
@@ -62,6 +67,8 @@ class RefereeNode(Node):
 
     def summary_extra(self) -> dict[str, object]:
         out = self.box.summary()
+        if self.operator is not None:
+            out["operator"] = self.operator.log
         if self.follower is not None:
             out["refbox_follow"] = self.follower.summary()
         return out

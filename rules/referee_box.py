@@ -116,10 +116,11 @@ class Clock:
 
 @dataclass(frozen=True)
 class Forced:
-    """A scenario's step forces `override` at `tick` (processes/director.py; docs/scenarios.md)."""
+    """A scenario's step, or a live session's operator, forces `override` at `tick` (processes/director.py)."""
 
     tick: int
     override: RefereeOverride
+    by: str = "scenario"  # or "operator"
 
 
 @dataclass(frozen=True)
@@ -428,8 +429,8 @@ class LogEntry:
             case Observed(event=ev):
                 who = f" {ev.team}/{ev.robot}" if ev.robot >= 0 else (f" {ev.team}" if ev.team else "")
                 return f"{ev.kind.lower()}{who}"
-            case Forced():
-                return "scenario"
+            case Forced(by=by):
+                return by
             case _:
                 return "clock"
 
@@ -446,10 +447,18 @@ class RefereeBox:
         self.log: list[LogEntry] = []
         self.counts: Counter[str] = Counter()
 
-    def step(self, tick: int, events: list[BallEvent], forced: tuple[RefereeOverride, ...] = ()) -> list[RefCommand]:
-        """The commands of referee tick `tick`: a scenario's forced ones, the engine's events, then the clock."""
+    def step(
+        self,
+        tick: int,
+        events: list[BallEvent],
+        forced: tuple[RefereeOverride, ...] = (),
+        operator: tuple[RefereeOverride, ...] = (),
+    ) -> list[RefCommand]:
+        """The commands of referee tick `tick`: a scenario's and an operator's forced ones, the engine's
+        events, then the clock."""
         out: list[RefCommand] = []
-        for change in [*(Forced(tick, o) for o in forced), *(Observed(tick, ev) for ev in events), Clock(tick)]:
+        changes = [*(Forced(tick, o) for o in forced), *(Forced(tick, o, "operator") for o in operator)]
+        for change in [*changes, *(Observed(tick, ev) for ev in events), Clock(tick)]:
             pre = self.state
             state, cmds = process(pre, change, self.rules)
             if state == pre and not cmds:

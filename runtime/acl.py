@@ -20,7 +20,9 @@ read-only `viewer`) gets a zenoh `access_control` policy, matched on its
 * the viewer: reading `world`, `referee`, `field`, `engine/events` and the
   teams' `report`s and `order`s (the live viewer draws what each robot and
   base station believes), and the live viewer's `control` (pause, step,
-  pace) to the engine.
+  pace) to the engine;
+* the `operator`: putting `operator` frames (teleports, referee overrides),
+  which only the engine and the referee may read, and nobody else may put.
 
 The router (hosted by `arena match` / `arena run router`) enforces it for every process,
 since in a secure match every process is a client of it (runtime/credentials.py says why).
@@ -36,6 +38,8 @@ from arena.schemas.keys import (
     CONFIG,
     CONTROL,
     KEY_BY_NAME,
+    OPERATOR,
+    OPERATOR_PRINCIPAL,
     REFUSED,
     SERVED,
     SUMMARY,
@@ -97,6 +101,14 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         perms["put/egress"] = [*reads, *control]
         perms["query/ingress"] = [*config, *control]
         perms["reply/egress"] = [*config, *control]
+    operator = [f"{prefix}{OPERATOR}"]  # a live session's teleports and overrides: the operator's alone
+    if principal in ("engine", "referee"):
+        perms["declare_subscriber/ingress"] = [*perms["declare_subscriber/ingress"], *operator]
+        perms["put/egress"] = [*perms["put/egress"], *operator]
+    if principal == OPERATOR_PRINCIPAL:  # puts its frames and reads the score; no token, no process of the match
+        perms["put/ingress"] = operator
+        for what in ("liveliness_token/ingress",):
+            perms.pop(what)
     if principal == COLLECTOR_PRINCIPAL:
         perms["declare_subscriber/ingress"] = perms["put/egress"] = [f"{prefix}{SUMMARY}/**", *reads]
         perms["put/ingress"] = [f"{prefix}{ACK}/**"]
@@ -120,8 +132,8 @@ def _served(rel: str) -> bool:
 
 
 def principals(processes: list[str]) -> list[str]:
-    """The principals of a match: its processes (`MatchConfig.processes()`) and the viewer."""
-    return [*processes, VIEWER] if VIEWER not in processes else list(processes)
+    """The principals of a match: its processes (`MatchConfig.processes()`), the viewer and the operator."""
+    return [*processes, *(p for p in (VIEWER, OPERATOR_PRINCIPAL) if p not in processes)]
 
 
 def access_control(prefix: str, robots: int, processes: list[str]) -> dict:

@@ -28,6 +28,7 @@ from arena.schemas.keys import (
     MAC_KEY_BYTES,
     MAX_BATCH,
     MAX_FRAME_BYTES,
+    OPERATOR,
     SIGNED_DATA,
     SUMMARY,
     TAP,
@@ -94,6 +95,7 @@ Infrastructure keys (not data pairs):
 | `arena/<match>/{ACK}/<process>` | the collector's acknowledgement of a summary (payload `ack`) |
 | `arena/<match>/{TAP}/<process>` | `TapBatch`, only in a recorded match: every frame the process sent, batched every {TAP_PERIOD} ticks, for the recorder (docs/recording.md) |
 | `arena/<match>/{CONTROL}` | `Control`, only in a live lockstep match (`arena match --live`): the viewer pauses, steps and paces the engine; waits only, never a different digest (docs/recording.md) |
+| `arena/<match>/{OPERATOR}` | `Operator`, only in a live session (`--realtime` or `--live`): teleports and referee overrides from `arena operator`, applied at the engine's and the referee's next tick; in a secure match only the `operator` principal may put it (docs/scenarios.md) |
 
 """
 
@@ -433,6 +435,9 @@ all), plus its own `{ALIVE}/<process>` and `{WAITING}/<process>/*` tokens,
 `{ALIVE}/**`, `{WAITING}/**`, `{COLLECTOR}` and `{CONFIG}`, and asking for its identity
 (`{CLAIM}/<process>`, below). A put or a subscription outside that is dropped silently by the
 router. `viewer` is read-only: it may put nothing but the live `control`.
+`operator` (`operator.json5`, for `arena operator`) may put nothing but
+`{OPERATOR}`, which only the engine and the referee may read; it declares no
+liveliness token.
 
 **Message authentication** (every match, with or without `--secure`). The
 sender of `{SUMMARY}/<process>`, `{TAP}/<process>` and of

@@ -246,6 +246,8 @@ REFUSED = "refused"  # arena/<m>/refused/<process id>: a second process with tha
 CLAIM = "claim"
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
 CONTROL = "control"  # arena/<m>/control: Control frames, viewer -> engine, live lockstep matches only
+OPERATOR = "operator"  # arena/<m>/operator: Operator frames -> engine and referee, live sessions only
+OPERATOR_PRINCIPAL = "operator"  # the one principal the access control lets put them
 TAP_PERIOD = 50  # [ticks] one tap batch per process every 1 s of simulated time (at 20 ms ticks)
 
 
@@ -289,6 +291,9 @@ class Keys:
 
     def control(self) -> str:
         return f"{self.prefix}{CONTROL}"
+
+    def operator(self) -> str:
+        return f"{self.prefix}{OPERATOR}"
 
     def ack(self, process: str) -> str:
         return f"{self.prefix}{ACK}/{process}"

@@ -433,6 +433,18 @@ class Step(Base):
     actions: list[Action] = []
 
 
+class Operator(Base):
+    """Operator to engine and referee, live sessions only (`--realtime` or `--live`; `arena operator`).
+
+    The scenario messages, applied at the receiver's next tick: the engine takes the
+    teleports, the referee the overrides. Both log what they applied, with the tick,
+    in their summaries' `operator`, so a session can be written down as a scenario.
+    """
+
+    seq: Annotated[int, Meta(ge=0, description="increases with every frame of the operator")]
+    actions: Annotated[list[TeleportBall | TeleportRobot | RefereeOverride], Meta(description="applied in order")] = []
+
+
 MESSAGE_TYPES: tuple[type[Base], ...] = (
     FieldSpec,
     Sense,
@@ -447,6 +459,7 @@ MESSAGE_TYPES: tuple[type[Base], ...] = (
     TapBatch,
     Control,
     Step,
+    Operator,
 )
 
 _ENCODER = msgspec.msgpack.Encoder()

@@ -56,7 +56,7 @@ def test_a_secure_match_keeps_team_b_out_of_team_a_and_a_hand_started_robot_play
     command = match.stderr.readline().split()
     assert command[:3] == ["arena", "run", "robot"] and "--credentials" in command
     assert command[command.index("--connect") + 1] == f"tls/127.0.0.1:{port}"
-    for name in ("robot-b-1", "basestation-a", "referee", "viewer", "engine"):
+    for name in ("robot-b-1", "basestation-a", "referee", "viewer", "engine", "operator"):
         path = creds / f"{name}.json5"
         assert stat.S_IMODE(path.stat().st_mode) == 0o600, name
     frag = {p.stem: json.loads(p.read_text()) for p in creds.glob("*.json5")}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import hashlib
 import json
 
-from arena.runtime.acl import access_control, permissions
+from arena.runtime.acl import access_control, permissions, principals
 from arena.runtime.credentials import Secrets, load_fragment
 from arena.runtime.mac import Keyring, tag
 from arena.schemas.keys import process_names
@@ -60,7 +60,7 @@ def test_the_viewer_reads_world_referee_and_field_and_writes_no_match_data():
 def test_default_deny_and_one_policy_per_principal():
     acl = access_control(P, 3, NAMES)
     assert acl["enabled"] and acl["default_permission"] == "deny"
-    assert {s["id"] for s in acl["subjects"]} == {n.replace("/", "-") for n in NAMES} | {"viewer"}
+    assert {s["id"] for s in acl["subjects"]} == {n.replace("/", "-") for n in NAMES} | {"viewer", "operator"}
     ids = [r["id"] for r in acl["rules"]]
     assert len(ids) == len(set(ids))
     assert all(r["key_exprs"] and all(k.startswith(P) for k in r["key_exprs"]) for r in acl["rules"])
@@ -94,3 +94,12 @@ def test_the_mac_is_keyed_blake2b_over_key_nul_payload():
     assert ok(payload, tag(key, "arena/m/engine/events", payload))
     assert not ok(payload, None) and not ok(payload, tag(key, "arena/m/referee", payload))
     assert ring.verifier("robot/a/1", "arena/m/summary/robot/a/1") is None  # no key: accepted as before
+
+
+def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_read_them():
+    key = f"{P}operator"
+    puts = {p for p in principals(NAMES) if key in permissions(p, P, 3).get("put/ingress", [])}
+    reads = {p for p in principals(NAMES) if key in permissions(p, P, 3).get("declare_subscriber/ingress", [])}
+    assert puts == {"operator"} and reads == {"engine", "referee"}
+    op = permissions("operator", P, 3)
+    assert op["put/ingress"] == [key] and "liveliness_token/ingress" not in op

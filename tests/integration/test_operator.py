@@ -1,0 +1,50 @@
+"""The operator principal: `arena operator` teleports the ball and forces a referee command in a live
+session over real zenoh; the engine and the referee apply them at a tick and log them."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+
+from arena.recording.reader import load
+from arena.runtime.session import listening
+from arena.schemas.messages import World
+from tests.integration.helpers import ARENA, free_port, spawn, wait_for, wait_until_playing
+
+
+def test_arena_operator_drives_a_real_time_match(reap, tmp_path):
+    port, mcap = free_port(), tmp_path / "op.mcap"
+    endpoint = f"tcp/127.0.0.1:{port}"
+    match = spawn(
+        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "4", "--listen", endpoint,
+        "--match", "op", "--record", str(mcap), "--json",
+    )  # fmt: skip
+    reap.append(match)
+    wait_for(lambda: listening(endpoint), 60, "the match's router")
+    wait_until_playing(endpoint, "op")
+    teleport = '{"type": "teleport_ball", "x": 3.3, "y": -2.2, "vx": 0, "vy": 0}'
+    corner = '{"type": "referee", "command": "CORNER", "team": "b"}'
+    op = subprocess.run(
+        [*ARENA, "operator", "--match", "op", "--connect", endpoint, teleport, corner],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert op.returncode == 0 and "sent 2 action(s) to arena/op/operator" in op.stdout, op.stderr
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    assert json.loads(out)["events"].get("CORNER", 0) >= 1
+    rec = load(str(mcap))
+    (applied,) = rec.summaries["engine"].extra["operator"]
+    assert applied["action"]["type"] == "teleport_ball"
+    world = {w.tick: w for w in rec.decoded("world", World)}[applied["tick"]]
+    assert (world.ball_x, world.ball_y) == (3.3, -2.2), "the world frame of that tick shows the teleport"
+    (forced,) = rec.summaries["referee"].extra["operator"]
+    log = rec.summaries["referee"].extra["log"]
+    assert {"tick": forced["tick"], "command": "CORNER", "team": "b", "cause": "operator"} in log
+
+
+def test_a_bad_action_is_one_line_and_nobody_listening_is_said(tmp_path):
+    bad = subprocess.run(
+        [*ARENA, "operator", "--match", "x", "--connect", "tcp/127.0.0.1:1", '{"type": "teleport_bal"}'],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "ACTION 1:" in bad.stderr, bad.stderr
