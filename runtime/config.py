@@ -333,7 +333,7 @@ class MatchConfig:
         if not self.half_time > 0:
             raise ConfigError(f"--half-time must be positive, got {self.half_time}")
         if not self.half_time <= MAX_HALF_TIME:  # also catches inf and nan
-            raise ConfigError(f"--half-time must be at most {MAX_HALF_TIME:g} s, got {self.half_time}")
+            raise ConfigError(f"--half-time must be at most {MAX_HALF_TIME:g} s per half, got {self.half_time}")
         t = self.timing  # before anything divides by dt
         if not (math.isfinite(t.dt) and 0 < t.dt <= MAX_DT) or not 1 <= t.substeps <= MAX_SUBSTEPS:
             raise ConfigError(

@@ -119,6 +119,15 @@ def parse_override(text: str) -> tuple[str, str, float]:
         raise ConfigError(f"bad link override {text!r}: use CLASS.PARAM=VALUE, e.g. wifi.latency_ms=12") from None
 
 
+def parse_overrides(texts) -> dict[str, dict[str, float]]:
+    """Every `--link-param CLASS.PARAM=V` as {class: {param: value}}, the later one winning."""
+    out: dict[str, dict[str, float]] = {}
+    for text in texts:
+        cls, param, value = parse_override(text)
+        out.setdefault(cls, {})[param] = value
+    return out
+
+
 class LinkEmulator:
     """Decides, frame by frame and in send order, whether a frame is dropped and how late it is."""
 

@@ -9,8 +9,6 @@ import math
 import sys
 from typing import TYPE_CHECKING, NoReturn
 
-from arena.runtime.config import MAX_HALF_TIME
-
 if TYPE_CHECKING:
     from arena.tools.launch.result import MatchResult
 
@@ -77,14 +75,6 @@ def seconds(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
     if not math.isfinite(value) or value <= 0:
         raise argparse.ArgumentTypeError(f"{text!r}: give a finite number of seconds > 0")
-    return value
-
-
-def half_time(text: str) -> float:
-    """argparse type: a half's length, finite, > 0 and at most MAX_HALF_TIME."""
-    value = seconds(text)
-    if value > MAX_HALF_TIME:
-        raise argparse.ArgumentTypeError(f"{text!r}: at most {MAX_HALF_TIME:g} s per half")
     return value
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 
-from arena.commands._common import half_time
+from arena.commands._common import seconds
 from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 
 
@@ -17,7 +17,7 @@ def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tru
     p.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team, goalkeeper included (3)")
     p.add_argument(
         "--half-time",
-        type=half_time,
+        type=seconds,
         default=None,
         metavar="SECONDS",
         help=f"simulated half length [s], at most {MAX_HALF_TIME:g} (300)",
@@ -63,41 +63,43 @@ def every_match_latency(p: argparse.ArgumentParser) -> None:
 
 
 def match_config(
-    args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None
+    args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None, seed: bool = True
 ) -> MatchConfig:
-    from arena.runtime.links import parse_override, resolve
+    """The one place flags become a `MatchConfig`: the match flags a command has (`--home`, `--away`,
+    `--robots`, `--half-time`, `--seed`, `--link`, `--link-param`, `--perception-latency`, `--batch`,
+    `--config FILE`) over the file's values or the defaults, every range checked by `MatchConfig.validate`.
+    A command that plays many matches gets the one they share (`seed=False`: its --seed is not a match's)."""
+    from arena.runtime.links import parse_overrides, resolve
     from arena.strategies import registry
 
-    overrides: dict[str, dict[str, float]] = {}
-    for text in args.link_param:
-        cls, param, value = parse_override(text)
-        overrides.setdefault(cls, {})[param] = value
+    def given(name: str):
+        return getattr(args, name, None)
+
+    overrides = parse_overrides(given("link_param") or ())
     base = MatchConfig()
-    if getattr(args, "config_file", None):
+    if given("config_file"):
         from arena.runtime import matchfile
 
         base = matchfile.load(args.config_file)
-    link = args.link if args.link is not None else base.link
-    if args.link is None:  # the file's overrides, then the flags' on top
+    link = given("link") if given("link") is not None else base.link
+    if given("link") is None:  # the file's overrides, then the flags' on top
         merged = {cls: dict(ps) for cls, ps in base.link_overrides.items()}
         for cls, ps in overrides.items():
             merged.setdefault(cls, {}).update(ps)
         overrides = merged
     resolve(link, overrides)  # validates preset, classes and values
-    home = registry.resolve_name(args.home or base.home)
-    away = registry.resolve_name(args.away or base.away)
     timing = base.timing
-    if getattr(args, "perception_latency", None) is not None:
+    if given("perception_latency") is not None:
         timing = dataclasses.replace(timing, perception_latency=args.perception_latency)
-    if getattr(args, "batch", None) is not None:
+    if given("batch") is not None:
         timing = dataclasses.replace(timing, batch=args.batch)
     cfg = base.replace(
         timing=timing,
-        seed=args.seed if args.seed is not None else base.seed,
-        home=home,
-        away=away,
-        robots=args.robots if args.robots is not None else base.robots,
-        half_time=args.half_time if args.half_time is not None else base.half_time,
+        seed=args.seed if seed and given("seed") is not None else base.seed,
+        home=registry.resolve_name(given("home") or base.home),
+        away=registry.resolve_name(given("away") or base.away),
+        robots=given("robots") if given("robots") is not None else base.robots,
+        half_time=given("half_time") if given("half_time") is not None else base.half_time,
         link=link,
         link_overrides=overrides,
         realtime=realtime,

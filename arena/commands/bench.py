@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from arena.commands._common import add_command, half_time, positive_int
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.commands._common import add_command, positive_int, seconds
+from arena.commands._match_flags import match_config
+from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
 STOPS_PROCESSES = True
@@ -38,7 +39,7 @@ def add_parser(sub) -> None:
         "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
     )
     b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
-    b.add_argument("--half-time", type=half_time, default=60.0, metavar="SECONDS", help="half length [s] (60)")
+    b.add_argument("--half-time", type=seconds, default=60.0, metavar="SECONDS", help="half length [s] (60)")
     b.add_argument("--robots", type=int, default=3, metavar="N")
     b.add_argument("--link", default="ideal", metavar="PRESET")
     b.add_argument("--json", action="store_true")
@@ -60,14 +61,11 @@ def run(args: argparse.Namespace) -> int:
     from arena.tools.experiments import bench
 
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
-        from arena.runtime.links import resolve
-
-        resolve(args.link, {})
-        MatchConfig(robots=args.robots, half_time=args.half_time, link=args.link).validate()
+        base = match_config(args, seed=False)  # --seed is nav's
         if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
-            registry.resolve_name(args.strategy)
+            strategy = registry.resolve_name(args.strategy)
     if args.what == "record":
-        return bench.bench_record(args.runs, args.half_time, args.robots, args.link, args.json)
+        return bench.bench_record(base, args.runs, args.json)
     if args.what == "robot":
         return bench.bench_robot(args.strategy, args.json)
     if args.what == "learn":
@@ -84,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.what == "throughput":
         from arena.tools.experiments import throughput
 
-        return throughput.bench_throughput(args.runs, args.half_time, args.robots, args.link, args.strategy, args.json)
+        return throughput.bench_throughput(base, args.runs, strategy, args.json)
     if args.what == "nav":
         from arena.tools.experiments import navbench
 
@@ -96,4 +94,4 @@ def run(args: argparse.Namespace) -> int:
             plots=args.plots,
             as_json=args.json,
         )
-    return bench.bench_match(args.runs, args.half_time, args.robots, args.link, args.json)
+    return bench.bench_match(base, args.runs, args.json)

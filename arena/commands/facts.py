@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from arena.commands._common import add_command, half_time
-from arena.commands._match_flags import every_match_latency
+from arena.commands._common import add_command, seconds
+from arena.commands._match_flags import every_match_latency, match_config
 from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
@@ -28,9 +28,7 @@ def add_parser(sub) -> None:
     )
     fa.add_argument("--seeds", type=int, default=20, metavar="N", help="matches, seeds first-seed.. (20)")
     fa.add_argument("--first-seed", type=int, default=0, metavar="S", help="first seed (0)")
-    fa.add_argument(
-        "--half-time", type=half_time, default=60.0, metavar="SECONDS", help="simulated half length [s] (60)"
-    )
+    fa.add_argument("--half-time", type=seconds, default=60.0, metavar="SECONDS", help="simulated half length [s] (60)")
     fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
     fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
     fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once; 0 (the default): up to 2")
@@ -46,16 +44,14 @@ def run(args: argparse.Namespace) -> int:
 
     if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
         raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")
+    every = match_config(args, seed=False)  # --seed is the round robin's
     return facts.main(
+        every,
         seeds=args.seeds,
         first_seed=args.first_seed,
-        half_time=args.half_time,
-        home=args.home,
-        away=args.away,
         workers=args.workers or None,
         round_robin_of=[s for s in (args.round_robin or "").split(",") if s] or None,
         legs=args.legs,
         seed=args.seed,
-        perception_latency=args.perception_latency,
         as_json=args.json,
     )

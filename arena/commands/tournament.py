@@ -6,8 +6,8 @@ import argparse
 import json
 import sys
 
-from arena.commands._common import ENGINE_FLAG, add_command, half_time, positive_int
-from arena.commands._match_flags import every_match_latency
+from arena.commands._common import ENGINE_FLAG, add_command, positive_int, seconds
+from arena.commands._match_flags import every_match_latency, match_config
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
         "--legs", type=positive_int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
     )
     t.add_argument(
-        "--half-time", type=half_time, default=300.0, metavar="SECONDS", help="simulated half length [s] (300)"
+        "--half-time", type=seconds, default=300.0, metavar="SECONDS", help="simulated half length [s] (300)"
     )
     t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
@@ -62,7 +62,6 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from arena.runtime.links import parse_override, resolve
     from arena.strategies import registry
     from arena.tools.experiments import tournament
     from arena.tools.experiments.tournament_report import print_summary
@@ -72,17 +71,9 @@ def run(args: argparse.Namespace) -> int:
     names = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
     if len(set(names)) < 2:
         raise ConfigError("--strategies needs at least two different strategies")
-    if args.legs < 1 or args.jobs < 0 or args.half_time <= 0 or not 1 <= args.robots <= 6:
-        raise ConfigError("--legs >= 1, --jobs >= 0, --half-time > 0 and --robots 1..6, please")
-    overrides: dict[str, dict[str, float]] = {}
-    for text in args.link_param:
-        cls, param, value = parse_override(text)
-        overrides.setdefault(cls, {})[param] = value
-    resolve(args.link, overrides)
-    if args.perception_latency is not None:  # its range, as arena match checks it
-        from arena.runtime.config import MatchConfig, TimingParams
-
-        MatchConfig(timing=TimingParams(perception_latency=args.perception_latency)).validate()
+    every = match_config(args, seed=False)  # what every match shares, each range checked as for arena match
+    if args.jobs < 0:
+        raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
         from arena.tools.experiments.cluster import parse_address, parse_runtime_env
 
@@ -93,9 +84,9 @@ def run(args: argparse.Namespace) -> int:
     opts = tournament.TournamentOptions(
         strategies=tuple(names),
         legs=args.legs,
-        half_time=args.half_time,
-        robots=args.robots,
-        link=args.link,
+        half_time=every.half_time,
+        robots=every.robots,
+        link=every.link,
         link_param=tuple(args.link_param),
         perception_latency=args.perception_latency,
         seed=args.seed,

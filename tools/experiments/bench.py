@@ -20,16 +20,16 @@ from arena.tools.console import console as make_console
 from arena.tools.launch import launcher, zygote
 
 
-def bench_match(
-    runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
-) -> int:
+def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
+    """`runs` matches of `base` (seeds 1000, 1001, ...) as separate processes: speed and start-up."""
+    half_time, robots, link = base.half_time, base.robots, base.link
     console = make_console(stderr=True)
     results = []
     # Before the first router: every match's processes are forked by the zygote (tools/launch/zygote.py),
     # the first match's too (warm: the zygote has imported everything before the first launch).
-    zygote.start(ready=len(MatchConfig(robots=robots).processes()))
+    zygote.start(ready=len(base.processes()))
     for i in range(runs):
-        cfg = MatchConfig(seed=1000 + i, robots=robots, half_time=half_time, link=link)
+        cfg = base.replace(seed=1000 + i)
         console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, {robots}v{robots}, link {link} ...")
         r = launcher.play_match(cfg).to_dict()
         results.append(r)
@@ -89,21 +89,20 @@ def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: b
     return 0
 
 
-def bench_record(
-    runs: int = 3, half_time: float = 60.0, robots: int = 3, link: str = "ideal", as_json: bool = False
-) -> int:
-    """The cost of `--record`: the same matches with and without a recorder, interleaved."""
+def bench_record(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
+    """The cost of `--record`: matches of `base` with and without a recorder, interleaved."""
+    half_time, robots, link = base.half_time, base.robots, base.link
     console = make_console(stderr=True)
     plain, recorded, sizes = [], [], []
-    zygote.start(ready=len(MatchConfig(robots=robots).processes()) + 1)
+    zygote.start(ready=len(base.processes()) + 1)
     with tempfile.TemporaryDirectory(prefix="arena-bench-") as tmp:
         for i in range(runs):
-            base = MatchConfig(seed=1000 + i, robots=robots, half_time=half_time, link=link)
+            cfg = base.replace(seed=1000 + i)
             path = Path(tmp) / f"run{i}.mcap"
             # Alternate which goes first, so that drift in the machine's load favours neither.
             order = [(False, ""), (True, str(path))]
             for rec, record in order if i % 2 == 0 else reversed(order):
-                r = launcher.play_match(base, record=record).to_dict()
+                r = launcher.play_match(cfg, record=record).to_dict()
                 (recorded if rec else plain).append(r)
                 console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
             sizes.append(path.stat().st_size)

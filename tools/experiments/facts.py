@@ -26,7 +26,7 @@ from itertools import combinations
 import msgspec
 
 from arena.recording.analysis.facts import MatchFacts, measure
-from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY, ConfigError, MatchConfig, TimingParams
+from arena.runtime.config import ConfigError, MatchConfig
 from arena.schemas.messages import Referee, World
 from arena.tools.experiments import facts_table, pools
 from arena.tools.launch.inprocess import play_in_process
@@ -67,9 +67,10 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
 
 
 def round_robin(
-    strategies: list[str], legs: int, half_time: float, seed: int, workers: int, timing: TimingParams | None = None
+    strategies: list[str], legs: int, every: MatchConfig, seed: int, workers: int
 ) -> tuple[list, list[MatchFacts]]:
-    """Every pairing `legs` times, home and away alternating, in-process; returns (Results, facts)."""
+    """Every pairing `legs` times, home and away alternating, matches like `every`, in-process;
+    returns (Results, facts)."""
     from arena.runtime import seeds
     from arena.tools.experiments.fixtures import Result
 
@@ -79,8 +80,7 @@ def round_robin(
             home, away = (first, second) if leg % 2 == 1 else (second, first)
             s = seeds.derive(seed, "tournament", first, second, leg) % (2**31)
             fixtures.append((first, second, leg, home, away, s))
-    timing = timing or TimingParams()
-    cfgs = [MatchConfig(seed=s, home=h, away=a, half_time=half_time, timing=timing) for _, _, _, h, a, s in fixtures]
+    cfgs = [every.replace(seed=s, home=h, away=a) for _, _, _, h, a, s in fixtures]
     facts = many(cfgs, workers, progress=True)
     results = [
         Result(
@@ -101,42 +101,33 @@ def round_robin(
 
 
 def main(
+    every: MatchConfig,
     seeds: int = 20,
     first_seed: int = 0,
-    half_time: float = 60.0,
-    home: str = "chase",
-    away: str = "chase",
     workers: int | None = None,
     round_robin_of: list[str] | None = None,
     legs: int = 4,
     seed: int = 0,
-    perception_latency: int | None = None,
     as_json: bool = False,
 ) -> int:
-    """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2."""
+    """`arena facts`: one line per seed and a summary, or a round robin with the paper's Table 2.
+    `every`: the match they all play (strategies, half, perception latency); the seeds vary."""
     from arena.strategies import registry
 
     workers = workers or min(2, os.cpu_count() or 1)
-    home, away = registry.resolve_name(home), registry.resolve_name(away)  # as arena match: AD is advance-dynamic
     if seeds < 1 or legs < 1 or workers < 1:
         raise ConfigError(f"--seeds, --legs and --workers must be at least 1 (got {seeds}, {legs}, {workers})")
-    if not half_time > 0:
-        raise ConfigError(f"--half-time must be > 0, got {half_time}")
-    latency = DEFAULT_PERCEPTION_LATENCY if perception_latency is None else perception_latency
-    timing = TimingParams(perception_latency=latency)
-    MatchConfig(timing=timing).validate()  # its range, as arena match checks it
+    timing = every.timing
+    latency = timing.perception_latency
     if not as_json:
         print(f"perception latency {latency} ticks ({latency * timing.dt * 1000:g} ms)")
     t0 = time.monotonic()
-    results, names = None, [home, away]
+    results, names = None, [every.home, every.away]
     if round_robin_of:
         names = [registry.resolve_name(s) for s in round_robin_of]
-        results, facts = round_robin(names, legs, half_time, seed, workers, timing)
+        results, facts = round_robin(names, legs, every, seed, workers)
     else:
-        cfgs = [
-            MatchConfig(seed=s, half_time=half_time, home=home, away=away, timing=timing)
-            for s in range(first_seed, first_seed + seeds)
-        ]
+        cfgs = [every.replace(seed=s) for s in range(first_seed, first_seed + seeds)]
         facts = many(cfgs, workers, progress=True)
     if as_json:
         print(json.dumps(facts_table.as_json(facts, latency, time.monotonic() - t0, results, names)))

@@ -20,6 +20,7 @@ from arena.tools.experiments import pools
 from arena.tools.experiments.fixtures import Fixture, Result, void_reason, write_atomic
 
 if TYPE_CHECKING:
+    from arena.runtime.config import MatchConfig
     from arena.tools.experiments.tournament import TournamentOptions
 
 
@@ -96,33 +97,7 @@ class Runner:
             pools.stop(self.pool, now=self.stopping)
 
     def command(self, fx: Fixture) -> list[str]:
-        a = self.opts
-        argv = [
-            sys.executable,
-            "-m",
-            "arena",
-            "match",
-            "--home",
-            fx.home,
-            "--away",
-            fx.away,
-            "--robots",
-            str(a.robots),
-            "--half-time",
-            str(a.half_time),
-            "--seed",
-            str(fx.seed),
-            "--link",
-            a.link,
-            "--perception-latency",
-            str(a.latency()),
-            "--engine",
-            self.engine,
-            "--json",
-        ]
-        for p in a.link_param:
-            argv += ["--link-param", p]
-        return argv
+        return match_argv(self.match_config(fx), self.engine)
 
     def play(self, fx: Fixture) -> Result | None:
         """Play one fixture (one retry on failure). None if stopped by Ctrl-C."""
@@ -198,6 +173,18 @@ def _play_inprocess(cfg) -> dict:
     from arena.tools.launch.inprocess import play_match
 
     return play_match(cfg).to_dict()
+
+
+def match_argv(cfg: MatchConfig, engine: str) -> list[str]:
+    """The `arena match ... --json` command that plays `cfg` (strategies, size, half, seed, link and its
+    overrides, perception latency) on `engine`, as a user would type it."""
+    argv = [sys.executable, "-m", "arena", "match", "--home", cfg.home, "--away", cfg.away]
+    argv += ["--robots", str(cfg.robots), "--half-time", str(cfg.half_time), "--seed", str(cfg.seed)]
+    argv += ["--link", cfg.link, "--perception-latency", str(cfg.timing.perception_latency)]
+    argv += ["--engine", engine, "--json"]
+    for cls, params in cfg.link_overrides.items():
+        argv += [x for p, v in params.items() for x in ("--link-param", f"{cls}.{p}={v!r}")]
+    return argv
 
 
 def default_jobs() -> int:

@@ -26,11 +26,14 @@ import os
 import resource
 import statistics
 import subprocess
-import sys
 import time
+from typing import TYPE_CHECKING
 
 from arena.tools.console import console as make_console
-from arena.tools.experiments.matches import default_jobs
+from arena.tools.experiments.matches import default_jobs, match_argv
+
+if TYPE_CHECKING:
+    from arena.runtime.config import MatchConfig
 
 ENGINES = ("processes", "inprocess")
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
@@ -48,12 +51,10 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def play(engine: str, seed: int, *, strategy: str, robots: int, half_time: float, link: str) -> dict:
-    argv = [sys.executable, "-m", "arena", "match", "--home", strategy, "--away", strategy]
-    argv += ["--robots", str(robots), "--half-time", str(half_time), "--link", link]
-    argv += ["--seed", str(seed), "--engine", engine, "--json"]
+def play(engine: str, cfg: MatchConfig) -> dict:
+    """`cfg` played by an `arena match` command on `engine`: what the command took, and what it says."""
     cpu0, t0 = _children_cpu(), time.time()
-    proc = subprocess.run(argv, capture_output=True, text=True, timeout=600 + 10 * half_time)
+    proc = subprocess.run(match_argv(cfg, engine), capture_output=True, text=True, timeout=600 + 10 * cfg.half_time)
     wall, cpu = time.time() - t0, _children_cpu() - cpu0
     if proc.returncode != 0:
         tail = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
@@ -62,7 +63,7 @@ def play(engine: str, seed: int, *, strategy: str, robots: int, half_time: float
     started = r.get("play_started_unix") or t0
     return {
         "engine": engine,
-        "seed": seed,
+        "seed": cfg.seed,
         "digest": r["digest"],
         "rtf": r["rtf"],
         "sim_seconds": r["sim_seconds"],
@@ -97,7 +98,8 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
     }
 
 
-def bench_throughput(runs: int, half_time: float, robots: int, link: str, strategy: str, as_json: bool) -> int:
+def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool) -> int:
+    """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved."""
     console = make_console(stderr=True)
     cores = os.cpu_count() or 1
     jobs = default_jobs()
@@ -105,8 +107,8 @@ def bench_throughput(runs: int, half_time: float, robots: int, link: str, strate
     for i in range(runs):
         seed = 1 + i
         for engine in ENGINES if i % 2 == 0 else ENGINES[::-1]:
-            console.print(f"run {i + 1}/{runs}: --engine {engine}, 2 x {half_time:g} s, seed {seed} ...")
-            r = play(engine, seed, strategy=strategy, robots=robots, half_time=half_time, link=link)
+            console.print(f"run {i + 1}/{runs}: --engine {engine}, 2 x {base.half_time:g} s, seed {seed} ...")
+            r = play(engine, base.replace(seed=seed, home=strategy, away=strategy))
             played[engine].append(r)
             console.print(f"  rtf {r['rtf']:.1f}, first tick after {r['launch_to_first_tick_s']:.2f} s")
     per = {e: summarise(played[e], jobs, cores) for e in ENGINES}
@@ -114,7 +116,7 @@ def bench_throughput(runs: int, half_time: float, robots: int, link: str, strate
     ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
     out = {
         "runs": runs,
-        "match": f"{strategy} v {strategy}, {robots}v{robots}, 2 x {half_time:g} s, link {link}",
+        "match": f"{strategy} v {strategy}, {base.robots}v{base.robots}, 2 x {base.half_time:g} s, link {base.link}",
         "cores": cores,
         "jobs": jobs,
         "engines": per,

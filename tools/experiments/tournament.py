@@ -61,13 +61,9 @@ class TournamentOptions:
         return DEFAULT_PERCEPTION_LATENCY if self.perception_latency is None else self.perception_latency
 
     def link_overrides(self) -> dict[str, dict[str, float]]:
-        from arena.runtime.links import parse_override
+        from arena.runtime.links import parse_overrides
 
-        overrides: dict[str, dict[str, float]] = {}
-        for text in self.link_param:
-            cls, param, value = parse_override(text)
-            overrides.setdefault(cls, {})[param] = value
-        return overrides
+        return parse_overrides(self.link_param)
 
 
 def settings(opts: TournamentOptions) -> dict:
