@@ -90,7 +90,7 @@ class DefenseMixin:
         carrier = self.carrier(ball)
         if carrier is not None and S.dist(carrier, own) < self.p.block_zone:
             block = S.block_point(carrier, own, sp, ball)
-            if self.is_blocker(block, carrier, own):
+            if self.is_blocker(order, block, carrier, own):
                 # Within take_distance of the ball, take it, but only from the kick line: straight at the
                 # ball from goal-side; going round the ball to get behind it would open the line to our goal.
                 on_line = abs(wrap_angle(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
@@ -118,12 +118,18 @@ class DefenseMixin:
         if target is None:
             return None
         mark = S.mark_point(target, own, sp.mark_distance)
+        if not self.in_area(order, mark):  # static roles: a mark outside its Fig. 5 area is not its job
+            return None
         return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
 
-    def is_blocker(self, block: Vec, carrier: Vec, own: Vec) -> bool:
+    def is_blocker(self, order: Order, block: Vec, carrier: Vec, own: Vec) -> bool:
         """Advance defense: of our outfield robots, the one that gets onto the kick line soonest blocks:
         the nearest to the block point, counting `behind_penalty` more for a robot not goal-side of the
-        carrier (it has to go round it) and `chase_hysteresis` less for the current blocker."""
+        carrier (it has to go round it) and `chase_hysteresis` less for the current blocker. Static roles:
+        only robots whose Fig. 5 area holds the block point."""
+        if not self.in_area(order, block):
+            self.mem.blocking = False
+            return False
         limit = S.dist(carrier, own) - 0.2
 
         def cost(pt: Vec) -> float:
@@ -131,7 +137,10 @@ class DefenseMixin:
 
         x, y, _ = self.view.pose  # type: ignore[misc]
         mine = (cost((x, y)) - (self.p.chase_hysteresis if self.mem.blocking else 0.0), self.n)
-        self.mem.blocking = all((cost((mx, my)), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
+        mates = self.view.mates.items()
+        self.mem.blocking = all(
+            (cost((mx, my)), n) > mine for n, (mx, my, _) in mates if n != 0 and self.in_area(order, block, n)
+        )
         return self.mem.blocking
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:

@@ -9,6 +9,11 @@
   can brake to `push_guard` before contact, and to `contact_push` (0) in
   contact (`guard_push`): no pushing fouls, no shoving, no driving the ball
   into an opponent.
+* static roles (paper 2, "IRIS Role Assignment" and Fig. 5): an outfield
+  robot without the ball never drives out of its area, the defender's from
+  our goal line to 0.5 m past the centre line, the attacker's from 0.5 m
+  behind it to the opponents' goal line; with the ball, attack.py keeps the
+  defender in its area (it feeds the attacker or clears at the edge).
 """
 
 from __future__ import annotations
@@ -42,6 +47,17 @@ class MotionMixin:
     def my_area(self, order: Order) -> tuple[float, float]:
         return self.plan.area  # type: ignore[union-attr]
 
+    def in_area(self, order: Order, pt: Vec, n: int | None = None) -> bool:
+        """Static roles: `pt` lies in the Fig. 5 area of robot `n` (default: this robot); dynamic roles,
+        the goalkeeper, or a robot with no area in the plan: always."""
+        if self.p.dynamic:
+            return True
+        area = self.plan.area if n is None else self.plan.areas.get(n)  # type: ignore[union-attr]
+        if area is None or (n is None and self.role == "goalkeeper"):
+            return True
+        u = order.attack_dir * pt[0]
+        return area[0] <= u <= area[1]
+
     def drive(
         self,
         tick: int,
@@ -64,6 +80,11 @@ class MotionMixin:
         gx, gy, hx, hy = target[0], target[1], self._drive_hx, self._drive_hy
         gx = -hx if gx < -hx else hx if gx > hx else gx
         gy = -hy if gy < -hy else hy if gy > hy else gy
+        if self._static_area and not view.has_ball:  # paper 2, Fig. 5: a static robot stays in its area
+            d = self.order.attack_dir  # type: ignore[union-attr]
+            lo, hi = self.plan.area  # type: ignore[union-attr]
+            u = d * gx
+            gx = d * lo if u < lo else d * hi if u > hi else gx
         tx, ty = gx - x, gy - y
         d = hypot(tx, ty)
         vx, vy = tx, ty  # straight at it, at 1 m/s per metre to go (capped below)

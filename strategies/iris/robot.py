@@ -61,6 +61,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
         self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
+        self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
 
     def report(self, tick: int, sense: Sense | None) -> Report:
         if sense is None:

@@ -75,7 +75,10 @@ class SetPieceMixin:
         wall = self.inside((own[0] + r * math.cos(a), own[1] + r * math.sin(a)), margin=-0.3)
         x, y, _ = self.view.pose  # type: ignore[misc]
         mine = (S.dist((x, y), wall), self.n)
-        walls = all((S.dist((mx, my), wall), n) > mine for n, (mx, my, _) in self.view.mates.items() if n != 0)
+        mates = self.view.mates.items()  # static roles: only robots whose Fig. 5 area holds the wall point
+        walls = self.in_area(order, wall) and all(
+            (S.dist((mx, my), wall), n) > mine for n, (mx, my, _) in mates if n != 0 and self.in_area(order, wall, n)
+        )
         if walls:
             return wall
         best, found = self.p.mark_zone + 1.0, None
@@ -92,11 +95,14 @@ class SetPieceMixin:
         return self.inside(mark, margin=-0.3)
 
     def is_taker(self, order: Order, spot: Vec) -> bool:
-        """The outfield robot of ours nearest the spot takes the set piece (robot number breaks ties)."""
+        """The outfield robot of ours nearest the spot takes the set piece (robot number breaks ties);
+        static roles: of those whose Fig. 5 area holds the spot."""
+        if not self.in_area(order, spot):
+            return False
         x, y, _ = self.view.pose  # type: ignore[misc]
         mine = (S.dist((x, y), spot), self.n)
         for n, (mx, my, _) in self.view.mates.items():
-            if n != 0 and (S.dist((mx, my), spot), n) < mine:
+            if n != 0 and (S.dist((mx, my), spot), n) < mine and self.in_area(order, spot, n):
                 return False
         return True
 

@@ -281,6 +281,26 @@ def test_the_robot_nearest_the_kick_line_blocks_and_the_other_marks():
     assert vx * (mark[0] - 0.5) + vy * (mark[1] + 0.5) > 0.9 * math.hypot(vx, vy) * S.dist(mark, (0.5, -0.5))
 
 
+def test_static_roles_keep_each_robot_in_its_fig5_area():
+    """Paper 2, Fig. 5: the attacker's area starts 0.5 m behind the centre line; with static roles the
+    attacker nearest the kick line neither blocks nor marks in our half, the defender blocks."""
+    carrier, ball, other = (-1.0, 0.0), (-1.33, 0.0), (-2.5, 2.0)
+    own = [TeamPose(robot=1, x=-2.2, y=0.3, role="attacker"), TeamPose(robot=2, x=0.5, y=-0.5, role="defender")]
+    block = S.block_point(carrier, (-6.0, 0.0), S.SkillParams(), ball)
+    for name, pose in (("AS", (-2.2, 0.3)), ("BS", (-2.2, 0.3)), ("AS", (-0.4, 2.5))):
+        near = _robot(name, n=1)
+        near.role = "attacker"
+        vx, _ = _body_to_field(_defending_view(near, pose, ball, [carrier, other], own), 0.0)
+        assert vx > 0.0 or pose[0] > -0.5 and vx >= 0.0, (name, pose)  # back into its area, or staying there
+    far = _robot("AS", n=2)  # the defender blocks, though it has to go round the carrier
+    vx, vy = _body_to_field(_defending_view(far, (0.5, -0.5), ball, [carrier, other], own), 0.0)
+    assert vx < 0.0 and far.mem.blocking
+    dynamic = _robot("AD", n=1)  # dynamic roles are not confined: the nearest robot blocks (test above)
+    dynamic.role = "attacker"
+    vx, vy = _body_to_field(_defending_view(dynamic, (-2.2, 0.3), ball, [carrier, other], own), 0.0)
+    assert vx * (block[0] + 2.2) + vy * (block[1] - 0.3) > 0.0
+
+
 def test_advance_defense_walls_the_kick_line_at_an_opponent_free_kick():
     spot = (-1.0, 1.0)
     own = [TeamPose(robot=1, x=-3.0, y=0.0, role="attacker"), TeamPose(robot=2, x=1.0, y=0.0, role="defender")]
