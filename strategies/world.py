@@ -18,6 +18,18 @@ detection when visible, otherwise the base station's P_ball of the latest order
 (aged by the order's delay) or its own last detection, whichever is younger;
 opponents are its own detections plus the order's P_B entries that no own
 detection explains. Robots never see ground truth.
+
+Latency (`RobotView.opponents_now`, `pose_now`): a robot sees the world
+`latency` ticks late (`timing.perception_latency`). It tracks each opponent it
+detects (a detection within `merge_radius` of a track's last one continues it)
+and estimates the opponent's velocity by linear regression over the track's
+last `track_window` detections (CAMBADA's world model, Silva et al., "World
+modeling on an MSL robotic soccer team", Mechatronics 21, 2011: linear
+regression for the velocities of the ball and the robots), then predicts
+where the opponent is now, `latency` ticks on; its own pose it moves on by its
+odometry velocity (Brainstormers Tribots: the sensor latency is bridged by
+predicting the tracked objects and the robot itself forward with their
+estimated motion).
 """
 
 from __future__ import annotations
@@ -38,6 +50,7 @@ class FusionParams:
     opponent_memory: int = 100  # [ticks] an unseen opponent is forgotten after this long
     ball_memory: int = 250  # [ticks] a ball estimate older than this is not used
     vel_smoothing: float = 0.5  # [-] weight of the newest velocity sample (exponential filter)
+    track_window: int = 10  # [detections] an opponent's velocity: linear regression over its last this many
     max_ball_speed: float = 10.0  # [m/s] faster jumps between estimates are noise, not motion
 
 
@@ -158,6 +171,25 @@ class TeamModel:
         return t.xy
 
 
+def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Vec:
+    """[m/s] The least-squares slope of x and y over the track's ticks; (0, 0) with fewer than 3 points."""
+    n = len(track)
+    if n < 3:
+        return 0.0, 0.0
+    mt = sum(t for t, _, _ in track) / n
+    mx = sum(x for _, x, _ in track) / n
+    my = sum(y for _, _, y in track) / n
+    stt = sxt = syt = 0.0
+    for t, x, y in track:
+        d = t - mt
+        stt += d * d
+        sxt += d * (x - mx)
+        syt += d * (y - my)
+    if stt <= 0.0:
+        return 0.0, 0.0
+    return sxt / (stt * dt), syt / (stt * dt)
+
+
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
     """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
     if not seen:  # nothing to explain them away: all of them
@@ -176,11 +208,17 @@ def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: 
 class RobotView:
     """One robot's picture of the world for this tick."""
 
-    def __init__(self, team: str, n: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams()):
+    def __init__(
+        self, team: str, n: int, sensor: SensorParams, dt: float, p: FusionParams = FusionParams(), latency: int = 0
+    ):
         self.team = team
         self.other = other_team(team)
         self.n = n
         self.p = p
+        self.lead = latency * dt  # [s] how far the view is behind the present
+        self._tracks: list[list[tuple[int, float, float]]] = []  # per opponent seen: its last detections
+        self._now: list[Vec] | None = []  # see `opponents_now`
+        self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
         self.dt = dt
         self.own_ball = BallFilter(p, dt)
@@ -263,6 +301,58 @@ class RobotView:
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
+        if self.lead > 0.0 and sense is not None:
+            self._track(sense.tick, seen)
+            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`)
+
+    def _track(self, tick: int, seen: list[Vec]) -> None:
+        """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
+        old, merge2, window = self._tracks, self._merge2, self.p.track_window
+        tracks: list[list[tuple[int, float, float]]] = []
+        for x, y in seen:
+            best, best_d2 = None, merge2
+            for t in old:
+                _, lx, ly = t[-1]
+                d2 = (lx - x) ** 2 + (ly - y) ** 2
+                if d2 < best_d2:
+                    best, best_d2 = t, d2
+            if best is not None:
+                old.remove(best)
+                if best[-1][0] >= tick:  # the same sense again: the newer detection replaces it
+                    best.pop()
+                best.append((tick, x, y))
+                if len(best) > window:
+                    del best[0]
+                tracks.append(best)
+            else:
+                tracks.append([(tick, x, y)])
+        self._tracks = tracks
+
+    @property
+    def opponents_now(self) -> list[Vec]:
+        """The opponents where they are now: own detections moved on by `latency` ticks at their
+        regressed velocity, then the base station's entries as in `opponents` (no velocity)."""
+        if self.lead == 0.0:
+            return self.opponents
+        now = self._now
+        if now is None:
+            lead, now = self.lead, []
+            for t in self._tracks:
+                vx, vy = _regression_velocity(t, self.dt)
+                _, x, y = t[-1]
+                now.append((x + vx * lead, y + vy * lead))
+            now.extend(self.opponents[len(self._seen) :])
+            self._now = now
+        return now
+
+    @property
+    def pose_now(self) -> tuple[float, float]:
+        """[m] Where the robot is now: its sensed position moved on by `latency` ticks at its odometry velocity."""
+        x, y, _ = self.pose  # type: ignore[misc]
+        if self.lead == 0.0:
+            return x, y
+        vx, vy = self.vel
+        return x + vx * self.lead, y + vy * self.lead
 
     @property
     def vel(self) -> Vec:

@@ -8,7 +8,10 @@
   opponent, of the robot and of a ball it holds, is capped to what the drive
   can brake to `push_guard` before contact, and to `contact_push` (0) in
   contact (`guard_push`): no pushing fouls, no shoving, no driving the ball
-  into an opponent.
+  into an opponent. The guard works on where the robots are now, not where
+  the robot saw them `perception_latency` ago (`RobotView.opponents_now` and
+  `pose_now`: opponents moved on at their regressed velocities, the robot at
+  its odometry velocity).
 * static roles (paper 2, "IRIS Role Assignment" and Fig. 5): an outfield
   robot without the ball never drives out of its area, the defender's from
   our goal line to 0.5 m past the centre line, the attacker's from 0.5 m
@@ -108,11 +111,12 @@ class MotionMixin:
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
         c, s = cos(th), sin(th)
-        vx, vy = self.guard_push(x, y, vx, vy, p.contact_range)
+        nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
+        vx, vy = self.guard_push(nx, ny, vx, vy, p.contact_range)
         has_ball = view.has_ball
         if has_ball:  # the held ball is part of the body: do not push it into an opponent either
             reach = self.ball_reach
-            vx, vy = self.guard_push(x + reach * c, y + reach * s, vx, vy, p.ball_contact_range)
+            vx, vy = self.guard_push(nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
         mem = self.mem
         omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
@@ -135,7 +139,7 @@ class MotionMixin:
         rng, brake2, guard2, contact_push = self._guard
         if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
             return vx, vy
-        for ox, oy in self.view.opponents:
+        for ox, oy in self.view.opponents_now:
             dx, dy = ox - x, oy - y
             if abs(dx) > rng or abs(dy) > rng:
                 continue

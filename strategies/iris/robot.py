@@ -38,7 +38,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self.half_length = cfg.field.length / 2.0
         self.half_width = cfg.field.width / 2.0
         self.goal_half = cfg.field.goal_width / 2.0
-        self.view = RobotView(ctx.team, ctx.n, cfg.sensor, cfg.timing.dt, p.fusion)
+        self.view = RobotView(ctx.team, ctx.n, cfg.sensor, cfg.timing.dt, p.fusion, cfg.timing.perception_latency)
         self.nav = get(p.navigator)
         self.nav_params = p.nav_params()
         self.area_params = R.AreaParams(field_length=cfg.field.length, overlap=p.overlap)

@@ -272,6 +272,17 @@ def test_robot_view_uses_its_own_ball_else_the_base_station_model():
     assert v.opponents == [(4.1, 0.0)]  # the order's P_B entry is explained by an own detection
 
 
+def test_robot_view_tracks_opponents_and_predicts_them_by_the_latency():
+    v = RobotView("a", 1, SensorParams(), 0.02, latency=3)
+    for k in range(12):  # b at 2 m/s along +y; a second opponent appears at tick 10
+        robots = [RobotSeen(team="b", x=1.0, y=0.04 * k)] + ([RobotSeen(team="b", x=-2.0, y=0.0)] if k >= 10 else [])
+        v.update(k + 3, Sense(tick=k, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=robots), None)
+    assert v.opponents == [(1.0, 0.44), (-2.0, 0.0)]  # what it saw, 60 ms ago
+    (x, y), second = v.opponents_now
+    assert (x, y) == pytest.approx((1.0, 0.44 + 2.0 * 0.06)) and second == (-2.0, 0.0)  # the new one: no velocity yet
+    assert RobotView("a", 1, SensorParams(), 0.02).opponents_now is not None  # no latency: the view itself
+
+
 # ------------------------------------------------------------------ skills
 def test_behind_point_and_lined_up():
     assert S.behind_point((1.0, 0.0), (6.0, 0.0), 0.4) == pytest.approx((0.6, 0.0))

@@ -190,6 +190,32 @@ def test_the_push_guard_stops_a_robot_from_shoving_an_opponent():
     assert vx == pytest.approx(math.sqrt(0.5**2 + 2 * 1.2 * (1.5 - 0.65)))  # what it can still brake from
 
 
+def test_the_push_guard_acts_on_where_the_robots_are_now_not_where_they_were_seen():
+    """The view is `perception_latency` ticks late; an opponent coming at 1 m/s is 0.06 m nearer than seen
+    (60 ms), and a robot moving at 1 m/s is 0.06 m farther on: the guard caps on the present gap."""
+    robot = _robot("AD")
+    lat = CFG.timing.perception_latency
+    lead = lat * CFG.timing.dt
+    assert lat == 3  # the model's default: 60 ms
+    for k in range(10):
+        sense = Sense(
+            tick=k,
+            pose=Pose(x=0.0, y=0.0, theta=0.0),
+            vx=1.0,
+            robots=[RobotSeen(team="b", x=2.0 - 0.02 * k + (0.01 if k % 2 else -0.01), y=0.0)],
+            ball=BallSeen(visible=True, x=-3.0, y=0.0),
+        )
+        robot.step(k + lat, sense, _order(k + lat - 1, 1, "attacker", R.ATTACKING_ATTACKER))
+    seen = robot.view.opponents[0][0]
+    ((now_x, _),) = robot.view.opponents_now
+    assert seen == pytest.approx(1.83)  # the last detection: 2.0 - 0.18 + 0.01 of noise
+    assert now_x == pytest.approx(1.82 - 1.0 * lead, abs=0.02)  # the regressed 1 m/s, 60 ms on
+    assert robot.view.pose_now == pytest.approx((lead, 0.0))
+    vx, _ = robot.guard_push(*robot.view.pose_now, 2.5, 0.0, 0.65)
+    gap = now_x - lead
+    assert vx == pytest.approx(math.sqrt(0.5**2 + 2 * 1.2 * (gap - 0.65)), abs=0.02)
+
+
 # ----------------------------------------------------------------- physics
 def test_the_loser_of_a_challenge_cannot_win_the_ball_straight_back():
     """Face to face at one ball, both dribblers on: without NO_CHALLENGE_S the ball changes holder every tick."""
