@@ -105,10 +105,9 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
     if principal in ("engine", "referee"):
         perms["declare_subscriber/ingress"] = [*perms["declare_subscriber/ingress"], *operator]
         perms["put/egress"] = [*perms["put/egress"], *operator]
-    if principal == OPERATOR_PRINCIPAL:  # puts its frames and reads the score; no token, no process of the match
+    if principal == OPERATOR_PRINCIPAL:  # puts its frames and reads the score; not a process: no alive token
         perms["put/ingress"] = operator
-        for what in ("liveliness_token/ingress",):
-            perms.pop(what)
+        perms["liveliness_token/ingress"] = []
     if principal == COLLECTOR_PRINCIPAL:
         perms["declare_subscriber/ingress"] = perms["put/egress"] = [f"{prefix}{SUMMARY}/**", *reads]
         perms["put/ingress"] = [f"{prefix}{ACK}/**"]
