@@ -24,7 +24,8 @@ stops at half time); it is truncated when that ends, and terminated at a goal
 by default +1 a goal scored, -1 a goal conceded.
 
 `reset(seed=s)` plays the match of seed s, and `reset(seed=s, options={"scenario":
-PATH})` that scenario's run, judged at its end. The same seed and actions give the
+PATH})` that scenario's run, judged after every step and terminated once its verdict
+is decided (`end_on_verdict`). The same seed and actions give the
 same match, digest for digest (`digests()`), as `arena match` gives when the robots
 play those actions from the file `save_actions` writes (`policy:PATH`).
 """
@@ -69,6 +70,7 @@ class SoccerParallelEnv(ParallelEnv):
         actions: str = "box",
         reward=None,
         end_on_goal: bool = True,
+        end_on_verdict: bool = True,
         until: str = "match",
         config: MatchConfig | None = None,
     ):
@@ -93,6 +95,7 @@ class SoccerParallelEnv(ParallelEnv):
         self.discrete = actions == "discrete"
         self.reward_fn = reward or GoalReward()
         self.end_on_goal = end_on_goal
+        self.end_on_verdict = end_on_verdict
         self.until = until
         self._views = {a: View.of(self.cfg, a[0]) for a in names}
         flat = spaces.Box(self._views[names[0]].low, self._views[names[0]].high, dtype=np.float32)
@@ -163,20 +166,24 @@ class SoccerParallelEnv(ParallelEnv):
         self._last_score, self._last_ball = m.score, m.ball
         goal = (ga or gb) and self.end_on_goal
         over = m.over or (self.until == "half" and m.tick >= m.cfg.half_ticks)
-        passed = None
-        if self.scenario is not None and (goal or over):
-            self.verdict = self._judge()
-            passed = self.verdict["passed"]
+        passed, decided = None, False
+        if self.scenario is not None:
+            verdict = self._judge(None if goal or over else m.tick)
+            decided = self.end_on_verdict and verdict["decided"]
+            if goal or over or decided:
+                self.verdict = verdict
+                passed = verdict["passed"]
         out = {
             "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, closing["a"], passed),
             "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, closing["b"], passed),
         }
         rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
-        terms = {a: bool(goal) for a in self.agents}
-        truncs = {a: bool(over and not goal) for a in self.agents}
+        ended = bool(goal) or (decided and not over)  # a terminal state: a goal, or the scenario's verdict
+        terms = {a: ended for a in self.agents}
+        truncs = {a: bool(over and not ended) for a in self.agents}
         obs = self._observations()
         infos = {a: self._info() for a in self.agents}
-        if goal or over:
+        if ended or over:
             self.agents = []
         return obs, rewards, terms, truncs, infos
 
@@ -225,8 +232,12 @@ class SoccerParallelEnv(ParallelEnv):
             return load(*scenario)
         return load(scenario)
 
-    def _judge(self) -> dict[str, Any]:
-        """Every expectation of the scenario, judged on the episode so far (arena.scenarios.expect)."""
+    def _judge(self, now: int | None) -> dict[str, Any]:
+        """Every expectation of the scenario, judged on the episode so far (arena.scenarios.expect).
+
+        `now`: the tick played to, mid-episode (None at its end). A judgement is final once the tick it
+        names is past: a "happens" kind that happened, a "never" kind that was broken, or any kind whose
+        window is over. `decided`: a final failure, or every judgement final."""
         from arena.scenarios.expect import Trace, judge
 
         m, sc = self.match, self.scenario
@@ -238,9 +249,11 @@ class SoccerParallelEnv(ParallelEnv):
             digests=m.digests(),
             fence=(f.length / 2 + f.runoff, f.width / 2 + f.runoff),
         )
-        failures = []
+        failures, final = [], []
         for e in sc.spec.expect:
             ok, tick, detail = judge(e, trace, sc.spec.time_limit)
+            final.append(now is None or tick < now)  # frames of tick `now` may still come
             if not ok:
-                failures.append({"expectation": e.name, "tick": tick, "detail": detail})
-        return {"name": sc.name, "passed": not failures, "failures": failures}
+                failures.append({"expectation": e.name, "tick": tick, "detail": detail, "final": final[-1]})
+        decided = bool(final) and (all(final) or any(x["final"] for x in failures))  # none: only the time limit
+        return {"name": sc.name, "passed": not failures, "failures": failures, "decided": decided}

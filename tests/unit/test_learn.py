@@ -176,7 +176,8 @@ def test_arena_bench_learn_reports_the_ratios():
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert out["match_ticks_per_cpu_second"] > 0 and out["env1_steps_per_cpu_second"] > 0
-    assert out["env1_ratio"] == round(out["env1_steps_per_cpu_second"] / out["match_ticks_per_cpu_second"], 3)
+    ratio = out["env1_steps_per_cpu_second"] / out["match_ticks_per_cpu_second"]  # of the rounded figures
+    assert out["env1_ratio"] == pytest.approx(ratio, abs=0.002)
     assert set(out["vector_ratio"]) == {"1", "5"}
 
 
@@ -299,3 +300,31 @@ def test_the_vector_envs_autoresets_keep_playing_the_scenario_it_was_reset_to(tm
         assert goals >= 4
     finally:
         venv.close()
+
+
+def test_a_scenario_episode_ends_once_its_verdict_is_decided(tmp_path):
+    """The ball in the penalty area passes `ball_in` early; an expectation broken early fails it early."""
+    head = SHOT.split("[[scenario.expect]]")[0].replace("time_limit = 3.0", "time_limit = 10.0")
+    cases = {
+        "reached": '[[scenario.expect]]\nname = "in the area"\nkind = "ball_in"\nregion = [4.9, -2.5, 6.0, 2.5]\n',
+        "broken": '[[scenario.expect]]\nname = "stays out"\nkind = "ball_never_in"\nregion = [4.9, -2.5, 6.0, 2.5]\n',
+    }
+    for name, expect in cases.items():
+        path = tmp_path / f"{name}.scenario.toml"
+        path.write_text(head + expect)
+        env = SoccerParallelEnv(agents=["a/1"], robots=2, frame_skip=5)
+        env.reset(seed=2, options={"scenario": str(path)})
+        steps = 0
+        while env.agents:
+            _, _, term, trunc, info = env.step({"a/1": np.array([0.6, 0, 0, 0], np.float32)})
+            steps += 1
+        verdict = info["a/1"]["scenario"]
+        assert term["a/1"] and not trunc["a/1"] and steps < 40, (name, steps)
+        assert verdict["passed"] == (name == "reached") and verdict["decided"]
+    plain = SoccerParallelEnv(agents=["a/1"], robots=2, frame_skip=5, end_on_verdict=False)
+    plain.reset(seed=2, options={"scenario": str(tmp_path / "reached.scenario.toml")})
+    steps = 0
+    while plain.agents:
+        plain.step({"a/1": np.zeros(4, np.float32)})
+        steps += 1
+    assert steps == 101  # the whole 10 s
