@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import socket
 import subprocess
 import sys
 
@@ -171,9 +172,13 @@ def test_a_robot_provisioned_once_plays_two_matches_and_each_wrong_set_up_says_i
     reap.extend(twins)
     errs = [t.communicate(timeout=240)[1] for t in twins]
     assert sorted(t.returncode for t in twins) == [0, 2], errs
-    assert any("robot/a/1 is already running in match 'monday'" in e.strip().splitlines()[-1] for e in errs), errs
+    winner, loser = sorted(twins, key=lambda t: t.returncode)
+    # The refused one is told who holds the identity; the match names the refused one (issue 34 item 4).
+    told = errs[twins.index(loser)].strip().splitlines()[-1]
+    assert f"robot/a/1 is already running in match 'monday' (from {socket.gethostname()}, pid {winner.pid})" in told
     out, err = monday.communicate(timeout=240)
     assert monday.returncode == 0, err
+    assert f"refused robot/a/1 from {socket.gethostname()}, pid {loser.pid}: robot/a/1 is already running" in err
     result = json.loads(out)
     assert result["outcome"] == "completed" and result["rejected"] == 0, result["rejected_reasons"]
     assert [r["process"] for r in result["refused_starts"]] == ["robot/a/1"], result["refused_starts"]

@@ -137,3 +137,12 @@ def test_a_match_that_cannot_start_leaves_no_temp_dir(tmp_path):
     )
     assert r.returncode == 2 and "/proc/no-logs-here" in r.stderr, r.stderr
     assert list(tmp_path.glob("arena-*")) == [], "its secrets stayed behind"
+
+
+def test_arena_up_of_a_bad_compose_file_leaves_no_temp_dir(tmp_path):
+    bad = tmp_path / "compose.yaml"
+    bad.write_text("services: {router: {command: arena run engine --match x --listen tcp/127.0.0.1:1}}\n")
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    r = subprocess.run([*ARENA, "up", str(bad)], capture_output=True, text=True, env=env, timeout=60)
+    assert r.returncode == 2, r.stderr
+    assert list(tmp_path.glob("arena-*")) == [], "a temp dir for the credentials stayed behind"

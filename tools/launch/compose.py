@@ -17,14 +17,13 @@ import os
 import re
 import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import yaml
 
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.credentials import COLLECTOR_PRINCIPAL
+from arena.runtime.credentials import COLLECTOR_PRINCIPAL, OWNER, match_directory
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
@@ -112,7 +111,7 @@ def up(path: str, timeout: float = 600.0) -> dict:
         check_match_id(match)
     except ValueError as exc:
         raise ComposeError(f"ARENA_MATCH: {exc}", bad_input=True) from None
-    tmp = Path(tempfile.mkdtemp(prefix="arena-up-"))
+    tmp = match_directory("arena-up-")  # private; swept by the next start if we are killed
     sock = tmp / "router.sock"
     env = dict(os.environ)
     env.update(
@@ -121,13 +120,13 @@ def up(path: str, timeout: float = 600.0) -> dict:
         ARENA_CONNECT=f"unixsock-stream/{sock}",
         ARENA_CREDENTIALS=str(tmp / "credentials"),
     )
-    services = load_services(path, env)
-    routers = [n for n, argv in services.items() if _process_of(argv) is None]
-    if len(routers) != 1:
-        raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
     children: list[Child] = []
     keep = False  # a failed match keeps the services' logs (and says where); bad input leaves nothing behind
     try:
+        services = load_services(path, env)
+        routers = [n for n, argv in services.items() if _process_of(argv) is None]
+        if len(routers) != 1:
+            raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
         router = routers[0]
         children.append(spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
         _wait_for_socket(sock, children[0])
@@ -184,7 +183,10 @@ def up(path: str, timeout: float = 600.0) -> dict:
         raise ComposeError(f"{exc}\nevery service's log is kept in {tmp}") from None
     finally:
         stop_all(children)
-        if not keep:
+        if keep:  # the logs stay, the credentials the router service wrote go (and the owner mark)
+            shutil.rmtree(tmp / "credentials", ignore_errors=True)
+            (tmp / OWNER).unlink(missing_ok=True)
+        else:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
