@@ -425,7 +425,7 @@ configuration and is never sent on the wire.
 **Secure match** (`arena match --secure`, the default when `--listen` is not
 a loopback address): the router refuses a session without a valid user and
 password at connect time; TCP endpoints become TLS (`tls/host:port`), with a
-CA made for this match alone (trust only `root_ca_certificate_base64`; it
+CA made for this match alone, or once for a credentials directory (trust only `root_ca_certificate_base64`; it
 signs the router's certificate and nothing else, so host names are not
 checked). The router's access control is generated from the key table above,
 default deny: a principal may put only on the keys it sends, declare
