@@ -41,6 +41,15 @@ def test_a_robot_started_before_the_match_without_its_file_is_refused_at_connect
         "arena run: error: refused by match 'early': match 'early' needs robot/a/1's own --credentials file "
         "(every frame of its processes is authenticated): start it with the command arena match printed"
     )
+    # A second engine started by hand (the match's own is running) is refused too (issue 36).
+    engine = subprocess.run(
+        [*ARENA, "run", "engine", "--match", "early", "--connect", sock, "--home", "BS", "--away", "BS"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert engine.returncode == 2, engine.stderr
+    assert "engine is already running in match 'early' (started by arena match, pid" in engine.stderr, engine.stderr
     robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
     assert robot.returncode == 0, robot.stderr
     out, err = match.communicate(timeout=120)
@@ -48,8 +57,9 @@ def test_a_robot_started_before_the_match_without_its_file_is_refused_at_connect
     result = json.loads(out)
     assert result["outcome"] == "completed" and result["rejected"] == 0, result["rejected_reasons"]
     assert result["forged_summaries"] == {} and "forged" not in err, err
-    [refused] = result["refused_starts"]
+    refused, second_engine = result["refused_starts"]
     assert refused["process"] == "robot/a/1" and refused["from"].endswith(f"pid {early.pid}"), refused
+    assert second_engine["process"] == "engine", result["refused_starts"]
 
 
 def test_the_next_match_removes_what_a_killed_launcher_left(tmp_path, reap):
@@ -109,25 +119,6 @@ def test_of_two_simultaneous_starts_exactly_one_plays(kind, secure, tmp_path, re
         result = _twins(kind, secure, tmp_path, reap, run)
         assert result["outcome"] == "completed" and result["rejected"] == 0, (run, result["rejected_reasons"])
         assert len(result["refused_starts"]) == 1, (run, result["refused_starts"])
-
-
-def test_a_second_engine_started_by_hand_is_refused(tmp_path, reap):
-    sock = f"unixsock-stream/{tmp_path}/r.sock"
-    match = spawn(*GAME, "--external", "a/1", "--match", "one", "--listen", sock)
-    reap.append(match)
-    command = _printed(match)
-    engine = subprocess.run(
-        [*ARENA, "run", "engine", "--match", "one", "--connect", sock, "--home", "BS", "--away", "BS"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert engine.returncode == 2, engine.stderr
-    assert "engine is already running in match 'one' (started by arena match, pid" in engine.stderr, engine.stderr
-    robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
-    assert robot.returncode == 0, robot.stderr
-    out, err = match.communicate(timeout=120)
-    assert match.returncode == 0 and json.loads(out)["outcome"] == "completed", err
 
 
 def test_a_match_that_cannot_start_leaves_no_temp_dir(tmp_path):
