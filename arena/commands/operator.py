@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
         if args.credentials:
             from arena.tools.launch.run import load_credentials
 
-            base, asked, _ = load_credentials(args.credentials, OPERATOR_PRINCIPAL, args.match)
+            base, asked, _ = load_credentials(args.credentials, OPERATOR_PRINCIPAL)
             mode = asked or mode
         net = NetConfig(mode=mode, connect=(args.connect,), base=base)
     except (ValueError, ConfigError) as exc:

@@ -48,3 +48,41 @@ def test_a_bad_action_is_one_line_and_nobody_listening_is_said(tmp_path):
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "ACTION 1:" in bad.stderr, bad.stderr
+
+
+def test_in_a_secure_match_only_the_operator_principal_gets_through(reap, tmp_path):
+    import time
+
+    import zenoh
+
+    from arena.schemas.messages import Operator, TeleportBall, encode
+
+    port, mcap, creds = free_port(), tmp_path / "sec.mcap", tmp_path / "creds"
+    endpoint = f"tls/127.0.0.1:{port}"
+    match = spawn(
+        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "4", "--secure", "--listen", endpoint,
+        "--credentials", str(creds), "--match", "opsec", "--record", str(mcap), "--json",
+    )  # fmt: skip
+    reap.append(match)
+    wait_for(lambda: (creds / "operator.json5").exists() and listening(f"tcp/127.0.0.1:{port}"), 60, "the router")
+    # robot b/1's credentials: a put on the operator key is dropped by the router's access control
+    frag = json.loads((creds / "robot-b-1.json5").read_text())
+    c = zenoh.Config.from_json5(json.dumps(frag))
+    c.insert_json5("connect/endpoints", json.dumps([endpoint]))
+    c.insert_json5("scouting/multicast/enabled", "false")
+    spy = zenoh.open(c)
+    forged = encode(Operator(seq=1, actions=[TeleportBall(x=-1.1, y=1.1, vx=0.0, vy=0.0)]))
+    op = subprocess.run(
+        [*ARENA, "operator", "--match", "opsec", "--connect", endpoint, "--credentials", str(creds / "operator.json5"),
+         '{"type": "teleport_ball", "x": 3.3, "y": -2.2, "vx": 0, "vy": 0}'],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert op.returncode == 0, op.stderr
+    for _ in range(20):
+        spy.put("arena/opsec/operator", forged)
+        time.sleep(0.05)
+    spy.close()
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    applied = load(str(mcap)).summaries["engine"].extra["operator"]
+    assert [(a["action"]["x"], a["action"]["y"]) for a in applied] == [(3.3, -2.2)], applied
