@@ -306,6 +306,7 @@ def fetch_config(
     deadline = time.monotonic() + timeout
     state = ""
     ep = None
+    elsewhere = ""  # the other matches the router we reached hosts
     refused_since: float | None = None  # a router listens, and we are still not connected to it
     while time.monotonic() < deadline:
         payload = transport.query(keys.config(), timeout=1.0)
@@ -323,6 +324,9 @@ def fetch_config(
                     raise refused(ep) if refused is not None else ConfigError(f"refused by {ep}")
             # A router that listens and has not taken us yet is told apart within REFUSED_AFTER.
             now = f"waiting for match {keys.match!r} to start at {where}" if connected else f"no router at {where}"
+            if connected:  # a typo in --match is said with the match that is there
+                elsewhere = elsewhere or hosted_elsewhere(session, keys)
+                now += elsewhere
             if now != state and tell is not None and (connected or refused_since is None):
                 tell(f"{now if connected else 'waiting: ' + now} (up to {timeout:g} s)")
             state = now
@@ -335,6 +339,16 @@ def fetch_config(
         else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
         f"{keys.match!r} running and reachable on the given endpoint?"
     )
+
+
+def hosted_elsewhere(session, keys: Keys) -> str:
+    """`; the router hosts match 'x'` when the router we reached plays other matches than ours."""
+    others = set()
+    for reply in session.liveliness().get("arena/*/alive/engine", timeout=0.5):
+        if reply.ok is not None:
+            others.add(str(reply.ok.key_expr).split("/")[1])
+    others.discard(keys.match)
+    return f"; the router hosts match {', '.join(repr(m) for m in sorted(others))}" if others else ""
 
 
 def open_until(net: NetConfig, timeout: float, where: str, tell, refused):
