@@ -1,6 +1,25 @@
-"""The installed soccer-arena's version (the source tree's when it is not installed)."""
+"""The installed soccer-arena's version (the source tree's when it is not installed), and its packages."""
 
 from __future__ import annotations
+
+# The packages below `arena` (pyproject.toml `packages`, first level): the bytecode the launcher writes
+# before a match (tools/launch/launcher.py) and the source a cluster's version check hashes
+# (tools/experiments/cluster.py) cover them all. learn is hashed by path: its extra need not be installed.
+PACKAGES = (
+    "runtime",
+    "processes",
+    "schemas",
+    "tools",
+    "strategies",
+    "navigation",
+    "sim",
+    "rules",
+    "recording",
+    "refbox",
+    "scenarios",
+    "learn",
+    "commands",
+)
 
 
 def package_version() -> str:

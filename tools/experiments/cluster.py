@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from arena.runtime.config import ConfigError
+from arena.runtime.version import PACKAGES
 
 if TYPE_CHECKING:
     from arena.tools.experiments.tournament import TournamentOptions
@@ -51,20 +52,6 @@ SYSTEM_RETRIES = 3  # worker or node deaths Ray absorbs per task (not match fail
 # (15) lets every other process on the machine starve the matches: on the
 # shared 2-core development host it made --ray 1.2-1.9x slower than --jobs 2.
 LOCAL_SYSTEM_CONFIG = {"worker_niceness": 0}
-PACKAGES = (
-    "runtime",
-    "processes",
-    "schemas",
-    "tools",
-    "strategies",
-    "navigation",
-    "sim",
-    "rules",
-    "recording",
-    "scenarios",
-    "learn",  # policy:PATH strategies; hashed by path, so the learn extra need not be installed
-    "commands",
-)
 INSTALL_HINT = "--ray needs Ray: pip install 'soccer-arena[cluster]'"
 
 

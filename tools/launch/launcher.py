@@ -35,6 +35,7 @@ from arena.runtime.credentials import (
 from arena.runtime.provision import provision
 from arena.runtime.session import EndpointError, NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
+from arena.runtime.version import PACKAGES
 from arena.schemas.keys import Keys, routes
 from arena.tools.launch import forkstart
 from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all
@@ -45,20 +46,9 @@ from arena.tools.launch.run import run_job
 from arena.tools.launch.supervise import Progress, open_collector, supervise
 from arena.tools.launch.witness import Witness
 
-# The packages mapped to a directory of their own (pyproject.toml `package-dir`);
-# their subpackages (arena.sim.physics, arena.strategies.iris, ...) live below them.
-_PACKAGES = (
-    "arena",
-    "arena.runtime",
-    "arena.processes",
-    "arena.schemas",
-    "arena.strategies",
-    "arena.navigation",
-    "arena.tools",
-    "arena.sim",
-    "arena.rules",
-    "arena.recording",
-)
+# Every package of the distribution; compiling one compiles its subpackages
+# (arena.sim.physics, arena.strategies.iris, ...) too.
+_PACKAGES = ("arena", *(f"arena.{p}" for p in PACKAGES))
 
 
 def compile_sources() -> None:
