@@ -29,7 +29,7 @@ from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
 from arena.tools.launch import launcher
 from arena.tools.launch.children import Child, MatchError, spawn, stop_all
-from arena.tools.launch.result import assemble
+from arena.tools.launch.result import MatchResult, assemble
 from arena.tools.launch.run import load_credentials
 from arena.tools.launch.supervise import Progress, open_collector, supervise
 
@@ -104,7 +104,7 @@ def _process_of(argv: list[str]) -> ProcessId | None:
     return ProcessId(kind)
 
 
-def up(path: str, timeout: float = 600.0) -> dict:
+def up(path: str, timeout: float = 600.0) -> MatchResult:
     t_start = time.monotonic()
     match = os.environ.get("ARENA_MATCH") or launcher.new_match_id(0)
     try:
