@@ -177,6 +177,7 @@ def test_run_passes_fails_and_reports(files, tmp_path, capsys):
     assert failure["name"] == "a scores" and failure["tick"] == 30
     record = never["runs"][0]["record"]
     assert record and load_recording(record).complete, "the failed run's MCAP is whole"
+    assert main(["review", record]) == 0 and "basic-static (a) 1 : 0" in capsys.readouterr().out
     cases = ET.parse(junit).getroot().findall("testcase")
     assert sorted(c.get("name") for c in cases) == ["never", "roll-in"]
     assert [c.get("name") for c in cases if c.find("failure") is not None] == ["never"]
