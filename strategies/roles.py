@@ -25,6 +25,9 @@
   an attacker. "Gets the ball" is the moment of capture; a robot still holding
   the ball also triggers the swap when it carries the ball out of its own
   area altogether (past the overlap), so roles never flap inside the overlap.
+* A robot sent off (RED_CARD, DOUBLE_YELLOW, REPAIR_OUT) leaves the roles, and
+  eq. 6 holds again for the n outfield robots left (`RoleAssigner.send_off`):
+  with one left, it is the defender (n_d = ceil(1/2) = 1, n_a = 0).
 """
 
 from __future__ import annotations
@@ -165,6 +168,26 @@ class RoleAssigner:
 
     def apply(self, n: int, inp: str) -> None:
         self.state[n] = transition(self.state[n], inp)
+
+    def send_off(self, n: int) -> None:
+        """Robot n has left the field for good: eq. 6 for the outfield robots left. Surplus attackers
+        become defenders (input d), the highest-numbered first; missing attackers are the lowest-numbered
+        defenders (input a), so static roles keep robots 1..n_a attacking."""
+        if n not in self.state:
+            return
+        del self.state[n]
+        if self.holder == n:
+            self.holder = None
+        left = sorted(self.state)
+        n_a = len(left) - n_defenders(len(left))
+        attackers = [k for k in left if is_attacker(self.state[k])]
+        defenders = [k for k in left if not is_attacker(self.state[k])]
+        while len(attackers) > n_a:
+            self.apply(attackers.pop(), D)
+        while len(attackers) < n_a and defenders:
+            k = defenders.pop(0)
+            self.apply(k, A)
+            attackers.append(k)
 
     def update(
         self, possession: str, holder: int | None, u: dict[int, float], xy: dict[int, tuple[float, float]]

@@ -7,7 +7,9 @@ Base station (`IrisTeam`), every comm period:
 * decides possession (inputs b and b-bar) and runs the role FSM of Fig. 6 with
   the areas and n_d = ceil(n/2) of eq. 6 (:mod:`arena.strategies.roles`); static roles never
   swap, dynamic roles swap with inputs a and d;
-* relays the referee command C and sends one `Order` per robot.
+* relays the referee command C and sends one `Order` per robot;
+* a robot the referee sends off (its RED_CARD, DOUBLE_YELLOW or REPAIR_OUT
+  command) leaves the roles, and eq. 6 assigns the robots left.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from __future__ import annotations
 import math
 
 from arena.schemas.messages import Order, Referee, Report, TeamPose
-from arena.schemas.vocabulary import SET_PIECES
+from arena.schemas.vocabulary import SEND_OFF, SET_PIECES
 from arena.strategies import roles as R
 from arena.strategies.base import TeamContext
 from arena.strategies.iris.params import PLAY, IrisParams
@@ -49,6 +51,10 @@ class IrisTeam:
 
     def step(self, tick: int, reports: dict[int, Report], referee: Referee | None) -> dict[int, Order]:
         self.model.update(tick, reports)
+        if referee is not None:
+            for cmd in referee.commands:  # a robot sent off leaves the roles (eq. 6 for the robots left)
+                if cmd.name in SEND_OFF and cmd.team == self.team and cmd.robot > 0:
+                    self.roles.send_off(cmd.robot)
         c = R.referee_fields(self.team, referee, default_attack_dir=1 if self.team == "a" else -1)
         command, cteam, attack_dir = c["command"], c["command_team"], c["attack_dir"]
         possession, holder = self.possession(tick)

@@ -11,7 +11,7 @@ from importlib import metadata
 import pytest
 
 from arena.runtime.config import MatchConfig, SensorParams
-from arena.schemas.messages import BallSeen, Cmd, Order, Pose, Report, RobotSeen, Sense, TeamPose
+from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RefCommand, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.strategies import conformance, registry
 from arena.strategies import roles as R
 from arena.strategies import skills as S
@@ -202,6 +202,35 @@ def test_static_roles_never_swap():
     a.update("own", 2, {1: 3.0, 2: 0.7}, {1: (3.0, 0.0), 2: (0.7, 0.0)})
     a.update("own", 1, {1: -3.0, 2: 0.7}, {1: (-3.0, 0.0), 2: (0.7, 0.0)})
     assert a.roles() == {1: "attacker", 2: "defender"} and a.swaps == 0
+
+
+@pytest.mark.parametrize("dynamic", [False, True])
+def test_a_robot_sent_off_leaves_the_roles_and_eq6_holds_for_the_robots_left(dynamic):
+    a = _assigner(dynamic)
+    a.update("opponent", None, {}, {})
+    a.send_off(2)  # the defender: the attacker left alone defends (n_d = ceil(1/2) = 1)
+    assert a.roles() == {1: "defender"} and a.state == {1: R.DEFENDING_DEFENDER}
+    a.send_off(2)  # again (the same referee frame twice): nothing more
+    assert a.roles() == {1: "defender"}
+    four = R.RoleAssigner(5, dynamic=dynamic, p=R.AreaParams())  # 4 outfield: 1, 2 attack; 3, 4 defend
+    four.send_off(1)
+    assert four.roles() == {2: "attacker", 3: "defender", 4: "defender"}  # 3 left: n_d = 2
+    four.send_off(2)
+    assert four.roles() == {3: "attacker", 4: "defender"}  # 2 left: one of each
+
+
+def test_the_base_station_reassigns_roles_after_a_send_off():
+    cfg = MatchConfig()
+    team = registry.get("AS").make_team(TeamContext(cfg=cfg, team="a", rng=random.Random(0)))
+    reports = {n: _report(n, -1.0 * n, 0.0) for n in range(3)}
+    before = team.step(10, reports, Referee(tick=10, stage="FIRST_HALF", command="START"))
+    assert before[1].role == "attacker" and before[2].role == "defender"
+    card = RefCommand(name="DOUBLE_YELLOW", team="a", robot=2, tick=15)
+    after = team.step(15, reports, Referee(tick=15, stage="FIRST_HALF", command="STOP", commands=[card]))
+    assert after[1].role == "defender"
+    other = RefCommand(name="DOUBLE_YELLOW", team="b", robot=1, tick=20)
+    again = team.step(20, reports, Referee(tick=20, stage="FIRST_HALF", command="STOP", commands=[other]))
+    assert again[1].role == "defender"  # the other team's card changes nothing here
 
 
 # ------------------------------------------------------------- fusion, eq. 5
