@@ -357,6 +357,12 @@ def start_params(spec: ScenarioSpec, dt: float, where: str, base: Path = Path(".
     p, st = spec.play, spec.start
     steps = [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
     ticks = int(round(spec.time_limit / dt))
+    for i, step in enumerate(steps):
+        if step.at > ticks:
+            raise ValueError(
+                f"{where}.step[{i}].at: {spec.step[i].at:g} s is after the run's end "
+                f"(time_limit {spec.time_limit:g} s): the step would never happen"
+            )
     if st is None:
         return ScenarioParams(ticks=ticks, steps=tuple(steps + substitution(spec, ticks, dt, where, base)))
     if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
@@ -410,15 +416,41 @@ def substitution(spec: ScenarioSpec, ticks: int, dt: float, where: str, base: Pa
     return steps
 
 
+def check_window(e: Expect, time_limit: float, where: str) -> None:
+    """The window `from` .. `within`/`until` lies inside the run and is not empty."""
+    if e.within is not None and e.until is not None:
+        raise ValueError(f"{where}: give `within` or `until`, not both (they are the same)")
+    key, end = ("within", e.within) if e.within is not None else ("until", e.until)
+    dt = MatchConfig().timing.dt
+    if end is not None and round(end / dt) > round(time_limit / dt):
+        raise ValueError(f"{where}.{key}: {end:g} s is after the run's end (time_limit {time_limit:g} s)")
+    end = time_limit if end is None else end
+    if round(e.from_ / dt) > round(end / dt):
+        raise ValueError(f"{where}.from: {e.from_:g} s is after the window's end ({end:g} s)")
+
+
 def check_expectations(spec: ScenarioSpec, where: str) -> None:
     from arena.scenarios.expect import check_expect
 
     names = set()
     for i, e in enumerate(spec.expect):
         check_expect(e, spec.play.robots, f"{where}.expect[{i}]")
+        check_window(e, spec.time_limit, f"{where}.expect[{i}]")
         if e.name in names:
             raise ValueError(f"{where}.expect[{i}].name: {e.name!r} is used twice")
         names.add(e.name)
+
+
+# MatchConfig names its command-line flags; a scenario file has these keys in `play`.
+PLAY_KEYS = {"--robots": "robots", "--half-time": "half_time", "--perception-latency": "perception_latency"}
+
+
+def play_error(message: str, where: str) -> str:
+    """A MatchConfig error about `play`, naming the file's key rather than `arena match`'s flag."""
+    for flag, key in PLAY_KEYS.items():
+        if message.startswith(flag + " "):
+            return f"{where}.play.{key}: {message[len(flag) + 1 :]}"
+    return f"{where}.play: {message}"
 
 
 def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
@@ -441,9 +473,13 @@ def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
             raise ValueError(f"{where}.play.{side}: {exc}") from None
     sc = Scenario(spec=spec, path=path, index=index, params=params, dt=dt, home=names[0], away=names[1])
     try:
+        resolve(p.link, {})
+    except ConfigError as exc:
+        raise ValueError(f"{where}.play.link: {exc}") from None
+    try:
         sc.config()
     except ConfigError as exc:
-        raise ValueError(f"{where}.play: {exc}") from None
+        raise ValueError(play_error(str(exc), where)) from None
     for ext in p.external:
         ProcessId.parse(ext)
     return sc
@@ -467,12 +503,15 @@ def load_all(path: str | Path) -> list[Scenario]:
             key = key.rstrip("`").lstrip(".")
             raise ScenarioError(f"{path}: {key}: {msg[0].lower() + msg[1:]}") from None
         raise ScenarioError(f"{path}: {text[0].lower() + text[1:]}") from None
-    out = []
+    out: list[Scenario] = []
     for i, s in enumerate(spec.scenario):
         try:
             out.append(build(s, path, i))
         except (ValueError, ConfigError) as exc:
             raise ScenarioError(f"{path}: {exc}") from None
+        twin = next((sc for sc in out[:-1] if sc.name == s.name), None)
+        if twin is not None:  # --name, the pytest id and the verdicts tell scenarios apart by name
+            raise ScenarioError(f"{path}: scenario[{i}].name: {s.name!r} is already scenario[{twin.index}]'s")
     return out
 
 

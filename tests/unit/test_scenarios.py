@@ -80,6 +80,20 @@ def files(tmp_path):
             ("[scenario.start]", "[scenario.play]\nhome = 'nobody'\n[scenario.start]"),
             "scenario[0].play.home: unknown strategy 'nobody'",
         ),
+        # the file's key, not arena match's flag; a bad link preset names the file too
+        (("[scenario.start]", "[scenario.play]\nrobots = 7\n[scenario.start]"), "scenario[0].play.robots: must be"),
+        (("[scenario.start]", "[scenario.play]\nlink = '5g'\n[scenario.start]"), "scenario[0].play.link: unknown"),
+        (("[scenario.start]", "[scenario.play]\nhalf_time = -1.0\n[scenario.start]"), "scenario[0].play.half_time"),
+        # a window or a step outside the run: it judged ticks the run never played, or never happened
+        (("within = 1.0", "within = 9.0"), "scenario[0].expect[0].within: 9 s is after the run's end (time_limit 2 s)"),
+        (("within = 1.0", "within = 1.0\nfrom = 1.5"), "scenario[0].expect[0].from: 1.5 s is after the window's end"),
+        (("within = 1.0", "within = 1.0\nuntil = 2.0"), "scenario[0].expect[0]: give `within` or `until`, not both"),
+        (
+            ("[scenario.start]", "[[scenario.step]]\nat = 3.0\npark = ['a/1']\n[scenario.start]"),
+            "scenario[0].step[0].at: 3 s is after the run's end (time_limit 2 s): the step would never happen",
+        ),
+        # two scenarios of one name: their verdicts were counted together, each twice
+        ((ROLL_IN, ROLL_IN + ROLL_IN), "scenario[1].name: 'roll-in' is already scenario[0]'s"),
     ],
 )
 def test_a_bad_file_is_one_line_naming_the_key(tmp_path, capsys, change, message):
