@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from arena.runtime.acl import COLLECTOR_PRINCIPAL, VIEWER, access_control, principals, user_of
+from arena.schemas.keys import routes
 
 __all__ = [
     "COLLECTOR_PRINCIPAL",
@@ -56,7 +57,9 @@ __all__ = [
 ]
 from arena.runtime.mac import Keyring, new_key
 
-OFFICIAL_VERIFIES = {"engine": ["referee"], "referee": ["engine"], "viewer": ["engine", "referee"]}
+# Besides the senders of every key it receives (the key table, `routes`): the viewer asks the teams
+# for their last reports and orders, which it does not subscribe to.
+ALSO_VERIFIES = {"viewer": ["engine", "referee"]}
 
 
 def new_zid() -> str:
@@ -99,8 +102,9 @@ class Secrets:
     def keyring(self, principal: str) -> Keyring:
         if principal in ("recorder", "launcher", COLLECTOR_PRINCIPAL):
             verifies = list(self.mac_keys)
-        else:
-            verifies = [principal, *OFFICIAL_VERIFIES.get(principal, [])]
+        else:  # every frame it receives carries its sender's MAC (runtime/mac.py)
+            senders = [s for _, s, receivers in routes(self.robots) if principal in receivers]
+            verifies = [principal, *senders, *ALSO_VERIFIES.get(principal, [])]
         return Keyring(principal, {p: self.mac_keys[p] for p in verifies if p in self.mac_keys})
 
     def fragment(self, principal: str) -> dict:

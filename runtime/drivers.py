@@ -178,6 +178,7 @@ class Reactor:
         self._since = 0.0
         self.error: BaseException | None = None
         self.before_wait: Callable[[], None] | None = None  # called as the loop starts to wait on a link not `paired`
+        self.on_idle: Callable[[], None] | None = None  # called on the main thread at each look
 
     def connect(
         self, ib: Inbound[Any], transport: Transport, verify: Verify | None, on_forged: Callable[[], None]
@@ -234,6 +235,8 @@ class Reactor:
             self._steps = steps
             self._advance()
         while not self.clock.wait(self.done, 0.1):
+            if self.on_idle is not None:
+                self.on_idle()
             self._look()
         self._set_announced(None)
         if self.error is not None:

@@ -88,7 +88,11 @@ class Rejections:
     """Counts malformed, out-of-sequence and invalid inputs, logs the first ones of each kind.
 
     `conflicts` counts, per key, frames for a tick that already had a
-    different accepted frame on that key: two senders on one key.
+    different accepted frame on that key: two senders on one key. `forged_by_key`
+    counts, per key, frames dropped before the lockstep because their MAC did not
+    check out (runtime/mac.py). Either is possible spoofing: the first one on a key
+    is logged once as "possible spoofing on KEY", and the key is queued in
+    `spoofed_new` for the process to announce (`Node.announce_spoofing`).
     """
 
     LOG_FIRST = 5
@@ -97,10 +101,30 @@ class Rejections:
         self.log = log
         self.by_reason: Counter[str] = Counter()
         self.conflicts: Counter[str] = Counter()
+        self.forged_by_key: Counter[str] = Counter()
+        self.spoofed: set[str] = set()
+        self.spoofed_new: list[str] = []
+        # A forged frame is counted on the transport's thread, outside the lockstep's lock.
+        self._lock = threading.Lock()
 
     def conflict(self, key: str, tick: int) -> None:
-        self.conflicts[key] += 1
-        self.reject(key, "conflict", f"a second, different frame for tick {tick}")
+        with self._lock:
+            self.conflicts[key] += 1
+            self._spoofing(key)
+            self.reject(key, "conflict", f"a second, different frame for tick {tick}")
+
+    def forged(self, key: str, sender: str) -> None:
+        """A frame on `key` without a valid MAC of `sender`: dropped before anything else looked at it."""
+        with self._lock:
+            self.forged_by_key[key] += 1
+            self._spoofing(key)
+            self.reject(key, "forged", f"not from {sender}")
+
+    def _spoofing(self, key: str) -> None:
+        if key not in self.spoofed:
+            self.spoofed.add(key)
+            self.spoofed_new.append(key)
+            self.log.warning("possible spoofing on %s", key)
 
     @property
     def total(self) -> int:
@@ -270,6 +294,9 @@ class Outbound(Generic[M]):
         return payload
 
 
+# [frames] accepted frames per link kept to tell a conflicting frame for a past tick from a repeat.
+RECENT = 256
+
 # A lockstep loop is a generator that yields (inbound, k) where it needs every
 # frame of that link due at tick k; the driver resumes it once they are in.
 Waits = Generator[tuple["Inbound[Any]", int], None, None]
@@ -322,6 +349,7 @@ class Inbound(Generic[M]):
         self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
         self.latest: M | None = None  # the last delivered message
         self._last_raw: bytes = b""  # payload of the last accepted frame (conflict detection)
+        self._recent: dict[int, bytes] = {}  # tick -> payload of the last RECENT accepted frames (conflicts)
         self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
         self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
@@ -365,18 +393,22 @@ class Inbound(Generic[M]):
         if self.strict:  # lockstep: exactly the next scheduled tick
             expected = self.last_seen + 1 if self._every_tick else self.schedule.first_after(self.last_seen)
             if tick != expected:
-                if tick == self.last_seen and raw != self._last_raw:
+                if tick <= self.last_seen and self._recent.get(tick, raw) != raw:
                     self._conflict(raw, msg)
                 else:
                     self._rej.reject(self.key, "out-of-sequence", f"tick {tick}, expected {expected}")
                 return False
         elif tick <= self.last_seen:
-            if tick == self.last_seen and raw != self._last_raw:
+            if self._recent.get(tick, raw) != raw:
                 self._conflict(raw, msg)
             else:
                 self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {self.last_seen}")
             return False
         self._last_raw = raw
+        recent = self._recent
+        recent[tick] = raw
+        if len(recent) > RECENT:
+            del recent[next(iter(recent))]
         self._stand_in = False
         # In sequence: the link advances whatever the content. A frame that fails
         # validation is counted and replaced by the key's safe default
@@ -423,13 +455,20 @@ class Inbound(Generic[M]):
         return frames, dropped, e.delays_ms[: frames - dropped]
 
     def _conflict(self, raw: bytes, msg: M) -> None:
-        """A second, different frame for the tick just accepted: two senders on one key.
+        """A second, different frame for a tick already accepted: two senders on one key.
 
-        Counted. If the accepted one was invalid (a safe default stands in for
-        it) and this one is valid and not yet delivered, this one takes its place.
+        Counted, whatever its tick (a genuine frame that comes after a forged one is
+        a conflict, not out-of-sequence). If it is for the tick just accepted, the
+        accepted one was invalid (a safe default stands in for it), and this one is
+        valid and not yet delivered, this one takes its place.
         """
         self._rej.conflict(self.key, msg.tick)  # type: ignore[attr-defined]
-        if not self._stand_in or nonfinite(raw, msg) or (self._check is not None and self._check(msg)):
+        if (
+            msg.tick != self.last_seen
+            or not self._stand_in
+            or nonfinite(raw, msg)
+            or (self._check is not None and self._check(msg))
+        ):
             return
         for i, (at, tick, _) in enumerate(self._pending):
             if tick == msg.tick:  # type: ignore[attr-defined]

@@ -2,28 +2,33 @@
 
 zenoh tells a subscriber nothing it can trust about a sample's sender: the
 source info is written by the sender itself, and without `--secure` anybody
-who reaches the router can put on any key. So the messages a match's *result*
-depends on carry a MAC, in the sample's zenoh attachment (the payload, and so
-every digest and every recorded byte, stays exactly what it was):
+who reaches the router can put on any key. So every frame of a match carries a
+MAC, in the sample's zenoh attachment (the payload, and so every digest and
+every recorded byte, stays exactly what it was):
 
     attachment = BLAKE2b(key=K_sender, digest_size=16)(key_expr || 0x00 || payload)
 
 `key_expr` is the full key put on (`arena/<match>/engine/events`), `K_sender`
 the sender's own 32-byte key. Every process of a match gets a fresh random key
 from the launcher (in its credentials fragment, schemas/README.md "Security"),
-and a receiver that must trust a sender gets that sender's key too:
+and the keys of the senders of every key it receives (the key table's
+`routes`): every data key (`sense`, `cmd`, `report`, `order`, `referee`,
+`engine/events`, `world`, `field`, `worldstate`), every `tap/<p>` and
+`summary/<p>`. The collector (`arena match`) and the recorder hold every key.
 
-* `summary/<p>`: verified by the collector (`arena match`) and the recorder;
-* `tap/<p>`: verified by the recorder;
-* `engine/events`: verified by the referee; `referee`: verified by the engine;
-* `world`: verified by whoever holds the engine's key (the viewer's fragment).
+A receiver checks the MAC before the frame reaches its lockstep: one with a
+missing or wrong MAC is dropped and counted, per key, as `forged`, so it can
+never take a tick's slot, displace or delay the genuine frame. A process with
+no key (started by hand without `--credentials`) sends no MAC, and a receiver
+with no key for a sender accepts what comes: that is the match of earlier
+versions, no worse. Replays of genuine messages are caught by what is already
+there: ticks and batch numbers in sequence, one Summary per process.
 
-A message on one of these keys with a missing or wrong MAC is dropped and
-counted under the reason `forged`. A process with no key (started by hand
-without `--credentials`) sends no MAC, and a receiver with no key for a
-sender accepts what comes: that is the match of earlier versions, no worse.
-Replays of genuine messages are caught by what is already there: ticks and
-batch numbers in sequence, one Summary per process.
+A MAC is symmetric: a receiver that holds a sender's key could forge that
+sender's frames to the others. Without `--secure` that is no new power (anyone
+on the router can put on any key; the MAC keeps out whoever has no key); with
+`--secure`, the router's access control lets a principal put only on the keys
+it sends (runtime/acl.py).
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
 from arena.runtime.transport import Transport
 from arena.schemas import messages as msgs
-from arena.schemas.keys import KEY_BY_NAME, SERVED, SIGNED_DATA, Keys
+from arena.schemas.keys import KEY_BY_NAME, SERVED, Keys
 
 M = TypeVar("M", bound=msgs.Base)
 
@@ -98,6 +98,18 @@ class Peer:
         self.on_waiting: Callable[[list[str]], None] | None = None
         self.tap: Tap | None = None  # a `Node`'s, in a recorded match
         self._tap_handoff: Handoff | None = None
+        self._spoofing_tokens: list[object] = []  # `announce_spoofing`
+
+    def announce_spoofing(self) -> None:
+        """Declare `spoofing/<user>/<key>` for every key first found spoofed since the last call
+        (a forged or conflicting frame, `Rejections`), so the launcher says so during the match.
+        Main thread only: a zenoh session call from its own callback thread can collide with it."""
+        new = self.rejections.spoofed_new
+        declare = getattr(self.transport, "declare_token", None)
+        while new:
+            key = new.pop(0)
+            if declare is not None:
+                self._spoofing_tokens.append(declare(self.keys.spoofing(self.name, self.keys.rel(key))))
 
     def rng(self, *path: object):
         """This process's own RNG for `path` (one per component)."""
@@ -171,6 +183,7 @@ class Peer:
                 clock.sleep(0.01)
         if told is not None and self.on_waiting is not None:
             self.on_waiting([])
+        self.announce_spoofing()  # frames come in at the barrier too, forged ones included
 
     # ------------------------------------------------------------------- play
     def loop(self) -> Waits:
@@ -214,6 +227,8 @@ class Peer:
 
     def conclude(self) -> msgs.Summary:
         """After the loop: the tap's final batch, then the Summary, published and returned."""
+        if not self.cooperative:
+            self.announce_spoofing()
         if self.tap is not None:
             self.tap.close(self.last_tick)
             if self._tap_handoff is not None:
@@ -287,6 +302,7 @@ class Peer:
             sent_by_key={o.rel.decode(): o.sent for o in self.outbound},
             conflicts={self.keys.rel(k): n for k, n in sorted(self.rejections.conflicts.items())},
             dead_at=dict(sorted(self.dead_at.items())),
+            forged={self.keys.rel(k): n for k, n in sorted(self.rejections.forged_by_key.items())},
         )
 
 
@@ -317,6 +333,8 @@ class Node(Peer):
             put = transport.publisher(keys.tap(self.name), sign=self.keyring.signer(keys.tap(self.name)))
             self._tap_handoff = Handoff(put) if isinstance(self.driver, Reactor) else None
             self.tap = Tap(self.name, self._tap_handoff or put)
+        if isinstance(self.driver, Reactor):  # its main thread looks ten times a second
+            self.driver.on_idle = self.announce_spoofing
 
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
@@ -324,8 +342,7 @@ class Node(Peer):
         is not put on the wire while nobody listens (it still counts in the digest).
         A key of `SERVED` (schemas/keys.py) is also served: a query gets its last frame."""
         key = self.keys.key(name, team, n)
-        sign = self.keyring.signer(key) if self.keys.rel(key) in SIGNED_DATA else None
-        put = self.transport.publisher(key, when_matched=viewers_only, sign=sign)
+        put = self.transport.publisher(key, when_matched=viewers_only, sign=self.keyring.signer(key))
         if self.tap is None:
             ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
         else:
@@ -361,8 +378,8 @@ class Node(Peer):
         model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
         changes = () if ideal or not self.cfg.scenario.steps else scheduled(self.cfg, spec.link_class)
         emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name), changes)
-        verify = self.keyring.verifier(sender, key) if self.keys.rel(key) in SIGNED_DATA else None
-        on_forged = functools.partial(self.rejections.reject, key, "forged", f"not from {sender}")
+        verify = self.keyring.verifier(sender, key)
+        on_forged = functools.partial(self.rejections.forged, key, sender)
         ib: Inbound[Any] = Inbound(
             key=key,
             msg_type=spec.message,

@@ -29,7 +29,7 @@ from arena.schemas.keys import (
     MAX_BATCH,
     MAX_FRAME_BYTES,
     OPERATOR,
-    SIGNED_DATA,
+    SPOOFING,
     SUMMARY,
     TAP,
     TAP_PERIOD,
@@ -94,6 +94,7 @@ Infrastructure keys (not data pairs):
 | `arena/<match>/{COLLECTOR}` | liveliness token of a summary collector (`arena match`, `arena up`); while present, a process repeats its summary until acknowledged |
 | `arena/<match>/{ACK}/<process>` | the collector's acknowledgement of a summary (payload `ack`) |
 | `arena/<match>/{TAP}/<process>` | `TapBatch`, only in a recorded match: every frame the process sent, batched every {TAP_PERIOD} ticks, for the recorder (docs/recording.md) |
+| `arena/<match>/{SPOOFING}/<user>/<key>` | liveliness token (`<user>`: the process with `/` as `-`, `robot-a-1`) a process declares the first time it drops a frame on `<key>` whose MAC does not check out, or counts one that conflicts with the frame it took for that tick; `arena match` prints `possible spoofing on <key>` once (see "Security") |
 | `arena/<match>/{CONTROL}` | `Control`, only in a live lockstep match (`arena match --live`): the viewer pauses, steps and paces the engine; waits only, never a different digest (docs/recording.md) |
 | `arena/<match>/{OPERATOR}` | `Operator`, only in a live session (`--realtime` or `--live`): teleports and referee overrides from `arena operator`, applied at the engine's and the referee's next tick; in a secure match only the `operator` principal may put it (docs/scenarios.md) |
 
@@ -412,7 +413,8 @@ Rust `Config::from_file`) and add only the router's endpoint
                      "verify_name_on_connect": false}}}}
   }},
   "metadata": {{"arena": {{"credentials": "<set id>", "process": "robot/b/1",
-                         "keys": {{"robot/b/1": "<{MAC_KEY_BYTES} bytes, hex>"}}}}}}
+                         "keys": {{"robot/b/1": "<{MAC_KEY_BYTES} bytes, hex>",    // its own
+                                  "engine": "...", "basestation/b": "..."}}}}}}}}  // its senders'
 }}
 ```
 
@@ -430,7 +432,7 @@ signs the router's certificate and nothing else, so host names are not
 checked). The router's access control is generated from the key table above,
 default deny: a principal may put only on the keys it sends, declare
 subscribers only on the keys it receives (the referee state is readable by
-all), plus its own `{ALIVE}/<process>` and `{WAITING}/<process>/*` tokens,
+all), plus its own `{ALIVE}/<process>`, `{WAITING}/<process>/*` and `{SPOOFING}/<user>/**` tokens,
 `{SUMMARY}/<process>`, `{TAP}/<process>`, `{ACK}/<process>` and reading
 `{ALIVE}/**`, `{WAITING}/**`, `{COLLECTOR}` and `{CONFIG}`, and asking for its identity
 (`{CLAIM}/<process>`, below). A put or a subscription outside that is dropped silently by the
@@ -439,27 +441,51 @@ router. `viewer` is read-only: it may put nothing but the live `control`.
 `{OPERATOR}`, which only the engine and the referee may read; it declares no
 liveliness token.
 
-**Message authentication** (every match, with or without `--secure`). The
-sender of `{SUMMARY}/<process>`, `{TAP}/<process>` and of
-{", ".join(f"`{k}`" for k in SIGNED_DATA)} puts, as the sample's zenoh
-**attachment**, a {MAC_BYTES}-byte MAC:
+**Message authentication** (every match, with or without `--secure`). Every
+frame on every data key of the table above, and every `{SUMMARY}/<process>` and
+`{TAP}/<process>`, carries as the sample's zenoh **attachment** a {MAC_BYTES}-byte MAC
+made with its sender's own key:
 
     BLAKE2b(key = own key from metadata.arena.keys, digest_size = {MAC_BYTES},
             data = <full key expression, UTF-8> 0x00 <payload>)
 
 e.g. key `00 01 02 ... 1f`, key expression `arena/m/summary/engine`, payload
 `81 a1 61 01`: MAC `d7c51f4829d4546d963595dcd996ee3f`. The payload, and so every
-digest and every recorded byte, is unchanged. A receiver that holds the
-sender's key (the collector and the recorder: every process's; the referee:
-the engine's; the engine: the referee's) drops a frame without a valid MAC
-and counts it as `forged`. The collector also accepts one Summary per process,
+digest and every recorded byte, is unchanged. A batch (see "Batches") is one
+payload: its MAC covers the whole msgpack array. In C, with libsodium
+(`crypto_generichash` is BLAKE2b):
+
+```c
+unsigned char mac[{MAC_BYTES}];
+crypto_generichash_state st;
+crypto_generichash_init(&st, own_key, {MAC_KEY_BYTES}, sizeof mac);
+crypto_generichash_update(&st, (const unsigned char *)key_expr, strlen(key_expr) + 1);  /* with its NUL */
+crypto_generichash_update(&st, payload, payload_len);
+crypto_generichash_final(&st, mac, sizeof mac);
+/* then put the payload with these 16 bytes as the put options' `attachment` (zenoh-c) */
+```
+
+and to check a frame you receive, compute the same over its key expression and
+payload with the sender's key from `metadata.arena.keys` (the sender is the
+table's `sender` column) and compare all {MAC_BYTES} bytes in constant time
+(`sodium_memcmp`), against the sample's attachment. The credentials
+file holds your own key and the key of every sender whose keys you receive
+(the collector and the recorder hold every key). A receiver drops a frame
+whose MAC is missing or wrong before it can take a tick's slot, counts it per
+key as `forged` (the match JSON's `forged`), and declares the liveliness token
+`arena/<match>/{SPOOFING}/<receiver's user>/<key>` the first time, which `arena match`
+prints once as "possible spoofing on KEY". A frame with a valid MAC that
+differs from the one already taken for its tick, whatever the tick, is a
+`conflict` (per key, `conflicts`) and is reported the same way. A process
+started without `--credentials` sends no MAC and checks none; the processes
+of a match that wrote it a credentials file drop what it sends as forged.
+
+The collector also accepts one Summary per process,
 only on that process's own key, and only if it is plausible (tick within the
 match, `sent` = sum of `sent_by_key`, `rejected` = sum of `rejected_reasons`);
 the match JSON lists what it refused under `forged_summaries`. The recorder
 writes a tap frame only if its key is one the batch's owner sends and its
-payload decodes as that key's type. A client of a match that announced a
-credentials file for it must MAC its Summary (and its tap batches, in a
-recorded match), or its Summary never counts.
+payload decodes as that key's type.
 """
 
 

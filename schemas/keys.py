@@ -167,9 +167,8 @@ KEY_BY_NAME = {k.name: k for k in KEYS}
 # frame ever needs zenoh's fragmentation, which relayed megabyte frames lose (schemas/contract.py).
 MAX_FRAME_BYTES = 1 << 16
 
-# Data keys whose frames carry their sender's MAC in the zenoh attachment (runtime/mac.py),
-# besides every `summary/<p>` and `tap/<p>`; relative to arena/<match>/.
-SIGNED_DATA = ("engine/events", "referee", "world")
+# Every frame on a data key of `KEYS`, every `summary/<p>` and every `tap/<p>` carries its sender's
+# MAC in the zenoh attachment (runtime/mac.py), in every match, `--secure` or not.
 # Keys (by name) whose sender also serves its last frame: the live viewer asks for what the
 # teams believe a few times a second (processes/viewer.py) instead of subscribing, which
 # would cost every robot and base station one more put per frame, many a second unpaced.
@@ -244,6 +243,9 @@ REFUSED = "refused"  # arena/<m>/refused/<process id>: a second process with tha
 # arena/<m>/claim/<process id>: queryable of the match's router, which gives each identity to one process;
 # arena/<m>/claim/<process id>/<nonce>: the claimant's liveliness token, held while it runs
 CLAIM = "claim"
+# arena/<m>/spoofing/<process id, / as ->/<key>: liveliness token of a process that dropped a forged
+# frame, or counted a conflicting one, on <key> (relative to arena/<m>/); the launcher prints each key once
+SPOOFING = "spoofing"
 TAP = "tap"  # arena/<m>/tap/<process id>: TapBatch, only when the match records
 CONTROL = "control"  # arena/<m>/control: Control frames, viewer -> engine, live lockstep matches only
 OPERATOR = "operator"  # arena/<m>/operator: Operator frames -> engine and referee, live sessions only
@@ -276,6 +278,13 @@ class Keys:
 
     def waiting_all(self) -> str:
         return f"{self.prefix}{WAITING}/**"
+
+    def spoofing(self, process: str, rel: str) -> str:
+        """`robot/a/1` saw spoofing on `referee`: arena/<m>/spoofing/robot-a-1/referee."""
+        return f"{self.prefix}{SPOOFING}/{process.replace('/', '-')}/{rel}"
+
+    def spoofing_all(self) -> str:
+        return f"{self.prefix}{SPOOFING}/**"
 
     def summary(self, process: str) -> str:
         return f"{self.prefix}{SUMMARY}/{process}"

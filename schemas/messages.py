@@ -287,6 +287,10 @@ class Summary(Base):
     dead_at: Annotated[
         dict[str, int], Meta(description="per peer in `dead`: this process's tick when it stopped waiting for it")
     ] = {}
+    forged: Annotated[
+        dict[str, int],
+        Meta(description="per inbound key (no prefix): frames dropped because their sender's MAC did not check out"),
+    ] = {}
 
 
 class TapFrame(Base):

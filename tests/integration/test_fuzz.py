@@ -40,9 +40,10 @@ import zenoh
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
+from arena.runtime.mac import tag
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
-from arena.schemas.keys import MAX_FRAME_BYTES
+from arena.schemas.keys import MAX_FRAME_BYTES, routes
 from tests.integration.helpers import ARENA, alive, cmdline, descendants, spawn, wait_for
 
 GOLDEN = json.loads((Path(__file__).resolve().parents[1] / "golden" / "digests.json").read_text())[0]
@@ -65,8 +66,11 @@ TARGETS: list[tuple[str, type, int]] = (
     ]
 )
 
-# Receivers that check a MAC before anything else (runtime/mac.py): the engine on `referee`, the referee on `engine/events`.
-MAC_CHECKED = {"referee": 1, "engine/events": 1}
+
+# Who sends each key: every receiver checks that sender's MAC first (runtime/mac.py), so the fuzzer
+# signs each payload with that sender's own key, read from the match's credentials directory, as an
+# insider would: the payloads must reach the decoders to be fuzzing them.
+SENDER = {rel: sender for rel, sender, _ in routes(CFG["robots"])}
 
 POSE = {"x": 0.5, "y": -0.5, "theta": 0.1}
 SHAPES = {  # a valid map of each type but for its tick
@@ -202,10 +206,12 @@ class Launcher:
 def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
     match_id = f"fuzz{n}"
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
+    creds = tmp_path / "creds"
     launcher = Launcher(reap, tmp_path / "logs", "match", "--home", CFG["home"], "--away", CFG["away"],
                         "--robots", str(CFG["robots"]), "--half-time", str(CFG["half_time"]),
                         "--seed", str(CFG["seed"]), "--link", CFG["link"], "--external", "a/0",
-                        "--match", match_id, "--listen", endpoint, "--json")  # fmt: skip
+                        "--match", match_id, "--listen", endpoint, "--credentials", str(creds),
+                        "--json")  # fmt: skip
     # The launcher prints the command that starts a/0 (with its credentials): start it exactly so, later.
     command = launcher.line("arena run robot", 60).split()
     sent = {"count": 0, "frames": 0, "too-large": 0, "big": 0}
@@ -222,6 +228,11 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
         wait_for(lambda: len(alive_) >= others, 120, "every other process at its start barrier")
         sub.undeclare()
         wait_for(lambda: len(list(session.info.peers_zid())) >= others, 30, "a direct link to every other process")
+        own_key = {}
+        for key, _, _ in TARGETS:
+            sender = SENDER[key]
+            frag = json.loads((creds / f"{sender.replace('/', '-')}.json5").read_text())
+            own_key[key] = bytes.fromhex(frag["metadata"]["arena"]["keys"][sender])
         pubs = {
             key: session.declare_publisher(
                 f"arena/{match_id}/{key}",
@@ -237,12 +248,12 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
             @given(frames(huge))
             def put(frame):
                 key, receivers, payload = frame
-                pubs[key].put(payload)
+                pubs[key].put(payload, attachment=tag(own_key[key], f"arena/{match_id}/{key}", payload))
                 sent["count"] += receivers
                 sent["frames"] += 1
                 sent["big"] += huge
-                if len(payload) > MAX_FRAME_BYTES:  # a receiver that checks a MAC counts it `forged` first
-                    sent["too-large"] += receivers - MAC_CHECKED.get(key, 0)
+                if len(payload) > MAX_FRAME_BYTES:
+                    sent["too-large"] += receivers
 
             put()
 

@@ -521,3 +521,33 @@ def test_the_counters_count_the_frames_waited_for_not_those_racing_the_end():
         assert ib.emulator.frames == 7 and ib.counted() == (frames, dropped, delays), "the late ones do not count"
     finally:
         harness.close()
+
+
+def test_a_genuine_frame_after_forged_ones_ahead_is_a_conflict_whatever_its_tick(h, caplog):
+    """A stranger without keys (a process started by hand, no MACs to check) puts ticks 0..4
+    ahead of the genuine sender: they take the slots, and each genuine frame that follows is
+    a conflict on this key, not `out-of-sequence` (only tick == last seen counted before);
+    "possible spoofing on KEY" is logged once, and the key is queued for its announcement."""
+    for t in range(5):
+        h.put(encode(Cmd(tick=t, vx=-5.0)))
+    h.inbound.sync(4 + h.inbound.lag)
+    caplog.set_level(logging.WARNING)
+    for t in range(5):
+        h.put(encode(Cmd(tick=t, vx=1.0)))  # the genuine frames, for ticks already taken
+    h.put(encode(Cmd(tick=3, vx=-5.0)))  # a repeat of an accepted frame: out of sequence, no conflict
+    h.put(encode(Cmd(tick=5, vx=1.0)))
+    h.inbound.sync(5 + h.inbound.lag)
+    assert h.rej.conflicts == {KEY: 5}, h.rej.by_reason
+    assert h.rej.by_reason["out-of-sequence"] == 1
+    assert [r.getMessage() for r in caplog.records].count(f"possible spoofing on {KEY}") == 1
+    assert h.rej.spoofed_new == [KEY]
+
+
+def test_a_forged_frame_is_counted_per_key_and_announced_once():
+    rej = Rejections(logging.getLogger("test"))
+    for _ in range(3):
+        rej.forged(KEY, "robot/a/1")
+    rej.forged("arena/t/referee", "referee")
+    assert rej.forged_by_key == {KEY: 3, "arena/t/referee": 1}
+    assert rej.by_reason == {"forged": 4} and rej.conflicts == {}
+    assert rej.spoofed_new == [KEY, "arena/t/referee"]

@@ -36,8 +36,14 @@ def test_robot_a1_puts_only_on_its_cmd_and_report():
         "ack/robot/a/1",
     }
     # its liveliness, and the tokens that announce its long lockstep waits (runtime/drivers.py Reactor)
-    # ... and the token that holds its identity (one process per identity: tools/launch/claims.py)
-    assert _rel(perms["liveliness_token/ingress"]) == {"alive/robot/a/1", "waiting/robot/a/1/*", "claim/robot/a/1/*"}
+    # ... the token that holds its identity (one process per identity: tools/launch/claims.py), and the
+    # tokens that say it saw forged or conflicting frames on a key (the launcher prints them)
+    assert _rel(perms["liveliness_token/ingress"]) == {
+        "alive/robot/a/1",
+        "waiting/robot/a/1/*",
+        "claim/robot/a/1/*",
+        "spoofing/robot-a-1/**",
+    }
     assert "claim/robot/a/1" in _rel(perms["query/ingress"]) and "claim/robot/a/2" not in _rel(perms["query/ingress"])
 
 
@@ -75,8 +81,14 @@ def test_fragments_hold_user_password_tls_root_and_keys(tmp_path):
     assert frag["transport"]["auth"]["usrpwd"]["user"] == "robot-b-1"
     assert frag["transport"]["link"]["tls"]["root_ca_certificate_base64"]
     keys = frag["metadata"]["arena"]["keys"]
-    assert set(keys) == {"robot/b/1"}, "a team process holds its own key only"
+    # Its own key, and the keys of the senders of what it receives (sense, field; its orders): every
+    # frame it takes is authenticated, in every mode. No other robot's, no other team's.
+    assert set(keys) == {"robot/b/1", "engine", "basestation/b"}
     assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine"}
+    bs = set(load_fragment(str(paths["basestation/a"]))["metadata"]["arena"]["keys"])
+    assert bs == {"basestation/a", "engine", "referee", "robot/a/0", "robot/a/1", "robot/a/2"}  # field: engine
+    engine = set(load_fragment(str(paths["engine"]))["metadata"]["arena"]["keys"])
+    assert engine == {"engine", "referee", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
     insecure = Secrets.new("m1", 3, NAMES, secure=False).fragment("robot/b/1")
     assert set(insecure) == {"metadata"}, "without --secure: the MAC key only, the zenoh settings untouched"
     json.dumps(frag)  # plain JSON, so valid JSON5

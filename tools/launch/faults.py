@@ -104,7 +104,7 @@ def outcome(
     missing: dict[str, str],
     void: str = "",
 ) -> dict:
-    """The `outcome`, `void`, `outcome_reasons`, `dead`, `faults` and `conflicts` of the match JSON."""
+    """The `outcome`, `void`, `outcome_reasons`, `dead`, `faults`, `conflicts` and `forged` of the match JSON."""
     dead = blame(summaries, set(lost))
     order = [str(p) for p in cfg.processes()]
     faults = []
@@ -140,9 +140,12 @@ def outcome(
     else:
         result = "completed"
     conflicts: dict[str, int] = {}
+    forged: dict[str, int] = {}
     for s in summaries.values():
         for key, n in s.conflicts.items():
             conflicts[key] = conflicts.get(key, 0) + n
+        for key, n in s.forged.items():
+            forged[key] = forged.get(key, 0) + n
     return {
         "outcome": result,
         "void": result == "void",
@@ -150,14 +153,17 @@ def outcome(
         "dead": sorted(dead),
         "faults": faults,
         "conflicts": dict(sorted(conflicts.items())),
+        "forged": dict(sorted(forged.items())),
     }
 
 
 def warnings(result: dict) -> list[str]:
-    """One line per fault and per key with two senders, for the terminal."""
+    """One line per fault and per key with forged or conflicting frames, for the terminal."""
     lines = []
-    for key, n in result.get("conflicts", {}).items():
-        lines.append(f"two senders on {key}: possible spoofing ({n} conflicting frames)")
+    conflicts, forged = result.get("conflicts", {}), result.get("forged", {})
+    for key in sorted({*conflicts, *forged}):
+        counts = [f"{n} {what}" for n, what in ((forged.get(key, 0), "forged"), (conflicts.get(key, 0), "conflicting"))]
+        lines.append(f"possible spoofing on {key} ({', '.join(c for c in counts if not c.startswith('0 '))} frames)")
     for f in result.get("faults", []):
         at = f" at tick {f['tick']}" if f.get("tick") is not None else ""
         lines.append(f"fault: {f['process']}{at}: {f['reason']}")
