@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import hmac
 import json
 import os
 import queue
@@ -42,14 +43,27 @@ def main(argv: list[str]) -> int:
     # Security: the credentials file is a zenoh configuration; add only the router's endpoint.
     with open(args.credentials) as f:
         creds = json.load(f)
-    mac_key = bytes.fromhex(creds["metadata"]["arena"]["keys"][me])
+    keys = {p: bytes.fromhex(k) for p, k in creds["metadata"]["arena"]["keys"].items()}
+    mac_key = keys[me]
     conf = zenoh.Config.from_file(args.credentials)
     conf.insert_json5("mode", '"client"')
     conf.insert_json5("connect/endpoints", json.dumps([args.connect]))
     conf.insert_json5("scouting/multicast/enabled", "false")
 
-    def mac(key: str, payload: bytes) -> bytes:
-        return hashlib.blake2b(key.encode() + b"\x00" + payload, key=mac_key, digest_size=16).digest()
+    def mac(key: str, payload: bytes, sender_key: bytes = mac_key) -> bytes:
+        return hashlib.blake2b(key.encode() + b"\x00" + payload, key=sender_key, digest_size=16).digest()
+
+    sense_key = f"{prefix}robot/{args.team}/{args.robot}/sense"
+    forged = [0]
+
+    def on_sense(sample: zenoh.Sample) -> None:
+        """Only the engine's frames: a sense whose MAC is not the engine's is dropped and counted."""
+        payload = sample.payload.to_bytes()
+        attachment = sample.attachment.to_bytes() if sample.attachment is not None else b""
+        if hmac.compare_digest(attachment, mac(sense_key, payload, keys["engine"])):
+            senses.put(payload)
+        else:
+            forged[0] += 1
 
     session = zenoh.open(conf)
     try:
@@ -70,9 +84,7 @@ def main(argv: list[str]) -> int:
 
         keep = [
             session.declare_subscriber(f"{prefix}referee", on_referee),  # public: what the README says occurs
-            session.declare_subscriber(
-                f"{prefix}robot/{args.team}/{args.robot}/sense", lambda s: senses.put(s.payload.to_bytes())
-            ),  # fmt: skip
+            session.declare_subscriber(sense_key, on_sense),
             session.declare_subscriber(f"{prefix}ack/{me}", lambda s: acked.set()),
             session.liveliness().declare_subscriber(f"{prefix}collector", on_collector, history=True),
         ]
@@ -124,7 +136,7 @@ def main(argv: list[str]) -> int:
             digest.update(len(payload).to_bytes(4, "little"))
             digest.update(payload)
             sent[key] += 1
-            pubs[key].put(payload)
+            pubs[key].put(payload, attachment=mac(prefix + key, payload))  # README, "Message authentication"
 
         latency = cfg["timing"]["perception_latency"]  # L: at tick k the robot sees the sense of tick k - L
         wait = cfg["timing"]["startup_timeout"] + cfg["timing"]["wait_timeout"]
@@ -166,8 +178,8 @@ def main(argv: list[str]) -> int:
             "pid": os.getpid(),
             "digest": digest.hexdigest(),
             "sent": sum(sent.values()),
-            "rejected": sum(rejected.values()),
-            "rejected_reasons": rejected,
+            "rejected": sum(rejected.values()) + forged[0],
+            "rejected_reasons": rejected | ({"forged": forged[0]} if forged[0] else {}),
             "sent_by_key": sent,
             "extra": {"client": "readme_robot"},
         }

@@ -23,7 +23,7 @@ def test_the_readme_client_imports_nothing_of_the_project():
     tree = ast.parse(CLIENT.read_text())
     imported = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
     imported |= {n.module.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
-    assert imported <= {"__future__", "argparse", "hashlib", "json", "os", "queue", "sys", "threading", "time",
+    assert imported <= {"__future__", "argparse", "hashlib", "hmac", "json", "os", "queue", "sys", "threading", "time",
                         "msgpack", "zenoh"}, imported  # fmt: skip
 
 
