@@ -13,6 +13,12 @@ caller (`drain`), the bad ones counted by team and reason.
 
 Nothing here ever blocks the caller: `broadcast` queues, the server thread
 writes. A base station that stops reading is cut off once 1 MiB is queued for it.
+
+No input ends the server: every message is bounded (`MAX_UNTERMINATED` characters,
+`MAX_DEPTH` levels of nesting) and every decode error is counted by reason. A base
+station that misbehaves is disconnected and the match goes on: one that nests too
+deep, sends `MAX_ERRORS` bad messages, or whose input raises anything unforeseen
+(counted as `unreadable`, with the exception's type in the log).
 """
 
 from __future__ import annotations
@@ -31,6 +37,8 @@ from arena.rules import refbox_protocol as rp
 from arena.runtime.config import RefboxParams
 
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
+MAX_ERRORS = 1000  # bad messages from one connection: then it is disconnected
+DISCONNECTS = ("too-deep",)  # reasons no honest base station gives: disconnected at the first
 TEAMS = ("a", "b")
 
 
@@ -43,6 +51,7 @@ class Client:
     name: str = ""
     reader: rp.WorldstateReader = field(default_factory=rp.WorldstateReader)
     out: bytearray = field(default_factory=bytearray)
+    errors: int = 0  # bad messages on this connection
 
 
 def check_listen(endpoint: str) -> None:
@@ -89,7 +98,10 @@ class BridgeServer:
     def broadcast(self, command: str, team: str = "", robot_id: int = -1) -> None:
         """Queue one command of our referee for every connected base station."""
         self._outq.put((command, team if command in rp.TEAM_COMMANDS else "", robot_id))
-        self._wake_w.send(b"x")
+        try:
+            self._wake_w.send(b"x")
+        except OSError:  # the server has stopped: nobody to send to, and the match goes on
+            pass
 
     def drain(self) -> list[tuple[str, str, rp.WorldstateResult, float]]:
         """(team, address, result, time.monotonic() when read) of every message read since the last call."""
@@ -134,10 +146,14 @@ class BridgeServer:
                         client = self.clients.get(key.fileobj)
                         if client is None:
                             continue
-                        if mask & selectors.EVENT_READ:
-                            self._read(client)
-                        if mask & selectors.EVENT_WRITE and client.sock in self.clients:
-                            self._flush(client)
+                        try:
+                            if mask & selectors.EVENT_READ:
+                                self._read(client)
+                            if mask & selectors.EVENT_WRITE and client.sock in self.clients:
+                                self._flush(client)
+                        except Exception as exc:  # noqa: BLE001 - no client's input may end the server
+                            self.errors[client.side]["unreadable"] += 1
+                            self._drop(client, f"unreadable input ({type(exc).__name__}: {str(exc)[:80]})")
                 self._send_queued()
         finally:
             self._close_all()
@@ -255,17 +271,24 @@ class BridgeServer:
     def _take(self, client: Client, data: bytes) -> None:
         now = time.monotonic()
         results = client.reader.feed(data)
+        why = ""
         for r in results:
             if r.doc is None:
                 self.errors[client.side][r.reason] += 1
-                self.log.error(
-                    "refbox: team %s worldstate error %s: %s (%r)", client.side, r.reason, r.detail, r.raw[:60]
-                )
+                client.errors += 1
+                if client.errors <= rp.LOG_FIRST_ERRORS:
+                    self.log.error(
+                        "refbox: team %s worldstate error %s: %s (%r)", client.side, r.reason, r.detail, r.raw[:60]
+                    )
+                if r.reason in DISCONNECTS or client.errors >= MAX_ERRORS:
+                    why = f"{r.reason}: {r.detail}" if r.reason in DISCONNECTS else f"{client.errors} bad messages"
             else:
                 self.counts[f"worldstates_{client.side}"] += 1
         if results:
             with self._lock:
                 self._results.extend((client.side, client.address, r, now) for r in results)
+        if why and client.sock in self.clients:
+            self._drop(client, f"misbehaving ({why})")
 
     def _close_all(self, grace: float = 0.5) -> None:
         """End of match: half-close every connection, read what is still in flight, close.

@@ -33,6 +33,7 @@ from __future__ import annotations
 import ipaddress
 import json
 import math
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -41,6 +42,11 @@ from arena.runtime.config import RefboxTeam as TeamEntry
 
 PORT = 28097  # the RefBox's base-station port
 MAX_UNTERMINATED = 100_000  # [characters] the RefBox discards a message this long without its NUL
+# [levels] arrays and objects inside one another in a worldstate at most (the schema's deepest is 4:
+# robots, a robot, its pose, a number). Deeper is refused unparsed (`too-deep`): Python's JSON
+# parser recurses, and 2,000 `[` raised RecursionError, which killed the bridge's server thread.
+MAX_DEPTH = 32
+LOG_FIRST_ERRORS = 20  # bad messages of one connection logged one by one; the rest are counted only
 
 COMMANDS = (
     "START", "STOP", "WELCOME", "RESET", "TESTMODE_ON", "TESTMODE_OFF",
@@ -191,15 +197,35 @@ class WorldstateResult:
 
     raw: str
     doc: dict | None = None
-    reason: str = ""  # malformed-json | missing-key | wrong-type | not-terminated
+    reason: str = ""  # malformed-json | missing-key | wrong-type | not-terminated | too-deep
     detail: str = ""
 
 
+_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
+_BRACKETS = str.maketrans("", "", "".join(chr(c) for c in range(128) if chr(c) not in "[]{}"))
+
+
+def nesting(raw: str) -> int:
+    """How deep arrays and objects nest in `raw` (JSON text), brackets inside strings not counted."""
+    depth = deepest = 0
+    for c in _STRING.sub("", raw).translate(_BRACKETS):
+        if c in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif c in "]}":
+            depth -= 1
+    return deepest
+
+
 def validate_worldstate(raw: str) -> WorldstateResult:
-    """The RefBox's checks, in its order; the first failure is the reason."""
+    """The RefBox's checks, in its order; the first failure is the reason. Before them, our own
+    bound: nesting deeper than `MAX_DEPTH` is `too-deep`, never parsed."""
+    deep = nesting(raw)
+    if deep > MAX_DEPTH:
+        return WorldstateResult(raw[:60], reason="too-deep", detail=f"{deep} levels of nesting, at most {MAX_DEPTH}")
     try:
         doc = json.loads(raw)
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:
         return WorldstateResult(raw, reason="malformed-json", detail=str(exc)[:80])
     if not isinstance(doc, dict):
         return WorldstateResult(raw, reason="malformed-json", detail="not a JSON object")

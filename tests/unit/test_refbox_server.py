@@ -122,3 +122,94 @@ def test_scoring_against_ground_truth():
     assert s["ball_m"]["mean"] == 0.0  # the confident ball, at tick 3's true ball x = 4
     assert s["obstacles"] == {"recall": 0.5, "precision": 0.5, "opponents": 2, "reported": 2, "radius_m": 0.5}
     assert s["age_ms"]["mean"] == 40.0
+
+
+def connect_as_a(server: BridgeServer) -> socket.socket:
+    """A fresh connection that gets side a (the previous one is gone): WELCOME read."""
+    deadline = time.monotonic() + 5.0
+    while server.sides() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    sock = socket.create_connection(("127.0.0.1", server.port))
+    sock.settimeout(5.0)
+    got = b""
+    while b"\0" not in got:
+        got += sock.recv(4096) or b"\0"
+    assert b"WELCOME" in got, got
+    return sock
+
+
+GOOD = json.dumps({"type": "worldstate", "ageMs": 5, "teamName": "T", "intention": "", "robots": [],
+                   "balls": [], "obstacles": []}).encode() + b"\0"  # fmt: skip
+
+
+def still_serves(server: BridgeServer) -> None:
+    """The server thread lives, takes a new base station, and counts its good worldstate."""
+    assert server.thread.is_alive()
+    before = server.counts["worldstates_a"]
+    sock = connect_as_a(server)
+    try:
+        sock.sendall(GOOD)
+        deadline = time.monotonic() + 5.0
+        while server.counts["worldstates_a"] == before and time.monotonic() < deadline:
+            time.sleep(0.005)
+        assert server.counts["worldstates_a"] == before + 1
+    finally:
+        sock.close()
+
+
+def test_2000_brackets_are_refused_unparsed_and_their_sender_disconnected():
+    """Issue 36: `[` * 2000 raised RecursionError in the JSON parser, which killed the server
+    thread; the bridge then exited 2 on its next send ("Bad file descriptor")."""
+    server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x"), LOG)
+    try:
+        sock = connect_as_a(server)
+        sock.sendall(b"[" * 2000 + b"\0")
+        assert recv_until_closed(sock) == b"", "disconnected"
+        sock.close()
+        assert server.errors["a"]["too-deep"] == 1
+        server.broadcast("START")  # the match goes on
+        still_serves(server)
+    finally:
+        server.close(linger=0)
+
+
+def test_the_bridge_survives_any_input_on_its_socket():
+    """Hypothesis drives the real TCP socket: random bytes, deep nesting, long and unterminated
+    messages, broken UTF-8 and almost-valid worldstates, in random cuts. After every example the
+    server thread lives, counts every bad message by reason, and serves a new base station."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    nested = st.tuples(st.integers(1, 5000), st.sampled_from(["[", "{", '{"a":', "[{"])).map(
+        lambda t: (t[1] * t[0]).encode()
+    )
+    almost = st.dictionaries(st.sampled_from(["type", "ageMs", "teamName", "robots", "x"]),
+                             st.recursive(st.none() | st.floats() | st.text(max_size=4),
+                                          lambda c: st.lists(c, max_size=3) | st.dictionaries(st.text(max_size=3), c, max_size=3),
+                                          max_leaves=20)).map(lambda d: json.dumps(d).encode())  # fmt: skip
+    message = st.one_of(st.binary(max_size=300), nested, almost, st.just(b"\xff\xfe\xc0"), st.just(GOOD[:-1]))
+    stream = st.lists(st.tuples(message, st.booleans()), min_size=1, max_size=6).map(
+        lambda ms: b"".join(m + (b"\0" if end else b"") for m, end in ms)
+    )
+    server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x"), LOG)
+
+    @settings(max_examples=150, deadline=None, database=None, suppress_health_check=list(HealthCheck))
+    @given(stream, st.integers(1, 4096))
+    def feed(data: bytes, cut: int) -> None:
+        sock = connect_as_a(server)
+        try:
+            for i in range(0, len(data), cut):
+                sock.sendall(data[i : i + cut])
+        except OSError:
+            pass  # disconnected for misbehaving: allowed
+        finally:
+            sock.close()
+        assert server.thread.is_alive()
+
+    try:
+        feed()
+        assert sum(server.errors["a"].values()) > 0
+        assert set(server.errors["a"]) <= {"malformed-json", "missing-key", "wrong-type", "not-terminated", "too-deep"}
+        still_serves(server)
+    finally:
+        server.close(linger=0)
