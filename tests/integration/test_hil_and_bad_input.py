@@ -12,6 +12,7 @@ from pathlib import Path
 import msgspec
 import zenoh
 
+from arena.runtime.mac import tag
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas.messages import RefCommand, Referee, Report, encode
 from tests.integration.helpers import ARENA, spawn, wait_for
@@ -82,11 +83,21 @@ def _client_of_a_match(tmp_path, reap, match_id: str, seed: int):
         "--json",
         "--logs",
         str(tmp_path / "logs"),
+        "--credentials",
+        str(tmp_path / "creds"),
     )
     reap.append(match)
     wait_for(lambda: Path(endpoint.split("/", 1)[1]).exists(), 30, "the router socket")
     with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
         yield match, session
+
+
+def _as(tmp_path, match_id: str, sender: str, key: str):
+    """The MAC of `sender` on `key` (`sign(payload)`), from the match's credentials directory: an
+    insider's frames reach every receiver's decoder and checks; a stranger's are dropped as forged."""
+    frag = json.loads((tmp_path / "creds" / f"{sender.replace('/', '-')}.json5").read_text())
+    own = bytes.fromhex(frag["metadata"]["arena"]["keys"][sender])
+    return lambda payload: tag(own, f"arena/{match_id}/{key}", payload)
 
 
 def _result(match) -> dict:
@@ -95,8 +106,9 @@ def _result(match) -> dict:
     return json.loads(out)
 
 
-def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payloads) -> dict:
-    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key`. Returns the match JSON.
+def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, sender: str, payloads) -> dict:
+    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key` with `sender`'s MAC.
+    Returns the match JSON.
 
     `tick` is the tick of the first referee frame heard: the match is at or past it.
     """
@@ -108,8 +120,9 @@ def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, payl
         referee.undeclare()
         tick = msgspec.msgpack.decode(first.payload.to_bytes(), type=Referee).tick
         pub = session.declare_publisher(f"arena/{match_id}/{key}", congestion_control=zenoh.CongestionControl.BLOCK)
+        sign = _as(tmp_path, match_id, sender, key)
         for payload in payloads(tick):
-            pub.put(payload)
+            pub.put(payload, attachment=sign(payload))
         return _result(match)
 
 
@@ -122,7 +135,7 @@ def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path,
         encode(Report(tick=0, robot=1, pose={"x": 0, "y": 0, "theta": 0})),  # another message type (no tick order)
         msgspec.msgpack.encode({"tick": 999_999, "vx": float("nan")}),  # out of sequence
     ]
-    result = _put_during_a_match(tmp_path, reap, "noisy", 5, "robot/a/1/cmd", lambda tick: bad * 5)
+    result = _put_during_a_match(tmp_path, reap, "noisy", 5, "robot/a/1/cmd", "robot/a/1", lambda tick: bad * 5)
     assert result["rejected"] >= len(bad) * 5 - 5, result["rejected_reasons"]
     assert result["rejected_reasons"].get("malformed", 0) >= 4 * 5
     log = (tmp_path / "logs" / "engine.log").read_text()
@@ -152,6 +165,7 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
             congestion_control=zenoh.CongestionControl.BLOCK,
             allowed_destination=zenoh.Locality.REMOTE,
         )
+        sign = _as(tmp_path, "refnoise", "referee", "referee")
         wait_for(lambda: match.poll() is not None or referee.try_recv() is not None, 60, "the match to start")
         while match.poll() is None:
             heard = None
@@ -160,32 +174,33 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
             if heard is not None:
                 tick = decode(heard.payload.to_bytes()).tick
                 for t in (tick + 5, tick + 10):
-                    pub.put(
-                        encode(Referee(tick=t, stage="FIRST_HALF", command="CELEBRATE"))
-                    )  # not an MSL command: fails to decode
-                    pub.put(
-                        encode(
-                            Referee(tick=t, stage="FIRST_HALF", command="START", commands=[RefCommand(name="CORNER")])
-                        )
-                    )  # a corner for nobody
-                    pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="START", command_team="c")))  # no team c
+                    for msg in (
+                        Referee(tick=t, stage="FIRST_HALF", command="CELEBRATE"),  # not an MSL command: no decode
+                        Referee(tick=t, stage="FIRST_HALF", command="START", commands=[RefCommand(name="CORNER")]),
+                        Referee(tick=t, stage="FIRST_HALF", command="START", command_team="c"),  # no team c
+                    ):  # fmt: skip
+                        payload = encode(msg)
+                        pub.put(payload, attachment=sign(payload))  # with the referee's key: reaches every check
+                    pub.put(encode(Referee(tick=t, stage="FIRST_HALF", command="STOP")))  # no MAC: forged
                 rounds += 1
             time.sleep(0.02)
         result = _result(match)
     assert rounds >= 10, f"only {rounds} rounds of bad frames before the match ended"
     reasons = result["rejected_reasons"]
     assert reasons.get("invalid", 0) >= 2, reasons  # at least one per base station
-    # Team c and command CELEBRATE never decode (the wire types are Literal), whatever the tick.
-    assert 2 <= reasons.get("malformed", 0) <= 2 * 4 * rounds, reasons
+    # Team c and command CELEBRATE never decode (the wire types are Literal), whatever the tick;
+    # the engine and both base stations read them.
+    assert 2 <= reasons.get("malformed", 0) <= 3 * 4 * rounds, reasons
     logs = tmp_path / "logs"
     for process in ("basestation_a", "basestation_b"):
         log = (logs / f"{process}.log").read_text()
         assert "rejected input on arena/refnoise/referee: invalid:" in log, process
         assert "malformed: Invalid enum value 'c'" in log, process
-    # The engine holds the referee's MAC key (runtime/mac.py): frames without a
-    # valid MAC never reach its checks, whatever their content.
-    assert reasons.get("forged", 0) >= 3 * rounds, reasons
+        # Every receiver holds the referee's MAC key (runtime/mac.py): a frame without a valid MAC
+        # never reaches its checks, whatever its content.
+        assert "rejected input on arena/refnoise/referee: forged: not from referee" in log, process
     assert "rejected input on arena/refnoise/referee: forged: not from referee" in (logs / "engine.log").read_text()
+    assert result["forged"]["referee"] >= 3 * rounds, result["forged"]
     assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
 
 
