@@ -22,7 +22,8 @@ from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.schemas.messages import Summary
+from arena.schemas.messages import Base, Summary
+from arena.schemas.validate import nonfinite
 
 # What a cut-off file can raise inside a record: short reads, a chunk that does
 # not decompress, a CRC that does not match.
@@ -67,15 +68,47 @@ class Recording:
 
     def decoded(self, topic: str, msg_type: type):
         """The messages of `topic` that decode as `msg_type`; the others are skipped and counted
-        in `undecodable` (a hostile or damaged file never ends a review in a traceback)."""
+        in `undecodable` (a hostile or damaged file never ends a review in a traceback).
+
+        A message that decodes but holds a number no match sends (a NaN, an infinity, or a
+        magnitude over `MAX_MAGNITUDE`) is a RecordingError: the file was made, not recorded.
+        """
         dec = msgspec.msgpack.Decoder(msg_type).decode
         out = []
         for _, _, p in self.topics.get(topic, []):
             try:
-                out.append(dec(p))
+                msg = dec(p)
             except (msgspec.DecodeError, msgspec.ValidationError):
                 self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
+                continue
+            problem = nonfinite(p, msg) or _too_large(msg, "")
+            if problem:
+                raise RecordingError(
+                    f"{self.path}: a {topic} frame (tick {msg.tick}) is not what a match sends: {problem}"
+                )
+            out.append(msg)
         return out
+
+
+# [any unit] the largest number a review accepts in a decoded frame: positions are metres within a
+# field's fence, speeds m/s, times s, ticks a few 100,000; 1e308 m overflowed the plots' pixels.
+MAX_MAGNITUDE = 1e9
+
+
+def _too_large(value: object, path: str) -> str | None:
+    if type(value) in (float, int):
+        return f"{path or 'value'} = {value:g} is beyond {MAX_MAGNITUDE:g}" if abs(value) > MAX_MAGNITUDE else None
+    if isinstance(value, Base):
+        for name in value.__struct_fields__:
+            problem = _too_large(getattr(value, name), f"{path}.{name}" if path else name)
+            if problem:
+                return problem
+    elif isinstance(value, list | tuple):
+        for i, item in enumerate(value):
+            problem = _too_large(item, f"{path}[{i}]")
+            if problem:
+                return problem
+    return None
 
 
 def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:  # noqa: C901, PLR0912, PLR0915 - one pass over the file, every topic and damage counted where met

@@ -346,3 +346,55 @@ def test_replay_refuses_what_it_cannot_do(recorded, tmp_path):
     rt, _ = record(tmp_path, "rt.mcap", MatchConfig(seed=1, half_time=0.2, realtime=True))
     with pytest.raises(replay.ReplayError, match="realtime"):
         replay.replay(str(rt), "robot/a/1")
+
+
+def rewrite(src, dst, change) -> None:
+    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages."""
+    from mcap.records import Metadata
+    from mcap.stream_reader import StreamReader
+
+    with open(src, "rb") as f:
+        meta = [r for r in StreamReader(f).records if isinstance(r, Metadata)]
+    with open(src, "rb") as f, open(dst, "wb") as out:
+        w = Writer(out)
+        w.start()
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for schema, channel, m in make_reader(f).iter_messages(log_time_order=False):
+            if schema is not None and schema.id not in schemas:
+                schemas[schema.id] = w.register_schema(schema.name, schema.encoding, schema.data)
+            if channel.id not in channels:
+                sid = schemas.get(schema.id, 0) if schema is not None else 0
+                channels[channel.id] = w.register_channel(channel.topic, channel.message_encoding, sid)
+            w.add_message(channels[channel.id], m.log_time, change(channel.topic, m.data), m.publish_time, m.sequence)
+        for md in meta:
+            w.add_metadata(md.name, md.metadata)
+        w.finish()
+
+
+@pytest.mark.parametrize(("field", "value"), [("ball_x", float("nan")), ("ball_y", 1e308), ("t", float("-inf"))])
+def test_a_crafted_recording_is_a_one_line_error_in_every_review_mode(recorded, tmp_path, capsys, field, value):
+    """Issue 36: a world frame with x = NaN made --html and --plots exit 1 ("internal error:
+    ValueError: cannot convert float NaN to integer"); bad input is exit 2 with its reason."""
+    from arena.schemas.messages import World
+
+    path, _ = recorded
+    crafted = tmp_path / "crafted.mcap"
+    seen = [0]
+
+    def poison(topic: str, data: bytes) -> bytes:
+        if topic != "world":
+            return data
+        seen[0] += 1
+        if seen[0] != 30:
+            return data
+        world = msgspec.msgpack.decode(data, type=World)
+        return msgspec.msgpack.encode(msgspec.structs.replace(world, **{field: value}))
+
+    rewrite(path, crafted, poison)
+    modes = [{}, {"as_json": True}, {"plots": str(tmp_path / "plots")}, {"html": str(tmp_path / "r.html")}]
+    for mode in modes:
+        assert review.main(str(crafted), **mode) == 2, mode
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "a world frame (tick 29) is not what a match sends" in err[0], (mode, err)
+        assert field in err[0], err

@@ -256,20 +256,20 @@ def main(
 ) -> int:
     try:
         rec = load(path, keep=NEEDED)
-    except RecordingError as exc:
+        review = analyse(rec)
+        if plots:
+            review["plots"] = write_plots(rec, review, plots, goalkeepers)
+        if html:
+            from arena.tools.review.replay_page import write_page
+
+            try:
+                review["html"] = write_page(rec, html)
+            except OSError as exc:
+                print(f"arena review: error: cannot write --html {html}: {exc.strerror}", file=sys.stderr)
+                return 2
+    except RecordingError as exc:  # the file, or a frame in it no match sends: in every mode
         print(f"arena review: error: {exc}", file=sys.stderr)
         return 2
-    review = analyse(rec)
-    if plots:
-        review["plots"] = write_plots(rec, review, plots, goalkeepers)
-    if html:
-        from arena.tools.review.replay_page import write_page
-
-        try:
-            review["html"] = write_page(rec, html)
-        except OSError as exc:
-            print(f"arena review: error: cannot write --html {html}: {exc.strerror}", file=sys.stderr)
-            return 2
     if as_json:
         print(json.dumps(review, indent=2))
     else:
