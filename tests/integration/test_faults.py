@@ -131,12 +131,14 @@ def test_a_dead_referee_voids_the_match_at_once(reap, tmp_path):
     reap.append(proc)
     victim = child(proc.pid, "arena run referee")
     kids = descendants(proc.pid)
-    wait_for_tick(endpoint, "noref", 200, proc)
+    at = wait_for_tick(endpoint, "noref", 200, proc)
     os.kill(victim, signal.SIGKILL)
     code, result, err = finish(proc, 60)
     assert code == 1
     assert result["void"] and result["outcome"] == "void"
-    assert result["ticks"] < 6000
+    # Issue 36: what was played, not `ticks: 0, score [0, 0]`: as far as the referee's last frame.
+    assert at <= result["ticks"] < 6000 and result["sim_seconds"] == round(result["ticks"] * 0.02, 3)
+    assert len(result["score"]) == 2 and all(isinstance(n, int) for n in result["score"])
     assert "referee exited with code -9 (SIGKILL)" in result["outcome_reasons"][0]
     assert err.strip().splitlines()[-1].startswith("arena match: void: referee exited with code -9")
     wait_for(lambda: not [p for p in kids if alive(p)], 10, "every process of the void match to stop")

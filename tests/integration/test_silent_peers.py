@@ -17,6 +17,7 @@ import msgpack
 import pytest
 import zenoh
 
+from arena.runtime.mac import tag
 from tests.integration.helpers import spawn, wait_for
 
 MATCH = ("match", "--home", "BS", "--away", "BS", "--json")
@@ -106,11 +107,18 @@ def test_forged_nan_orders_are_counted_and_the_match_plays_on(reap, tmp_path):
     The tester's run: the robot took them, its strategy made a NaN `cmd`, and the match stalled to ticks 0.
     Each forged frame is the next order the robot expects: it goes out when the robot's `cmd` shows that
     it has the genuine order before, ticks before the base station can send the genuine one.
+    The forger is an insider with the base station's MAC key (every frame carries its sender's MAC, and a
+    stranger's would be dropped as `forged` before the robot looked at it, issue 36): the NaN reaches
+    the robot's validation.
     """
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    proc = spawn(*MATCH, "--half-time", "10", "--seed", "6", "--match", "nanorder", "--listen", endpoint)
+    creds = tmp_path / "creds"
+    proc = spawn(*MATCH, "--half-time", "10", "--seed", "6", "--match", "nanorder", "--listen", endpoint,
+                 "--credentials", str(creds))  # fmt: skip
     reap.append(proc)
     wait_for(lambda: (tmp_path / "router.sock").exists(), 30, "the router socket")
+    frag = json.loads((creds / "basestation-b.json5").read_text())
+    bs_key = bytes.fromhex(frag["metadata"]["arena"]["keys"]["basestation/b"])
     session = plain_client(endpoint)
     try:
         # Remote only: our own forged frames must not come back to `on_order` as genuine ones.
@@ -136,8 +144,9 @@ def test_forged_nan_orders_are_counted_and_the_match_plays_on(reap, tmp_path):
                 nxt = genuine[-1] + (genuine[-1] - genuine[-2])
                 forged.append(nxt)
             nan = float("nan")
-            pub.put(msgpack.packb({"tick": nxt, "robot": 1, "command": "START", "spot_x": nan,
-                                   "ball_valid": True, "ball_x": nan, "ball_y": nan}))  # fmt: skip
+            payload = msgpack.packb({"tick": nxt, "robot": 1, "command": "START", "spot_x": nan,
+                                     "ball_valid": True, "ball_x": nan, "ball_y": nan})  # fmt: skip
+            pub.put(payload, attachment=tag(bs_key, "arena/nanorder/team/b/order/1", payload))
 
         subs = [
             session.declare_subscriber("arena/nanorder/team/b/order/1", on_order),
