@@ -151,7 +151,7 @@ class BridgeServer:
                                 self._read(client)
                             if mask & selectors.EVENT_WRITE and client.sock in self.clients:
                                 self._flush(client)
-                        except Exception as exc:  # noqa: BLE001 - no client's input may end the server
+                        except Exception as exc:  # no client's input may end the server
                             self.errors[client.side]["unreadable"] += 1
                             self._drop(client, f"unreadable input ({type(exc).__name__}: {str(exc)[:80]})")
                 self._send_queued()
