@@ -11,7 +11,7 @@ from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
 from arena.schemas.validate import nonfinite, safe_default, suspect
 from arena.sim.physics import Physics
-from arena.tools.launch.faults import blame, outcome
+from arena.tools.launch.faults import blame, lapses, outcome
 from tests.unit.test_lockstep import Harness
 
 
@@ -156,3 +156,33 @@ def test_the_one_scan_finds_exactly_the_four_suspect_pairs():
             raw = bytes([0x93, a, b, 0x01])
             assert suspect(raw) == any(p in raw for p in pairs), raw
     assert not suspect(b"") and suspect(msgspec.msgpack.encode([1.0, float("-inf")]))
+
+
+def test_a_token_that_lapsed_under_load_is_no_fault_unless_a_peer_gave_up_on_it():
+    """Issue 36: a flood of forged frames on the router made the launcher lose leases of processes
+    that never stopped (once all 11: "engine: its liveliness token vanished mid-match"). A lapse is
+    a failure only if a peer gave up waiting for the process's frames; else its frames kept coming."""
+    sums = {
+        "engine": _summary("engine", ["robot/a/1"], {"robot/a/1": 40}),
+        "referee": _summary("referee"),
+        "robot/a/1": _summary("robot/a/1"),
+        "robot/a/2": _summary("robot/a/2"),
+    }
+    lost, lapsed = lapses({"engine", "referee", "robot/a/1", "robot/a/2", "robot/b/0"}, sums)
+    assert lost == {"robot/a/1", "robot/b/0"}, "the engine gave up on a/1; b/0 sent no summary"
+    assert lapsed == {"engine", "referee", "robot/a/2"}
+
+
+def test_a_failed_engine_or_referee_voids_the_match_even_with_its_summary():
+    """Issue 36: an engine that stopped for a while (its peers gave up on it) and came back for its
+    summary was a fault of a match `completed_with_faults`; without the engine there is no game."""
+    cfg = MatchConfig(seed=1, half_time=1.0)
+    full = {str(p): _summary(str(p), tick=cfg.total_ticks) for p in cfg.processes()}
+    full["robot/a/1"] = _summary("robot/a/1", ["engine"], {"engine": 30}, tick=cfg.total_ticks)
+    why = "stopped responding for a while: its liveliness token vanished mid-match"
+    o = outcome(cfg, full, {}, {"engine": why}, {})
+    assert o["outcome"] == "void" and o["void"], o
+    assert o["outcome_reasons"] == [f"engine: {why}"]
+    assert [f["process"] for f in o["faults"]] == ["engine"]
+    o = outcome(cfg, full, {}, {"referee": why}, {})
+    assert o["outcome"] == "void" and o["outcome_reasons"] == [f"referee: {why}"]

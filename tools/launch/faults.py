@@ -47,6 +47,21 @@ def exit_reason(code: int) -> str:
     return f"exited with code {code}"
 
 
+def lapses(vanished: set[str], summaries: dict[str, Summary]) -> tuple[set[str], set[str]]:
+    """(lost, lapsed): of the processes whose liveliness token vanished mid-match in the
+    launcher's view and came back in time for their summary, which failed and which only lapsed.
+
+    The launcher watches the tokens through its router, and a router under load (a flood of
+    forged frames) loses leases of processes that never stopped. What tells them apart is the
+    process's own frames: a peer that stopped (SIGSTOP, a cut cable) owed frames meanwhile, and
+    whoever waited for them gave up on it (its `dead`). A process nobody gave up on kept its
+    frames coming: a lapse under load, no failure. A process with no summary is not judged here.
+    """
+    claimed = {peer for s in summaries.values() for peer in s.dead}
+    lapsed = {name for name in vanished if name in summaries and name not in claimed}
+    return vanished - lapsed, lapsed
+
+
 def blame(summaries: dict[str, Summary], lost: set[str]) -> dict[str, int]:
     """Who is dead: name -> tick.
 
@@ -120,9 +135,11 @@ def outcome(
     if void:
         reasons.append(void)
     for kind in VOIDING:
+        f = next((f for f in faults if f["process"] == kind), None)
         if kind not in summaries and not void:
-            f = next((f for f in faults if f["process"] == kind), None)
             reasons.append(f"{kind}: {f['reason']}" if f else f"{kind}: no summary")
+        elif f is not None and not (void and void.startswith(kind)):
+            reasons.append(f"{kind}: {f['reason']}")  # it failed, even if its summary came later
     referee = summaries.get("referee")
     follow = referee.extra.get("refbox_follow") if referee is not None else None
     if follow and not follow.get("connected"):
