@@ -169,7 +169,8 @@ class Launcher:
         self.proc = spawn(*args, "--logs", str(logs))
         reap.append(self.proc)
         self.err: list[str] = []
-        threading.Thread(target=lambda: self.err.extend(iter(self.proc.stderr.readline, "")), daemon=True).start()
+        self.reader = threading.Thread(target=lambda: self.err.extend(iter(self.proc.stderr.readline, "")), daemon=True)
+        self.reader.start()
 
     def line(self, prefix: str, timeout: float) -> str:
         def found() -> str | None:
@@ -184,11 +185,15 @@ class Launcher:
 
     def finish(self, timeout: float) -> str:
         """The launcher's stdout once it exits, or a failure that says what every process was doing."""
-        try:
-            out, _ = self.proc.communicate(timeout=timeout)
-            return out
-        except subprocess.TimeoutExpired:
-            pass
+        # Not `communicate`: it would read stderr too, and take lines from under `self.reader`.
+        out: list[str] = []
+        stdout = threading.Thread(target=lambda: out.append(self.proc.stdout.read()), daemon=True)
+        stdout.start()
+        stdout.join(timeout)
+        if not stdout.is_alive():
+            self.proc.wait(10)
+            self.reader.join(10)  # every line it wrote, read
+            return out[0]
         stuck = sorted((pid, cmdline(pid)) for pid in descendants(self.proc.pid) if alive(pid))
         for pid, _ in stuck:  # each `arena run` writes every thread's stack to its log (tools/launch/run.py)
             os.kill(pid, signal.SIGUSR1)
