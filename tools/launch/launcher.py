@@ -43,7 +43,7 @@ from arena.tools.launch.claims import Claims
 from arena.tools.launch.joins import Joins, instructions
 from arena.tools.launch.result import MatchResult, assemble, startup_seconds
 from arena.tools.launch.run import run_job
-from arena.tools.launch.supervise import Progress, open_collector, supervise
+from arena.tools.launch.supervise import Progress, open_collector, supervise, watch_spoofing
 from arena.tools.launch.witness import Witness
 
 # Every package of the distribution; compiling one compiles its subpackages
@@ -222,6 +222,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
         with open_router(NetConfig(mode="router", listen=(endpoint,), extra=router_extra), listen) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
+            watch_spoofing(transport, keys, announce)
             # An external's digest is recomputed from the frames it puts (tools/launch/witness.py).
             witness = Witness(transport, keys, cfg.robots, {str(p) for p in external}, cfg.timing.periods())
             if starter is not None:

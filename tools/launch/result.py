@@ -17,7 +17,7 @@ from msgspec import UNSET, UnsetType
 
 from arena.runtime.config import MatchConfig
 from arena.runtime.stats import percentile
-from arena.schemas.messages import Summary
+from arena.schemas.messages import Referee, Summary
 from arena.tools.launch.faults import outcome as match_outcome
 
 
@@ -32,6 +32,8 @@ class Collected:
     lost: dict[str, str] = field(default_factory=dict)  # liveliness gone before the summary
     missing: dict[str, str] = field(default_factory=dict)  # no summary within the bound
     void: str = ""  # why the match is void, found while supervising
+    lapsed: set[str] = field(default_factory=set)  # tokens that vanished under load, frames kept coming
+    last_referee: Referee | None = None  # the newest referee frame the launcher saw (a void match's ticks, score)
 
 
 class MatchResult(msgspec.Struct, kw_only=True):
@@ -68,7 +70,9 @@ class MatchResult(msgspec.Struct, kw_only=True):
     rejected_reasons: dict[str, int]
     dead: list[str]
     faults: list[dict[str, Any]]
-    conflicts: list[Any]
+    conflicts: dict[str, int]
+    forged: dict[str, int]
+    liveliness_lapses: list[str]
     forged_summaries: dict[str, int]
     sent_by_key: dict[str, int]
     recording: dict[str, Any] | None
@@ -142,14 +146,19 @@ def assemble(
                 "cpu_s": round(sum(s.cpu_s), 3) if s and s.cpu_s else None,
             }
         )
-    score = list(referee.extra.get("score", [0, 0])) if referee else [0, 0]
+    last = got.last_referee
+    if referee is not None:
+        score = list(referee.extra.get("score", [0, 0]))
+    else:  # a void match without the referee's summary: the score of its last frame, as played
+        score = [last.score_a, last.score_b] if last is not None else [0, 0]
     sent_by_key: dict[str, int] = {}
     for name in order:
         if name in sums:
             for key, n in sums[name].sent_by_key.items():
                 sent_by_key[key] = sent_by_key.get(key, 0) + n
     recorder = sums.get("recorder")
-    ticks = engine.tick if engine else 0
+    # Without the engine's summary (a void match): as far as the referee's frames went, as played.
+    ticks = engine.tick if engine else max(referee.tick if referee else 0, last.tick if last is not None else 0)
     sim_seconds = ticks * cfg.timing.dt
     # Simulation speed is measured by the engine from its start barrier to its
     # last tick; process start-up is reported apart (wall_seconds).
@@ -190,6 +199,8 @@ def assemble(
         dead=honest["dead"],
         faults=honest["faults"],
         conflicts=honest["conflicts"],
+        forged=honest["forged"],
+        liveliness_lapses=sorted(got.lapsed),
         forged_summaries=dict(sorted(got.forged.items())),
         sent_by_key=dict(sorted(sent_by_key.items())),
         recording=recording,

@@ -13,10 +13,10 @@ import msgspec
 
 from arena.runtime.config import MatchConfig
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys
+from arena.schemas.keys import SPOOFING, Keys
 from arena.schemas.messages import Referee, Summary
 from arena.tools.launch.children import Child, MatchError
-from arena.tools.launch.faults import VOIDING, exit_reason
+from arena.tools.launch.faults import VOIDING, exit_reason, lapses
 from arena.tools.launch.result import Collected
 from arena.tools.launch.witness import Witness
 
@@ -75,7 +75,10 @@ class Collector:
             key = keys.summary(name)
             verify = ring.verifier(name, key) if ring is not None else None
             on_forged = functools.partial(self.count, name, "no valid MAC")
-            self.channels[name] = transport.subscribe(key, verify=verify, on_forged=on_forged)
+            # A ring, never a FIFO: a flood of forged summaries must not fill a queue that blocks the
+            # router's own receive thread (its peers' leases then lapsed); a genuine summary is put
+            # again every 0.25 s until acknowledged, so one pushed out of the ring comes back.
+            self.channels[name] = transport.subscribe(key, latest=RING, verify=verify, on_forged=on_forged)
         transport.declare_alive(keys.collector())
 
     def count(self, name: str, why: str) -> None:
@@ -110,6 +113,26 @@ def implausible(s: Summary, name: str, cfg: MatchConfig, names: list[str]) -> st
 def open_collector(transport: ZenohTransport, keys: Keys, names: list[str]) -> Collector:
     """Subscribe to every process's summary and announce a collector, before any process starts."""
     return Collector(transport, keys, names)
+
+
+def watch_spoofing(transport: ZenohTransport, keys: Keys, announce) -> None:
+    """Print `possible spoofing on KEY` once per key, when a process first declares that it dropped a
+    forged frame on KEY, or counted a conflicting one (`spoofing/<user>/<key>`). Declared before any
+    process can play: a token declared while this subscription was being made could go unseen."""
+    spoofed: set[str] = set()
+
+    def on_spoofing(key: str, alive: bool) -> None:
+        user, _, rel = key.split(f"/{SPOOFING}/", 1)[-1].partition("/")
+        if alive and rel and rel not in spoofed and len(spoofed) < 100:  # a stranger may declare these too
+            spoofed.add(rel)
+            if announce is not None:
+                announce(f"possible spoofing on {rel} (forged or conflicting frames, seen by {user.replace('-', '/')})")
+
+    transport.watch_alive(keys.spoofing_all(), on_spoofing)
+
+
+# [frames] what the launcher's own subscriptions (summaries, referee) hold between two polls at most
+RING = 1024
 
 
 # [s] a process whose liveliness token vanished, or that exited, gets this long
@@ -156,7 +179,10 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
     decode_summary = msgspec.msgpack.Decoder(Summary).decode
     decode_ref = msgspec.msgpack.Decoder(Referee).decode
     sums = collector
-    refs = transport.subscribe(keys.key("referee")) if progress.enabled else None
+    # The referee's frames, MAC checked: the progress bar, and what a void match played (`last_referee`).
+    ring = getattr(transport, "keyring", None)
+    verify = ring.verifier("referee", keys.key("referee")) if ring is not None else None
+    refs = transport.subscribe(keys.key("referee"), latest=RING, verify=verify)  # only the newest matters
     got = Collected(started=time.monotonic())
     deadline = got.started + (timeout if timeout is not None else supervision_deadline(cfg))
     waiting = set(expected)
@@ -192,6 +218,19 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
             then = "the match is void" if voids else "the match plays on"
             announce(f"{name} {why}; {then}" + (f" (its log: {last})" if last else ""))
 
+    def take_referee() -> bool:
+        """Keep the newest referee frame that came; whether one did."""
+        last = None
+        while (r := refs.try_recv()) is not None:
+            last = r
+        if last is None:
+            return False
+        try:
+            got.last_referee = decode_ref(last)
+        except (msgspec.DecodeError, msgspec.ValidationError):
+            return False
+        return True
+
     got.forged = sums.forged
     acks: dict[str, object] = {}
     with progress:
@@ -225,15 +264,8 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
                 acks[name](b"ack")
             if polled:
                 continue
-            if refs is not None:
-                last = None
-                while (r := refs.try_recv()) is not None:
-                    last = r
-                if last is not None:
-                    try:
-                        progress.update(decode_ref(last))
-                    except (msgspec.DecodeError, msgspec.ValidationError):
-                        pass
+            if take_referee():
+                progress.update(got.last_referee)
             now = time.monotonic()
             for name in sorted(waiting - set(got.summaries)):
                 c = by_name.get(name)
@@ -268,11 +300,13 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
             # failed child: a slow poll leaves the two cores to the match. The
             # summaries all come within a few ms of each other: poll fast then.
             time.sleep(0.01 if got.summaries else 0.1)
+    take_referee()
     for name in list(gone_at):
         if name not in got.summaries and name not in got.lost and name not in got.crashed and name in expected:
             got.lost[name] = "stopped responding: its liveliness token vanished before its summary"
-    for name in sorted(lost_once & set(expected)):
-        # Back in time for its summary, but its peers lost it meanwhile; what it
+    failed, got.lapsed = lapses(lost_once & set(expected), got.summaries)
+    for name in sorted(failed):
+        # Back in time for its summary, but its peers gave up on it meanwhile; what it
         # says of them (everyone vanished from its view) is no evidence.
         got.lost.setdefault(name, "stopped responding for a while: its liveliness token vanished mid-match")
     got.ended = time.monotonic()
