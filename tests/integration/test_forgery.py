@@ -101,7 +101,7 @@ def test_a_stranger_forging_frames_ahead_changes_nothing_and_every_frame_is_coun
     result = json.loads(out)
     assert result["outcome"] == "completed" and result["faults"] == [], (result["faults"], result["outcome_reasons"])
     assert result["process_digests"] == GOLDEN["digests"], "a forged frame took a genuine one's place"
-    honest = play_match(MatchConfig(**CFG))
+    honest = play_match(MatchConfig(**CFG)).to_dict()
     assert result["score"] == honest["score"] and result["digest"] == honest["digest"]
     want = {key: receivers * len(payloads) for key, (receivers, payloads) in frames.items()}
     assert result["forged"] == dict(sorted(want.items())), result["rejected_reasons"]
