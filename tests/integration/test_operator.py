@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import subprocess
 
+import pytest
+
 from arena.recording.reader import load
 from arena.runtime.session import listening
 from arena.schemas.messages import World
@@ -16,7 +18,7 @@ def test_arena_operator_drives_a_real_time_match(reap, tmp_path):
     port, mcap = free_port(), tmp_path / "op.mcap"
     endpoint = f"tcp/127.0.0.1:{port}"
     match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "4", "--listen", endpoint,
+        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "3", "--listen", endpoint,
         "--match", "op", "--record", str(mcap), "--json",
     )  # fmt: skip
     reap.append(match)
@@ -50,6 +52,7 @@ def test_a_bad_action_is_one_line_and_nobody_listening_is_said(tmp_path):
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "ACTION 1:" in bad.stderr, bad.stderr
 
 
+@pytest.mark.slow
 def test_in_a_secure_match_only_the_operator_principal_gets_through(reap, tmp_path):
     import time
 
