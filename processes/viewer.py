@@ -18,7 +18,11 @@ server, which runs on the SDK's own threads) with:
 * `/match` (JSON): tick, time, stage, command in force, score, pause state;
 * parameters `paused`, `step` and `pace` (Foxglove's Parameters panel), which
   in a lockstep match pause the engine, step it tick by tick and set its pace
-  (runtime/pace.py, through `Control` frames on `arena/<m>/control`).
+  (runtime/pace.py, through `Control` frames on `arena/<m>/control`);
+* client messages on `/operator` (Foxglove's Publish panel, JSON
+  `{"actions": [...]}`), put as `Operator` frames on `arena/<m>/operator` for
+  the engine and the referee of a live session (docs/scenarios.md; in a secure
+  match the router drops them: only the `operator` principal may put there).
 
 It is in nobody's lockstep and has none of its own: it subscribes with rings
 that keep the newest frames (a viewer that falls behind drops, never blocks),
@@ -46,7 +50,19 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Observer
-from arena.schemas.messages import Control, EngineEvents, FieldSpec, Order, Referee, Report, World
+from arena.schemas.messages import (
+    Control,
+    EngineEvents,
+    FieldSpec,
+    Operator,
+    Order,
+    Referee,
+    RefereeOverride,
+    Report,
+    TeleportBall,
+    TeleportRobot,
+    World,
+)
 
 POLL_S = 0.02  # [s] wall: pause between polls of the subscriptions
 SCENE_HZ = 30.0  # [Hz] wall: at most this many scene updates per second, whatever the match's speed
@@ -124,6 +140,24 @@ class _Listener(ServerListener):
     def on_set_parameters(self, client, parameters, request_id=None):
         return self.node.on_set_parameters(client, parameters, request_id)
 
+    def on_client_advertise(self, client, channel):
+        self.node.client_topics[(client.id, channel.id)] = channel.topic
+
+    def on_client_unadvertise(self, client, client_channel_id):
+        self.node.client_topics.pop((client.id, client_channel_id), None)
+
+    def on_message_data(self, client, client_channel_id, data):
+        self.node.on_client_message(self.node.client_topics.get((client.id, client_channel_id), ""), data)
+
+
+class OperatorRequest(msgspec.Struct, forbid_unknown_fields=True):
+    """What the Foxglove Publish panel sends on `/operator` (JSON): the actions of an `Operator` frame."""
+
+    actions: list[TeleportBall | TeleportRobot | RefereeOverride]
+
+
+OPERATOR_TOPIC = "/operator"
+
 
 class ViewerNode(Observer):
     def _owned(self, name: str, sender: str) -> dict:
@@ -145,6 +179,11 @@ class ViewerNode(Observer):
         self.order_keys = {keys.key("order", t, 0): t for t in TEAMS}
         self._answers: collections.deque[tuple[str, bytes]] = collections.deque(maxlen=RING)  # transport threads
         self.control_put = tr.publisher(keys.control())
+        # A live session's operator frames from the Foxglove Publish panel (docs/scenarios.md). In a
+        # secure match the router drops them: only the `operator` principal may put them.
+        self.operator_put = tr.publisher(keys.operator())
+        self.client_topics: dict[tuple[int, int], str] = {}
+        self.operator_seq = 0
         # The engine asks for the viewer's state once before tick 0 (a pause set before
         # the start holds tick 0); every change after that is put on the same key.
         tr.serve(keys.control(), self._control_state)
@@ -175,7 +214,7 @@ class ViewerNode(Observer):
             scene.LOG_TOPIC, context=ctx, message_encoding="protobuf", schema=Log.get_schema()
         )
         self.match_ch = foxglove.Channel(MATCH_TOPIC, context=ctx, schema=MATCH_SCHEMA)
-        caps = [Capability.Time] + ([Capability.Parameters] if self.lockstep_control else [])
+        caps = [Capability.Time, Capability.ClientPublish] + ([Capability.Parameters] if self.lockstep_control else [])
         try:
             self.server = foxglove.start_server(
                 name=f"soccer-arena {keys.match}",
@@ -184,6 +223,7 @@ class ViewerNode(Observer):
                 context=ctx,
                 capabilities=caps,
                 server_listener=_Listener(self),
+                supported_encodings=["json"],
                 message_backlog_size=256,
             )
         except RuntimeError as exc:
@@ -224,6 +264,18 @@ class ViewerNode(Observer):
             self._control = Control(tick=tick, seq=self._seq, paused=self.paused, step=step, pace=self.pace)
             self.control_put(msgspec.msgpack.encode(self._control))  # a put from another thread is safe
             return self._parameters()
+
+    def on_client_message(self, topic: str, data: bytes) -> None:
+        """A Foxglove client published on `/operator`: forward its actions as an `Operator` frame."""
+        if topic != OPERATOR_TOPIC:
+            return
+        try:
+            req = msgspec.json.decode(data, type=OperatorRequest)
+        except (msgspec.DecodeError, msgspec.ValidationError) as exc:
+            self.rejections.reject(self.keys.operator(), "malformed", f"from Foxglove: {exc}")
+            return
+        self.operator_seq += 1
+        self.operator_put(msgspec.msgpack.encode(Operator(seq=self.operator_seq, actions=req.actions)))
 
     def _control_state(self) -> bytes:
         with self._lock:

@@ -129,6 +129,18 @@ class FoxgloveClient:
         params = [{"name": k, "value": v} for k, v in values.items()]
         self.ws.send(json.dumps({"op": "setParameters", "parameters": params, "id": f"set-{time.monotonic_ns()}"}))
 
+    def advertise(self, topic: str, schema_name: str = "") -> int:
+        """Advertise a client channel (the server's ClientPublish); returns its id."""
+        cid = self._next_sub
+        self._next_sub += 1
+        ch = {"id": cid, "topic": topic, "encoding": "json", "schemaName": schema_name}
+        self.ws.send(json.dumps({"op": "advertise", "channels": [ch]}))
+        return cid
+
+    def publish(self, channel_id: int, payload: bytes) -> None:
+        """Client message data: opcode 0x01, the channel id, the payload."""
+        self.ws.send(struct.pack("<BI", 0x01, channel_id) + payload)
+
     def messages(self, seconds: float):
         """Yield (topic, log time, payload) for `seconds`, or until the server closes."""
         end = time.monotonic() + seconds

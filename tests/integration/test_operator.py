@@ -89,3 +89,30 @@ def test_in_a_secure_match_only_the_operator_principal_gets_through(reap, tmp_pa
     assert match.returncode == 0, err
     applied = load(str(mcap)).summaries["engine"].extra["operator"]
     assert [(a["action"]["x"], a["action"]["y"]) for a in applied] == [(3.3, -2.2)], applied
+
+
+def test_the_foxglove_publish_panel_drives_a_live_match_through_the_viewer(reap, tmp_path):
+    from tests.integration.foxglove_client import FoxgloveClient
+
+    port, live, mcap = free_port(), free_port(), tmp_path / "fox.mcap"
+    endpoint = f"tcp/127.0.0.1:{port}"
+    match = spawn(
+        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "3", "--listen", endpoint,
+        "--match", "fox", "--live", str(live), "--record", str(mcap), "--json",
+    )  # fmt: skip
+    reap.append(match)
+    client = FoxgloveClient(f"ws://127.0.0.1:{live}", timeout=60)
+    assert "clientPublish" in client.info["capabilities"]
+    wait_until_playing(endpoint, "fox")  # the engine listens from its start
+    channel = client.advertise("/operator", "arena.Operator")
+    client.publish(channel, b'{"actions": [{"type": "teleport_ball", "x": -3.3, "y": 2.2, "vx": 0, "vy": 0}]}')
+    client.publish(channel, b'{"actions": [{"type": "teleport_bal"}]}')  # refused, counted
+    client.close()
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    rec = load(str(mcap))
+    (applied,) = rec.summaries["engine"].extra["operator"]
+    world = {w.tick: w for w in rec.decoded("world", World)}[applied["tick"]]
+    assert (world.ball_x, world.ball_y) == (-3.3, 2.2)
+    result = json.loads(out)
+    assert result["rejected"] >= 1 and any("malformed" in r for r in result["rejected_reasons"]), result
