@@ -23,11 +23,14 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument(
         "action",
         choices=["init", "rotate", "show"],
+        metavar="{init,rotate,show}",  # named so in "the following arguments are required"
         help="init: create what is missing; "
         "rotate: new secrets (for the PRINCIPALs given, else for all); show: list the set",
     )
     p.add_argument("directory", metavar="DIR", help="the credentials directory (made mode 0700)")
-    p.add_argument("principals", nargs="*", metavar="PRINCIPAL", help="rotate: e.g. robot/a/1 (default: all)")
+    p.add_argument(  # a default, or argparse lists it among the required arguments
+        "principals", nargs="*", default=[], metavar="PRINCIPAL", help="rotate: e.g. robot/a/1 (default: all)"
+    )
     p.add_argument("--robots", type=int, default=6, metavar="N", help="init: robots per team to provision (6)")
     return p
 

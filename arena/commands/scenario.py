@@ -36,10 +36,16 @@ def add_parser(sub) -> argparse.ArgumentParser:
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("action", choices=("run", "library"), help="run: play and judge; library: print its directory")
+    p.add_argument(
+        "action",
+        choices=("run", "library"),
+        metavar="{run,library}",  # named so in "the following arguments are required"
+        help="run: play and judge; library: print its directory",
+    )
     p.add_argument("target", nargs="?", metavar="FILE|DIR", help="a scenario file, or a directory of *.scenario.toml")
-    p.add_argument("--seeds", type=_count, default=1, metavar="N", help="seeds 0..N-1 per scenario (1)")
-    p.add_argument("--seed", type=_seed, metavar="S", help="just this seed")
+    seeds = p.add_mutually_exclusive_group()
+    seeds.add_argument("--seeds", type=_count, default=1, metavar="N", help="seeds 0..N-1 per scenario (1)")
+    seeds.add_argument("--seed", type=_seed, metavar="S", help="just this seed")
     p.add_argument("--name", metavar="NAME", help="just the scenario called NAME")
     p.add_argument("--engine", choices=("inprocess", "processes"), default="inprocess", help="(inprocess)")
     p.add_argument("--jobs", type=_count, default=1, metavar="J", help="runs at a time (1)")
@@ -56,7 +62,7 @@ def _count(text: str) -> int:
     try:
         n = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a whole number 1..100000, got {text!r}") from None
     if not 1 <= n <= 100_000:
         raise argparse.ArgumentTypeError(f"expected a whole number 1..100000, got {text!r}")
     return n
@@ -110,6 +116,9 @@ def run(args: argparse.Namespace) -> int:
     from arena.scenarios.library import LIBRARY
 
     if args.action == "library":
+        if args.target:
+            print(f"arena scenario: error: library takes no FILE|DIR, got {args.target!r}", file=sys.stderr)
+            return 2
         print(LIBRARY)
         return 0
     try:

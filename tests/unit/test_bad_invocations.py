@@ -67,6 +67,7 @@ BAD = [
     (["credentials", "show", "{tmp}", "robot/a/1"], "PRINCIPAL applies to rotate only"),
     (["credentials", "init", "{tmp}", "--robots", "9"], "--robots must be between 1 and 6"),
     (["credentials", "burn", "{tmp}"], "invalid choice: 'burn'"),
+    (["credentials"], "required: {{init,rotate,show}}, DIR (see"),  # named PRINCIPAL, optional, and 'action'
     # arena run
     (["run", "robot", "--match", "m", "--connect", "foo", "--team", "a", "--robot", "1"], "--connect foo"),
     (["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "needs --team"),
@@ -124,6 +125,9 @@ BAD = [
     (["facts", "--perception-latency", "99"], "--perception-latency must be 0..25 ticks, got 99"),
     # arena scenario
     (["scenario", "run", "--seeds", "0"], "--seeds: expected a whole number 1..100000"),
+    (["scenario", "run", "x", "--seed", "1", "--seeds", "2"], "--seeds: not allowed with argument --seed"),
+    (["scenario", "library", "x"], "library takes no FILE|DIR, got 'x'"),  # was ignored
+    (["scenario"], "required: {{run,library}} (see"),
     (
         ["scenario", "run", "--jbos", "2"],
         "arena scenario: error: unrecognized arguments: --jbos 2; did you mean --jobs?",
