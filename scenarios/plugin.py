@@ -10,6 +10,8 @@ scenario from Python and returns its `Outcome`.
 
 from __future__ import annotations
 
+import argparse
+
 import pytest
 
 from arena.scenarios.model import SUFFIX, ScenarioError, load, load_all
@@ -17,8 +19,19 @@ from arena.scenarios.model import SUFFIX, ScenarioError, load, load_all
 
 def pytest_addoption(parser: pytest.Parser) -> None:
     group = parser.getgroup("arena scenarios")
-    group.addoption("--scenario-seeds", type=int, default=1, metavar="N", help="seeds 0..N-1 per scenario (1)")
+    group.addoption("--scenario-seeds", type=_seeds, default=1, metavar="N", help="seeds 0..N-1 per scenario (1)")
     group.addoption("--scenario-engine", default="inprocess", choices=("inprocess", "processes"), help="(inprocess)")
+
+
+def _seeds(text: str) -> int:
+    """--scenario-seeds: a whole number >= 1 (0 was quietly taken as 1)."""
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return n
 
 
 def pytest_collect_file(file_path, parent):
@@ -56,7 +69,7 @@ class ScenarioItem(pytest.Item):
 
     def runtest(self) -> None:
         opt = self.config.getoption
-        outcome = play(self.scenario, max(1, opt("scenario_seeds")), opt("scenario_engine"))
+        outcome = play(self.scenario, opt("scenario_seeds"), opt("scenario_engine"))
         if not outcome.passed:
             raise ScenarioFailed(outcome)
 

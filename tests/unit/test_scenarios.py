@@ -234,6 +234,14 @@ def test_it(arena_scenario):
     assert math.isfinite(1.0)
 
 
+@pytest.mark.parametrize("seeds", ["0", "-2", "many"])
+def test_the_plugin_refuses_a_seed_count_below_one(pytester, seeds):
+    pytester.makefile(".scenario.toml", one=ROLL_IN)
+    result = pytester.runpytest_inprocess("-q", "-p", "no:cacheprovider", "--scenario-seeds", seeds)
+    assert result.ret == pytest.ExitCode.USAGE_ERROR
+    result.stderr.fnmatch_lines([f"*--scenario-seeds: expected a whole number >= 1, got '{seeds}'*"])
+
+
 # ------------------------------------------------------ replay with substitution
 def test_a_substituted_team_follows_its_recorded_poses_while_the_rest_plays_live(tmp_path):
     import msgspec
