@@ -330,6 +330,8 @@ def load_policy(path: str | Path) -> PolicyFile:
         data = pickle.loads(Path(path).read_bytes())
     except FileNotFoundError:
         raise ConfigError(f"policy file {path} not found") from None
+    except IsADirectoryError:
+        raise ConfigError(f"policy file {path} is a directory: give the file save_policy wrote") from None
     except Exception as exc:  # anything a file that is not a pickle of ours makes pickle raise
         raise ConfigError(f"policy file {path} cannot be read: {type(exc).__name__}: {exc}") from None
     if not isinstance(data, PolicyFile):

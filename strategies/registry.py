@@ -97,6 +97,8 @@ def resolve_name(name: str) -> str:
     only for a name that is not built in.
     """
     if name.startswith(learned.PREFIX):  # a policy file: its absolute path, as every process opens it
+        if not name[len(learned.PREFIX) :].strip():  # Path("") is the working directory
+            raise ConfigError(f"{name!r} names no file: policy:PATH, a file written by arena.learn.save_policy")
         return learned.policy_strategy(learned.PREFIX + str(Path(name[len(learned.PREFIX) :]).resolve())).name
     wanted = name.strip().lower()
     found = _find(builtin_strategies(), wanted) or _find(all_strategies(), wanted)

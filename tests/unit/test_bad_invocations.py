@@ -151,6 +151,8 @@ BAD = [
     (["match", "--config", "{file}"], "not valid TOML"),
     (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
+    (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
+    (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),
     # arena strategies
     (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
