@@ -123,6 +123,9 @@ BAD = [
     (["facts", "--round-robin", "AD"], "needs at least two different strategies"),
     (["facts", "--home", "nope"], "unknown strategy 'nope'"),
     (["facts", "--perception-latency", "99"], "--perception-latency must be 0..25 ticks, got 99"),
+    # arena operator
+    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", "not json"], "ACTION 1: JSON is malformed"),
+    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"x": 1}}'], "missing required field `type`"),
     # arena scenario
     (["scenario", "run", "--seeds", "0"], "--seeds: expected a whole number 1..100000"),
     (["scenario", "run", "x", "--seed", "1", "--seeds", "2"], "--seeds: not allowed with argument --seed"),
