@@ -156,6 +156,23 @@ BAD = [
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
     (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),
+    # arena operator
+    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_bal"}}'], "ACTION 1:"),
+    (["operator", "--match", "m", '{{"type": "teleport_ball"}}'], "required: --connect"),
+    (
+        [
+            "operator",
+            "--match",
+            "m",
+            "--connect",
+            "tcp/127.0.0.1:1",
+            "--credentials",
+            "/nonexistent.json5",
+            '{{"type": "referee", "command": "STOP"}}',
+        ],
+        "cannot read --credentials /nonexistent.json5",
+    ),
+    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_ball"}}'], "cannot connect to"),
     # arena strategies
     (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
