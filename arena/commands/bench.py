@@ -24,6 +24,30 @@ EXAMPLES = """examples:
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
 
 
+# The flags each benchmark reads (besides --json); any other one given is refused, not ignored.
+USES = {
+    "match": {"runs", "half_time", "robots", "link"},
+    "record": {"runs", "half_time", "robots", "link"},
+    "throughput": {"runs", "half_time", "robots", "link", "strategy"},
+    "robot": {"strategy"},
+    "learn": {"runs", "half_time", "strategy"},
+    "scenario": {"runs"},
+    "nav": {"trials", "seed", "scenarios", "only", "plots"},
+}
+DEFAULTS = {
+    "strategy": "advance-dynamic",
+    "runs": 3,
+    "half_time": 60.0,
+    "robots": 3,
+    "link": "ideal",
+    "trials": 10,
+    "seed": 0,
+    "scenarios": None,
+    "only": None,
+    "plots": None,
+}
+
+
 def add_parser(sub) -> None:
     b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
     b.add_argument(
@@ -36,17 +60,26 @@ def add_parser(sub) -> None:
         "and the ratio to a plain match of the same length",
     )
     b.add_argument(
-        "--strategy", default="advance-dynamic", metavar="NAME", help="robot, throughput: strategy (both teams) (AD)"
+        "--strategy",
+        default=DEFAULTS["strategy"],
+        metavar="NAME",
+        help="robot, throughput, learn: strategy (both teams) (AD)",
     )
-    b.add_argument("--runs", type=positive_int, default=3, metavar="N", help="runs (3)")
-    b.add_argument("--half-time", type=seconds, default=60.0, metavar="SECONDS", help="half length [s] (60)")
-    b.add_argument("--robots", type=int, default=3, metavar="N")
-    b.add_argument("--link", default="ideal", metavar="PRESET")
+    b.add_argument("--runs", type=positive_int, default=DEFAULTS["runs"], metavar="N", help="runs (3)")
+    b.add_argument(
+        "--half-time", type=seconds, default=DEFAULTS["half_time"], metavar="SECONDS", help="half length [s] (60)"
+    )
+    b.add_argument("--robots", type=int, default=DEFAULTS["robots"], metavar="N", help="match, record, throughput (3)")
+    b.add_argument("--link", default=DEFAULTS["link"], metavar="PRESET", help="match, record, throughput (ideal)")
     b.add_argument("--json", action="store_true")
     b.add_argument(
-        "--trials", type=positive_int, default=10, metavar="N", help="nav: trials per scheme and scenario (10)"
+        "--trials",
+        type=positive_int,
+        default=DEFAULTS["trials"],
+        metavar="N",
+        help="nav: trials per scheme and scenario (10)",
     )
-    b.add_argument("--seed", type=int, default=0, metavar="N", help="nav: seed of the trials' noise (0)")
+    b.add_argument("--seed", type=int, default=DEFAULTS["seed"], metavar="N", help="nav: seed of the trials' noise (0)")
     b.add_argument(
         "--scenarios",
         metavar="FILE",
@@ -60,6 +93,11 @@ def run(args: argparse.Namespace) -> int:
     from arena.strategies import registry
     from arena.tools.experiments import bench
 
+    unused = [k for k, v in DEFAULTS.items() if k not in USES[args.what] and getattr(args, k) != v]
+    if unused:  # learn and scenario played 3v3 on ideal links whatever --robots and --link said
+        flag = "--" + unused[0].replace("_", "-")
+        takes = ", ".join("--" + k.replace("_", "-") for k in DEFAULTS if k in USES[args.what])
+        raise ConfigError(f"{flag} does not apply to arena bench {args.what} (it takes {takes} and --json)")
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
         base = match_config(args, seed=False)  # --seed is nav's
         if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each

@@ -116,6 +116,9 @@ BAD = [
     (["bench", "nav", "--scenarios", "/nonexistent.toml"], "nonexistent.toml"),
     (["bench", "nav", "--only", "nosuch"], "nosuch"),
     (["bench", "frob"], "invalid choice: 'frob'"),
+    (["bench", "learn", "--link", "moon"], "--link does not apply to arena bench learn (it takes --strategy"),  # exit 0
+    (["bench", "scenario", "--robots", "2"], "--robots does not apply to arena bench scenario (it takes --runs and"),
+    (["bench", "nav", "--runs", "2"], "--runs does not apply to arena bench nav"),
     # arena facts
     (["facts", "--worker", "2"], "did you mean --workers? (see arena facts --help)"),
     (["facts", "--half-time", "inf"], "finite number"),
