@@ -15,13 +15,19 @@ PERIODS = dict(DEFAULT_PERIODS)
 
 
 class Callbacks:
-    """Test double: keeps the witness's callbacks so the test can feed them frames."""
+    """Test double: keeps the witness's callbacks so the test can feed them frames, each through the
+    MAC check the transport makes (`callbacks[key](payload, attachment)`) when it has a keyring."""
 
-    def __init__(self) -> None:
+    def __init__(self, keyring=None) -> None:
         self.callbacks: dict[str, object] = {}
+        self.keyring = keyring
 
-    def subscribe_callback(self, key: str, callback) -> None:
-        self.callbacks[key] = callback
+    def subscribe_callback(self, key: str, callback, verify=None) -> None:
+        def deliver(payload: bytes, attachment: bytes | None = None) -> None:
+            if verify is None or verify(payload, attachment):
+                callback(payload)
+
+        self.callbacks[key] = deliver
 
 
 def _sent_by_a_node() -> tuple[str, list[tuple[str, bytes]]]:
@@ -102,3 +108,18 @@ def test_batched_cmds_that_reach_the_wire_after_a_later_report_are_put_back_in_s
     assert w.frames["robot/a/1"] == 12 + 3
     assert w.check("robot/a/1", digest.hexdigest(), dead=[]) is None
     assert w.verified() == ["robot/a/1"]
+
+
+def test_a_forged_frame_ahead_of_the_genuine_one_never_enters_the_digest():
+    """Issue 36: with the launcher's keyring, a stranger's frame for the very tick the external sends next is
+    dropped for its missing MAC; before, it took the tick and the genuine Summary was refused as forged."""
+    from arena.runtime.mac import Keyring, tag
+
+    key = bytes(range(32))
+    expected, wire = _sent_by_a_node()
+    tr = Callbacks(Keyring("launcher", {"robot/a/1": key}))
+    w = Witness(tr, Keys("w"), robots=3, watched={"robot/a/1"}, periods=PERIODS)
+    tr.callbacks["arena/w/robot/a/1/cmd"](msgspec.msgpack.encode(Cmd(tick=0, vx=-5.0)))  # no MAC
+    for rel, payload in wire:
+        tr.callbacks[f"arena/w/{rel}"](payload, tag(key, f"arena/w/{rel}", payload))
+    assert w.check("robot/a/1", expected, dead=[]) is None and w.verified() == ["robot/a/1"]

@@ -59,11 +59,16 @@ class Witness:
         self._held: dict[str, list] = {name: [] for name in watched}
         self._next: dict[str, dict[str, tuple[int, int, int]]] = {name: {} for name in watched}
         self._seq = 0
+        # Only frames with the sender's MAC count (runtime/mac.py): a stranger's frame for a tick the
+        # external has not sent yet would otherwise enter the digest and refuse its genuine Summary.
+        ring = getattr(transport, "keyring", None)
         for rank, (rel, sender, _) in enumerate(routes(robots)):
             if sender in self.digests:
                 spec = spec_of(rel)
                 if spec is not None and spec.timing.period is not None:
-                    transport.subscribe_callback(keys.prefix + rel, self._on(sender, rel, spec, periods, rank))
+                    verify = ring.verifier(sender, keys.prefix + rel) if ring is not None else None
+                    on_frame = self._on(sender, rel, spec, periods, rank)
+                    transport.subscribe_callback(keys.prefix + rel, on_frame, verify)
 
     def _on(self, sender: str, rel: str, spec, periods: dict[str, int], rank: int):
         """Only the in-sequence frame of each scheduled tick counts, as for a receiver.
