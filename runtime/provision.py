@@ -109,18 +109,28 @@ def provision(directory: Path, names: list[str], robots: int, match: str = "") -
         tls = (s.ca_pem, s.router_cert_pem, s.router_key_pem)
         write_private(directory / ROUTER_FILE, json.dumps(_router_file(tls, s.viewer_zid, s.set_id), indent=2) + "\n")
         made.append(ROUTER_FILE)
-    s.match, s.robots, s.secure = match, robots, True
+    s.match, s.secure = match, True
     s.processes = list(dict.fromkeys([*names, *(p for p in s.passwords if p not in names)]))
     for p in principals(s.processes):
         if p not in s.passwords:
             s.passwords[p], s.mac_keys[p] = secrets.token_urlsafe(24), new_key()
+    # Each file holds the MAC keys of every sender its principal hears in a match of the set's
+    # size, whatever this match's: a 3v3 match (or a rotation, robots=0) must not rewrite robot
+    # a/4's file without the engine's key, which its copy on the robot needs in a 6v6 match.
+    s.robots = max(robots, set_robots(s.passwords))
     for p in principals(s.processes):
         path = directory / f"{user_of(p)}.json5"
         text = json.dumps(s.fragment(p), indent=2) + "\n"
         if not path.exists() or path.read_text() != text:
             write_private(path, text)
             made.append(path.name)
+    s.robots = robots  # the match's, for its access control
     return s, made
+
+
+def set_robots(principals_of_set) -> int:
+    """Robots per team a set provides for: one more than its highest robot number."""
+    return max((int(p.rsplit("/", 1)[1]) + 1 for p in principals_of_set if p.startswith("robot/")), default=0)
 
 
 def rotate(directory: Path, which: list[str]) -> list[str]:

@@ -43,8 +43,12 @@ def test_only_what_is_missing_is_created(tmp_path):
     a1 = (d / "robot-a-1.json5").read_bytes()
     (d / "robot-b-0.json5").unlink()
     t, made = provision(d, process_names(3), 3)  # a lost file, and a third robot per team
-    # and the recorder's, which holds every sender's key to verify
-    assert sorted(made) == ["recorder.json5", "robot-a-2.json5", "robot-b-0.json5", "robot-b-2.json5"]
+    # and the files of whoever verifies the new robots' frames (every lockstep frame carries its
+    # sender's MAC): the engine (their cmd), the base stations (their reports), recorder and viewer
+    assert sorted(made) == [
+        *("basestation-a.json5", "basestation-b.json5", "engine.json5", "recorder.json5"),
+        *("robot-a-2.json5", "robot-b-0.json5", "robot-b-2.json5", "viewer.json5"),
+    ]
     assert (d / "robot-a-1.json5").read_bytes() == a1 and t.passwords["robot/a/1"] == s.passwords["robot/a/1"]
     assert t.passwords["robot/b/0"] != s.passwords["robot/b/0"]
 
@@ -61,6 +65,22 @@ def test_rotate_one_principal_or_the_whole_set(tmp_path):
     with pytest.raises(ConfigError, match="no credentials for robot/c/9"):
         rotate(d, ["robot/c/9"])
     assert any("robot-a-1.json5: robot/a/1" in line for line in show(d))
+
+
+def test_a_smaller_match_or_a_rotation_leaves_every_other_robots_file_as_it_was(tmp_path):
+    """The files are the set's (6 robots a team), not the match's: a 3v3 match once rewrote robot a/4's
+    file without the engine's key, and a rotation (made for 0 robots) every robot's file."""
+    d = tmp_path / "creds"
+    provision(d, process_names(6), 6)
+    before = _files(d)
+    assert provision(d, process_names(3), 3, "friendly")[1] == []
+    assert _files(d) == before
+    made = rotate(d, ["robot/b/4"])
+    assert [m for m in made if m.startswith("robot-")] == ["robot-b-4.json5"]
+    after = _files(d)
+    assert all(after[n] == before[n] for n in before if n.startswith("robot-") and n != "robot-b-4.json5")
+    keys = json.loads(after["robot-b-4.json5"])["metadata"]["arena"]["keys"]
+    assert {"engine", "basestation/b", "robot/b/4"} <= set(keys), keys
 
 
 @pytest.mark.parametrize(
