@@ -19,7 +19,7 @@ examples:
   arena scenario run corner.scenario.toml                      # each scenario once, seed 0
   arena scenario run tests/scenarios/ --seeds 10 --jobs 2      # every *.scenario.toml below, 10 seeds each
   arena scenario run "$(arena scenario library)" --seeds 3 --junit report.xml   # the shipped library
-  arena scenario run corner.scenario.toml --name corner --seed 4 --record run.mcap   # replay one run
+  arena scenario run corner.scenario.toml --name corner-attack --seed 4 --record run.mcap   # replay one run
   arena scenario run corner.scenario.toml --engine processes   # every process its own OS process
 
 A run fails when an expectation fails; a scenario fails when its pass rate over the
@@ -93,9 +93,11 @@ def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
         raise ScenarioError("run needs a FILE or DIR")
     scenarios = [sc for path in discover(args.target) for sc in load_all(path)]
     if args.name:
-        scenarios = [sc for sc in scenarios if sc.name == args.name]
-        if not scenarios:
-            raise ScenarioError(f"{args.target}: no scenario named {args.name!r}")
+        named = [sc for sc in scenarios if sc.name == args.name]
+        if scenarios and not named:
+            have = ", ".join(sorted({sc.name for sc in scenarios}))
+            raise ScenarioError(f"{args.target}: no scenario named {args.name!r} (it has: {have})")
+        scenarios = named
     if not scenarios:
         raise ScenarioError(f"{args.target}: no *.scenario.toml files")
     external = [sc for sc in scenarios if sc.spec.play.external]

@@ -322,7 +322,7 @@ def test_the_documented_examples_load_and_run(tmp_path):
         (["scenario", "run"], "run needs a FILE or DIR"),
         (["scenario", "run", "EXT"], "'ext' has external processes (play.external): run it with --engine processes"),
         (["scenario", "run", "DIR", "--record", "x.mcap"], "--record needs one scenario (--name) and one seed"),
-        (["scenario", "run", "DIR", "--name", "nobody"], "no scenario named 'nobody'"),
+        (["scenario", "run", "DIR", "--name", "nobody"], "no scenario named 'nobody' (it has: never, roll-in)"),
         (["scenario", "run", "DIR", "--seeds", "0"], "expected a whole number 1..100000"),
     ],
 )
