@@ -84,8 +84,10 @@ class SoccerParallelEnv(ParallelEnv):
         for a in names:
             if int(a.split("/")[1]) >= robots:
                 raise ValueError(f"no robot {a} in a match of {robots} robots a team")
-        if obs not in ("flat", "dict") or actions not in ("box", "discrete") or until not in ("match", "half"):
-            raise ValueError("obs must be flat or dict, actions box or discrete, until match or half")
+        choices = {"obs": (obs, ("flat", "dict")), "actions": (actions, ("box", "discrete"))}
+        for option, (value, allowed) in (choices | {"until": (until, ("match", "half"))}).items():
+            if value not in allowed:
+                raise ValueError(f"{option} must be {' or '.join(allowed)}, got {value!r}")
         if frame_skip < 1:
             raise ValueError(f"frame_skip must be at least 1, got {frame_skip}")
         self.possible_agents = names

@@ -100,6 +100,19 @@ def test_bad_agents_are_refused():
             SoccerParallelEnv(agents=agents)
 
 
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ({"obs": "pixels"}, "obs must be flat or dict, got 'pixels'"),
+        ({"actions": "x"}, "actions must be box or discrete, got 'x'"),
+        ({"until": "goal"}, "until must be match or half, got 'goal'"),
+    ],
+)
+def test_a_bad_option_is_named_with_its_value(option, message):
+    with pytest.raises(ValueError, match=f"^{message}$"):  # one message named all three options, not which
+        SoccerParallelEnv(**option)
+
+
 def test_the_vector_env_steps_its_workers_with_their_own_seeds():
     venv = make_vector_env(2, asynchronous=False, robot="a/1", **SHORT)
     obs, infos = venv.reset(seed=4)
