@@ -35,6 +35,7 @@ logged, and the match goes on.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 
@@ -47,7 +48,7 @@ from arena.runtime import seeds
 from arena.runtime.config import TEAMS
 from arena.runtime.drivers import Reactor
 from arena.runtime.lockstep import Waits
-from arena.runtime.node import Node
+from arena.runtime.node import Node, killed_at
 from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee, TeleportBall, TeleportRobot, encode
 from arena.sim.drive import Drive
@@ -153,7 +154,8 @@ class EngineNode(Node):
         x, y = self.physics.park_robot(*r)
         self.sense_out[r].mute()  # nobody reads it any more
         self.parked[r] = {"tick": k, "x": round(x, 3), "y": round(y, 3)}
-        self.log.warning("tick %d: robot %s/%d is dead, parked at (%.2f, %.2f)", k, r[0], r[1], x, y)
+        level = logging.INFO if killed_at(self.cfg, f"robot/{r[0]}/{r[1]}") >= 0 else logging.WARNING  # `kill` step
+        self.log.log(level, "tick %d: robot %s/%d is dead, parked at (%.2f, %.2f)", k, r[0], r[1], x, y)
 
     def on_peer_dead(self, peer: str) -> None:
         """Tell the referee (G_Re) that a robot is gone; its wheels are stopped in the loop."""

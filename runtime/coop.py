@@ -155,7 +155,11 @@ def _advance(task: Task) -> None:
 
 
 def play(
-    bus: CoopBus, nodes: Iterable[Node], on_idle: Callable[[], None] | None = None, quit_early: set[str] | None = None
+    bus: CoopBus,
+    nodes: Iterable[Node],
+    on_idle: Callable[[], None] | None = None,
+    quit_early: set[str] | None = None,
+    meant_to_end: frozenset[str] = frozenset(),
 ) -> tuple[dict[str, Summary], list[str]]:
     """Play every node's match (`Node.playing`: loop and summary) at once, each driven by its
     `Task`; returns their summaries by name and the deadlocks met (`drive`)."""
@@ -165,17 +169,23 @@ def play(
         assert isinstance(task, Task), f"{node.name}: a cooperative match's nodes are driven by a coop.Task"
         task.steps = task.playing(node)
         tasks.append(task)
-    deadlocks = drive(bus, tasks, on_idle=on_idle, quit_early=quit_early)
+    deadlocks = drive(bus, tasks, on_idle=on_idle, quit_early=quit_early, meant_to_end=meant_to_end)
     return {t.name: t.summary for t in tasks if t.summary is not None}, deadlocks
 
 
 def drive(
-    bus: CoopBus, tasks: list[Task], on_idle: Callable[[], None] | None = None, quit_early: set[str] | None = None
+    bus: CoopBus,
+    tasks: list[Task],
+    on_idle: Callable[[], None] | None = None,
+    quit_early: set[str] | None = None,
+    meant_to_end: frozenset[str] = frozenset(),
 ) -> list[str]:
     """Run every task to its end; returns the deadlocks met (one line each), usually none.
 
     `quit_early` collects the nodes whose loop ended while others still waited
-    for them (what a launcher would see as a vanished liveliness token).
+    for them (what a launcher would see as a vanished liveliness token). Waits
+    given up only on nodes in `meant_to_end` (a scenario's `kill` step) are no
+    deadlock: they are not listed.
 
     `on_idle` is called whenever the run queue has gone round once (the
     recorder drains its taps there). A task that raises ends the match:
@@ -205,13 +215,14 @@ def drive(
         parked = [t for t in tasks if not t.done and t.waiting is not None]
         if not parked:
             return deadlocks
-        waits = ", ".join(f"{t.name} on {t.waiting[0].key} (tick {t.waiting[1]})" for t in parked)  # type: ignore[index]
-        deadlocks.append(f"deadlock: every unfinished node waits: {waits}")
         # Waits on a node whose loop has ended are given up first: in a distributed
         # match its liveliness token would be gone. Only a cycle of live nodes is
         # ended as the watchdog would end it after `wait_timeout`: every wait at once.
         live = {t.name for t in tasks if not t.done}
         stuck = [t for t in parked if t.waiting[0].sender not in live] or parked  # type: ignore[index]
+        if not all(t.waiting[0].sender in meant_to_end - live for t in stuck):  # type: ignore[index]
+            waits = ", ".join(f"{t.name} on {t.waiting[0].key} (tick {t.waiting[1]})" for t in parked)  # type: ignore[index]
+            deadlocks.append(f"deadlock: every unfinished node waits: {waits}")
         for t in stuck:
             ib, k = t.waiting  # type: ignore[misc]
             ib.channel.waiter = None  # type: ignore[union-attr]

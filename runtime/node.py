@@ -123,7 +123,8 @@ class Peer:
         if peer not in self.dead:
             self.dead[peer] = why
             self.dead_at[peer] = self.last_tick
-            self.log.error("treating %s as dead: %s", peer, why)
+            meant = killed_at(self.cfg, peer) >= 0  # a scenario's `kill` step: expected, so not an error
+            self.log.log(logging.INFO if meant else logging.ERROR, "treating %s as dead: %s", peer, why)
             if " silent for " in why:
                 self.silent[peer] = self.last_tick
             self.on_peer_dead(peer)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import threading
 
 import pytest
@@ -30,6 +31,21 @@ def test_a_node_that_stops_sending_is_a_detected_deadlock_and_the_match_goes_on(
     assert result["ticks"] == 200, "the match was played to its end"
     assert result["deadlocks"] and "robot/b/1" in result["deadlocks"][0]
     assert "robot/b/1" in result["dead"]
+
+
+def test_a_process_a_scenario_kills_is_dead_quietly_not_a_deadlock(caplog):
+    """`arena scenario run` of the rule library printed 'deadlock: every unfinished node waits'
+    and 'treating robot/a/1 as dead' for the kill step it asked for; --engine processes printed nothing."""
+    from arena.runtime.config import ScenarioParams
+    from arena.schemas.messages import KillProcess, RefereeOverride, Step
+
+    steps = (Step(at=0, actions=[RefereeOverride(command="START")]), Step(at=50, actions=[KillProcess("robot/b/1")]))
+    cfg = MatchConfig(seed=4, half_time=2.0, scenario=ScenarioParams(ticks=100, steps=steps))
+    r = inprocess.play_match(cfg).to_dict()
+    assert r["ticks"] == 100 and "robot/b/1" in r["dead"] and "b/1" in r["parked"]
+    assert r["deadlocks"] == []
+    loud = [rec.getMessage() for rec in caplog.records if rec.levelno >= logging.WARNING]
+    assert not any("robot/b/1" in m or "b/1 is dead" in m or "deadlock" in m for m in loud), loud
 
 
 def test_a_clean_match_has_no_deadlock_and_one_pid():

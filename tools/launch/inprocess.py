@@ -26,6 +26,7 @@ from arena.processes import node_class
 from arena.runtime import coop
 from arena.runtime.config import MatchConfig
 from arena.runtime.coop import CoopBus, NodeFailed, Task
+from arena.runtime.node import killed_at
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
 
@@ -56,7 +57,10 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     quit_early: set[str] = set()
     t0 = time.perf_counter()
     try:
-        summaries, deadlocks = coop.play(bus, nodes, recorder.pump if recorder is not None else None, quit_early)
+        killed = frozenset(n.name for n in nodes if killed_at(cfg, n.name) >= 0)  # a scenario's `kill` steps
+        summaries, deadlocks = coop.play(
+            bus, nodes, recorder.pump if recorder is not None else None, quit_early, killed
+        )
     except NodeFailed as exc:
         if recorder is not None:
             recorder.finish()
