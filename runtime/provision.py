@@ -147,7 +147,7 @@ def rotate(directory: Path, which: list[str]) -> list[str]:
         for p in directory.glob("*.json5"):
             p.unlink()
         return provision(directory, names, 0)[1]
-    for p in which:
+    for p in dict.fromkeys(which):  # a principal named twice: its file was unlinked twice, the second failed
         (directory / f"{user_of(p)}.json5").unlink()
     return provision(directory, names, 0)[1]
 

@@ -64,6 +64,9 @@ def test_rotate_one_principal_or_the_whole_set(tmp_path):
     assert json.loads((d / ROUTER_FILE).read_text())["metadata"]["arena"]["credentials"] != s.set_id
     with pytest.raises(ConfigError, match="no credentials for robot/c/9"):
         rotate(d, ["robot/c/9"])
+    a1 = (d / "robot-a-1.json5").read_bytes()
+    assert "robot-a-1.json5" in rotate(d, ["robot/a/1", "robot/a/1"])  # left the file deleted, and exit 2
+    assert (d / "robot-a-1.json5").read_bytes() != a1
     assert any("robot-a-1.json5: robot/a/1" in line for line in show(d))
 
 
