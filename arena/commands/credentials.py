@@ -50,7 +50,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"{directory}: {'made ' + ', '.join(made) if made else 'complete already, nothing changed'}")
     elif args.action == "rotate":
         made = rotate(directory, args.principals)
-        print(f"{directory}: new {', '.join(made)}; copy each robot's new file to its computer")
+        away = [m for m in made if m.startswith(("robot-", "basestation-"))]  # what may run on another computer
+        print(
+            f"{directory}: new {', '.join(made)}; copy {', '.join(away) or 'none of them'} again to the computer each is on"
+        )
     if args.action in ("init", "show"):
         print("\n".join(show(directory)))
     return 0

@@ -70,6 +70,16 @@ def test_rotate_one_principal_or_the_whole_set(tmp_path):
     assert any("robot-a-1.json5: robot/a/1" in line for line in show(d))
 
 
+def test_rotate_says_which_files_to_copy_again(tmp_path, capsys):
+    from arena.cli import main
+
+    assert main(["credentials", "init", str(tmp_path / "c"), "--robots", "2"]) == 0
+    capsys.readouterr()
+    assert main(["credentials", "rotate", str(tmp_path / "c"), "robot/a/1"]) == 0
+    out = capsys.readouterr().out  # said "copy each robot's new file" of a rotation that changed base station a's
+    assert "; copy basestation-a.json5, robot-a-1.json5 again to the computer each is on" in out, out
+
+
 def test_a_smaller_match_or_a_rotation_leaves_every_other_robots_file_as_it_was(tmp_path):
     """The files are the set's (6 robots a team), not the match's: a 3v3 match once rewrote robot a/4's
     file without the engine's key, and a rotation (made for 0 robots) every robot's file."""
