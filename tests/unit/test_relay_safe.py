@@ -72,7 +72,7 @@ def test_a_secure_router_opens_with_the_viewers_drop_rule(tmp_path):
 def test_a_standalone_secure_router_serves_the_viewer_it_wrote_credentials_for_with_drop(tmp_path):
     """`arena run router --credentials DIR` (compose): the same rule, naming the id in DIR/viewer.json5."""
     from arena.runtime.session import NetConfig
-    from arena.tools.launch.run import secure_router
+    from arena.tools.launch.router import secure_router
 
     net = secure_router(
         "m1", NetConfig(mode="router", listen=(f"unixsock-stream/{tmp_path}/r.sock",)), str(tmp_path), tmp_path

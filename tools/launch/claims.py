@@ -18,12 +18,17 @@ played on and every frame it sent was dropped as forged.
 from __future__ import annotations
 
 import json
+import os
+import secrets
+import socket
 import threading
 import time
 
 import zenoh
 
+from arena.runtime.config import ConfigError, ProcessId
 from arena.runtime.mac import Keyring
+from arena.runtime.session import NetConfig
 from arena.schemas.keys import Keys
 
 TOKEN_WAIT = 2.0  # [s] a claim whose token has not reached the router by then is refused
@@ -124,3 +129,62 @@ class Claims:
         self._sub.undeclare()
         self._queryable.undeclare()
         self._thread.join(timeout=2.0)
+
+
+# ---------------------------------------------------------------- the claimant's side (`arena run`)
+def claim(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, timeout: float = 3.0):
+    """Ask the match's router for this identity (tools/launch/claims.py); ConfigError with the
+    router's reason if refused. Returns the liveliness token that holds it (keep it while running),
+    or None if nobody answers (a router that gives out no identities)."""
+    name = str(pid)
+    nonce = secrets.token_hex(8)
+    token = session.liveliness().declare_token(keys.claim_token(name, nonce))
+    sign = keyring.signer(keys.claim(name)) if keyring is not None else None
+    ask = {"nonce": nonce, "host": socket.gethostname(), "pid": os.getpid()}
+    if sign is not None:
+        ask["mac"] = sign(nonce.encode()).hex()
+    for reply in session.get(keys.claim(name), payload=json.dumps(ask).encode(), timeout=timeout):
+        if reply.ok is None:
+            continue
+        try:
+            answer = json.loads(reply.ok.payload.to_bytes())
+        except ValueError:
+            continue
+        if answer.get("ok"):
+            return token
+        token.undeclare()
+        raise ConfigError(f"refused by match {keys.match!r}: {answer.get('reason')}")
+    token.undeclare()
+    return None
+
+
+def hold_identity(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, net: NetConfig):
+    """This process's identity in the match, or ConfigError with the reason it is someone else's.
+    `arena match` holds its own processes' for them; a router that gives out none leaves the
+    liveliness check. Returns what holds it (None: nothing to keep)."""
+    if launched(net):
+        return None
+    held = claim(session, keys, pid, keyring)
+    if held is None:
+        refuse_duplicate(session, keys, pid)
+    return held
+
+
+def launched(net: NetConfig) -> bool:
+    """Started by `arena match`, which holds this process's identity for it (its credentials say so)."""
+    return bool(net.base and json.loads(net.base).get("metadata", {}).get("arena", {}).get("launched"))
+
+
+def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
+    """Liveliness knows who is there: a second process with a running one's identity is turned away.
+
+    The match hears of it too (`arena/<m>/refused/<process>`, printed by `arena match`).
+    """
+    name = str(pid)
+    if not any(r.ok is not None for r in session.liveliness().get(keys.alive(name), timeout=1.0)):
+        return
+    session.put(keys.refused(name), f"{socket.gethostname()}, pid {os.getpid()}".encode())
+    time.sleep(0.2)  # let the put leave before the session closes
+    raise ConfigError(
+        f"{name} is already running in match {keys.match!r}: a second one is refused (check --team and --robot)"
+    )

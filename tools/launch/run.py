@@ -17,11 +17,7 @@ import dataclasses
 import faulthandler
 import json
 import logging
-import os
-import secrets
-import shutil
 import signal
-import socket
 import sys
 import time
 from pathlib import Path
@@ -32,16 +28,15 @@ import zenoh
 from arena.processes import OBSERVERS, node_class
 from arena.runtime.acl import user_of
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
-from arena.runtime.credentials import COLLECTOR_PRINCIPAL, load_fragment, match_directory, secure_endpoint
+from arena.runtime.credentials import load_fragment
 from arena.runtime.drivers import Driver, Pull, WaitBoard
 from arena.runtime.mac import Keyring
 from arena.runtime.node import StartupError
-from arena.runtime.provision import load, provision
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, listening, open_session
 from arena.runtime.transport import ZenohTransport
-from arena.schemas.keys import Keys, check_match_id, process_names
+from arena.schemas.keys import Keys, check_match_id
 from arena.schemas.messages import Referee
-from arena.tools.launch.claims import Claims
+from arena.tools.launch.claims import hold_identity
 from arena.tools.launch.connect import why_refused
 
 
@@ -123,6 +118,8 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     configure_logging(job.log_level or "WARNING", by_hand=job.config is None)
     net = NetConfig(mode=job.mode or "peer", connect=job.connect, listen=job.listen)
     if job.kind == "router":
+        from arena.tools.launch.router import run_router
+
         return main_guarded(run_router, job.match, net, job.credentials)
     keyring = None
     try:
@@ -399,64 +396,6 @@ def with_policy(cfg: MatchConfig, team: str, policy: str) -> MatchConfig:
     return cfg.replace(**{"home" if team == "a" else "away": policy})
 
 
-def claim(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, timeout: float = 3.0):
-    """Ask the match's router for this identity (tools/launch/claims.py); ConfigError with the
-    router's reason if refused. Returns the liveliness token that holds it (keep it while running),
-    or None if nobody answers (a router that gives out no identities)."""
-    name = str(pid)
-    nonce = secrets.token_hex(8)
-    token = session.liveliness().declare_token(keys.claim_token(name, nonce))
-    sign = keyring.signer(keys.claim(name)) if keyring is not None else None
-    ask = {"nonce": nonce, "host": socket.gethostname(), "pid": os.getpid()}
-    if sign is not None:
-        ask["mac"] = sign(nonce.encode()).hex()
-    for reply in session.get(keys.claim(name), payload=json.dumps(ask).encode(), timeout=timeout):
-        if reply.ok is None:
-            continue
-        try:
-            answer = json.loads(reply.ok.payload.to_bytes())
-        except ValueError:
-            continue
-        if answer.get("ok"):
-            return token
-        token.undeclare()
-        raise ConfigError(f"refused by match {keys.match!r}: {answer.get('reason')}")
-    token.undeclare()
-    return None
-
-
-def hold_identity(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, net: NetConfig):
-    """This process's identity in the match, or ConfigError with the reason it is someone else's.
-    `arena match` holds its own processes' for them; a router that gives out none leaves the
-    liveliness check. Returns what holds it (None: nothing to keep)."""
-    if launched(net):
-        return None
-    held = claim(session, keys, pid, keyring)
-    if held is None:
-        refuse_duplicate(session, keys, pid)
-    return held
-
-
-def launched(net: NetConfig) -> bool:
-    """Started by `arena match`, which holds this process's identity for it (its credentials say so)."""
-    return bool(net.base and json.loads(net.base).get("metadata", {}).get("arena", {}).get("launched"))
-
-
-def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:
-    """Liveliness knows who is there: a second process with a running one's identity is turned away.
-
-    The match hears of it too (`arena/<m>/refused/<process>`, printed by `arena match`).
-    """
-    name = str(pid)
-    if not any(r.ok is not None for r in session.liveliness().get(keys.alive(name), timeout=1.0)):
-        return
-    session.put(keys.refused(name), f"{socket.gethostname()}, pid {os.getpid()}".encode())
-    time.sleep(0.2)  # let the put leave before the session closes
-    raise ConfigError(
-        f"{name} is already running in match {keys.match!r}: a second one is refused (check --team and --robot)"
-    )
-
-
 def driver(pid: ProcessId, cfg: MatchConfig, transport: ZenohTransport, keys: Keys) -> dict[str, Driver]:
     """The driver of a lockstep node over zenoh, as a keyword for its constructor (none for an observer):
     the receive callbacks (`Reactor`, blaming silent peers by their announced waits), or in real time
@@ -579,66 +518,6 @@ def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
     except (msgspec.DecodeError, msgspec.ValidationError):
         return "match over (the last referee message was unreadable)"
     return f"match over at tick {ref.tick} ({ref.stage}): a ({cfg.home}) {ref.score_a} : {ref.score_b} b ({cfg.away})"
-
-
-ROUTER_ROBOTS = 6  # a standalone router's credentials cover every robot a configuration may ask for
-
-
-def secure_router(match: str, net: NetConfig, directory: str, private: Path) -> NetConfig:
-    """A secure match's router (`arena run router --credentials DIR`): every principal's credentials
-    file written into DIR, the router's passwords (a file in `private`, ours alone), access control
-    and TLS certificate in its config."""
-    if len(net.listen) != 1:
-        raise ConfigError("arena run router --credentials needs one --listen endpoint")
-    endpoint, _ = secure_endpoint(net.listen[0])
-    names = [*process_names(ROUTER_ROBOTS), "refbox", COLLECTOR_PRINCIPAL]
-    try:  # provisioned once: what DIR holds is kept (runtime/provision.py)
-        creds, _ = provision(Path(directory), names, ROUTER_ROBOTS, match)
-    except OSError as exc:
-        raise ConfigError(f"cannot write --credentials {directory}: {exc.strerror}") from None
-    return NetConfig(
-        mode="router", listen=(endpoint,), connect=net.connect, extra=(*net.extra, *creds.router_settings(private))
-    )
-
-
-def run_router(match: str, net: NetConfig, credentials: str | None = None) -> int:
-    """A zenoh router for one match; exits when every process of the match has left."""
-    signal.signal(signal.SIGTERM, _sigterm)  # SystemExit: the password dictionary goes too
-    private = match_directory("arena-router-")  # removed below, or by the next start if we are killed
-    try:
-        if not credentials:
-            return _route(match, net, None)
-        net = secure_router(match, net, credentials, private)
-        held = load(Path(credentials))  # just provisioned: every principal's key, to check claims with
-        return _route(match, net, held.keyring("launcher") if held is not None else None)
-    finally:
-        shutil.rmtree(private, ignore_errors=True)
-
-
-def _route(match: str, net: NetConfig, keyring: Keyring | None) -> int:
-    keys = Keys(match)
-    alive: set[str] = set()
-    seen = [False]
-
-    def on_change(sample: zenoh.Sample) -> None:
-        key = str(sample.key_expr)
-        if sample.kind == zenoh.SampleKind.PUT:
-            alive.add(key)
-            seen[0] = True
-        else:
-            alive.discard(key)
-
-    with open_session(NetConfig(mode="router", listen=net.listen, connect=net.connect, extra=net.extra)) as session:
-        sub = session.liveliness().declare_subscriber(keys.alive_all(), on_change, history=True)
-        said = lambda text: print(f"arena run: router: {text}", file=sys.stderr, flush=True)
-        claims = Claims(session, keys, keyring, {}, said)  # one process per identity (tools/launch/claims.py)
-        try:
-            while not (seen[0] and not alive):
-                time.sleep(0.2)
-        finally:
-            claims.close()
-            sub.undeclare()
-    return 0
 
 
 def main_guarded(fn, *args) -> int:
