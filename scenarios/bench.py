@@ -79,4 +79,9 @@ def bench_scenario(runs: int = 10, as_json: bool = False, jobs: int = 2) -> int:
         (f"runs per minute, {jobs} workers", f"{out['runs_per_minute_jobs']:.0f}"),
         ("load average (1 min) at the end", f"{out['load_average_1min']}"),
     ]
-    return print_metrics(out, f"arena bench scenario: median of {runs} runs of {SECONDS:g} simulated s", rows, as_json)
+    return print_metrics(
+        out,
+        f"arena bench scenario: {'one run' if runs == 1 else f'median of {runs} runs'} of {SECONDS:g} simulated s",
+        rows,
+        as_json,
+    )

@@ -109,6 +109,20 @@ def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
     seeds = [args.seed] if args.seed is not None else list(range(args.seeds))
     if args.record and (len(scenarios) != 1 or len(seeds) != 1):
         raise ScenarioError("--record needs one scenario (--name) and one seed (--seed)")
+    if args.record:  # as arena match --record: a new file, never an existing recording overwritten
+        from arena.runtime.config import ConfigError
+        from arena.tools.launch.run import record_path
+
+        try:
+            args.record = record_path(args.record, fresh=True)
+        except ConfigError as exc:
+            raise ScenarioError(str(exc)) from None
+    if args.junit:  # checked now, not after every run has played
+        junit = Path(args.junit).expanduser()
+        if not junit.parent.resolve().is_dir() or junit.is_dir():
+            raise ScenarioError(
+                f"--junit {args.junit}: {'is a directory' if junit.is_dir() else 'its directory does not exist'}"
+            )
     return scenarios, seeds
 
 

@@ -133,6 +133,14 @@ BAD = [
     (["scenario", "run", "--seeds", "0"], "--seeds: expected a whole number 1..100000"),
     (["scenario", "run", "x", "--seed", "1", "--seeds", "2"], "--seeds: not allowed with argument --seed"),
     (["scenario", "library", "x"], "library takes no FILE|DIR, got 'x'"),  # was ignored
+    (  # an existing recording is never overwritten, as with arena match --record
+        ["scenario", "run", "{lib}/rules/09-goal.scenario.toml", "--seed", "0", "--record", "{file}"],
+        "exists (0.0 MB): give a new file name",
+    ),
+    (  # said before the runs, not after them
+        ["scenario", "run", "{lib}/rules/09-goal.scenario.toml", "--junit", "/nonexistent/dir/r.xml"],
+        "--junit /nonexistent/dir/r.xml: its directory does not exist",
+    ),
     (["scenario"], "required: {{run,library}} (see"),
     (
         ["scenario", "run", "--jbos", "2"],
@@ -203,7 +211,9 @@ def garbage(tmp_path_factory):
 
 @pytest.mark.parametrize(("args", "needle"), BAD, ids=[" ".join(a)[:60] for a, _ in BAD])
 def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, busy_port, garbage, tmp_path):
-    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path) for a in args]
+    from arena.scenarios.library import LIBRARY
+
+    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY) for a in args]
     r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
     assert "Traceback" not in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr

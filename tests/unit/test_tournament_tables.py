@@ -168,6 +168,8 @@ def test_draws_alone_give_no_ratings_and_say_why():
     assert notes == [
         "no ratings yet: all 2 played matches were draws, so nothing tells the strategies apart; play more legs."
     ]
+    _, notes = ratings([match(AD, BS, 2, 2)], [AD, BS], boot=50)
+    assert notes[0].startswith("no ratings yet: the one played match was a draw,")  # not "all 1 ... were"
     rows, notes = ratings([match(AD, BS, 0, 0), match(BS, AD, 1, 0, leg=2)], [AD, BS], boot=50)
     assert all(r["rating"] is not None and r["ci95"][0] < r["ci95"][1] for r in rows)
 

@@ -72,7 +72,9 @@ def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
         ),
     ]
     rows += [(f"own work per tick, {k} [us]", f"{v:.0f}") for k, v in out["work_us_per_tick_median"].items()]
-    return print_metrics(out, f"arena bench match: median of {runs} runs", rows, as_json)
+    return print_metrics(
+        out, f"arena bench match: {'one run' if runs == 1 else f'median of {runs} runs'}", rows, as_json
+    )
 
 
 def print_metrics(out: dict, title: str, rows: list[tuple[str, str]], as_json: bool) -> int:
@@ -138,7 +140,9 @@ def bench_record(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int
         ("recorder CPU [s]", f"{out['recorder_cpu_s_median']:.2f}"),
         ("MCAP file [MB]", f"{out['file_mb_median']:.2f}"),
     ]
-    return print_metrics(out, f"arena bench record: median of {runs} runs each", rows, as_json)
+    return print_metrics(
+        out, f"arena bench record: {'one run' if runs == 1 else f'median of {runs} runs'} each", rows, as_json
+    )
 
 
 def robot_step_us(strategy: str = "advance-dynamic", batches: int = 200, per_batch: int = 50) -> dict[str, float]:

@@ -105,7 +105,11 @@ def ratings(results: list[Result], teams: list[str], boot: int = 400, seed: int 
         # Draws alone (or nothing played) fit every team at 1500 with a zero-width interval: that reads as
         # certainty that they are equal, from what is no evidence at all.
         rows = [{"team": t, "rating": None, "ci95": None} for t in sorted(teams)]
-        why = "no match was played" if not ok else f"all {plural(len(ok), 'played match', 'played matches')} were draws"
+        why = (
+            "no match was played"
+            if not ok
+            else ("the one played match was a draw" if len(ok) == 1 else f"all {len(ok)} played matches were draws")
+        )
         return rows, [f"no ratings yet: {why}, so nothing tells the strategies apart; play more legs."]
     point = bradley_terry(ok, teams)
     strength = {t: 10 ** ((v - 1500.0) / 400.0) for t, v in point.items()}
