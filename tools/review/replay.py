@@ -38,6 +38,7 @@ from arena.runtime.coop import CoopBus, NodeFailed, Task, drive
 from arena.runtime.lockstep import BATCH_HEADS, decode_batch
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
+from arena.schemas.messages import KillProcess
 
 
 class ReplayError(ValueError):
@@ -103,6 +104,11 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
         raise ReplayError("refbox: the RefBox bridge replays nothing: its worldstates came from outside the match")
     if cfg.realtime:
         raise ReplayError("this match ran with --realtime, which is not deterministic: only lockstep matches replay")
+    killed = [(a.process, s.at) for s in cfg.scenario.steps for a in s.actions if isinstance(a, KillProcess)]
+    if killed:  # the kill cuts a loop short where replay would go on; every node after it would differ
+        who, at = killed[0]
+        when = f"at tick {at}" if at >= 0 else "when its condition held"
+        raise ReplayError(f"this match's scenario killed {who} {when} (a kill step): only matches without one replay")
     cfg = cfg.replace(tap=False)  # the replayed node taps nothing
     name = str(pid)
     bus = CoopBus()
