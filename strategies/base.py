@@ -25,7 +25,24 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from arena.runtime.config import MatchConfig
-from arena.schemas.messages import Cmd, Order, Referee, Report, Sense
+from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, Sense
+
+
+def report_of(
+    tick: int, n: int, sense: Sense | None, role: str, pose: tuple[float, float, float] = (0.0, 0.0, 0.0)
+) -> Report:
+    """A robot's report to its base station: what its `sense` says, or `pose` (its best guess) before any."""
+    if sense is None:
+        return Report(tick=tick, robot=n, pose=Pose(x=pose[0], y=pose[1], theta=pose[2]), role=role)
+    return Report(
+        tick=tick,
+        robot=n,
+        pose=sense.pose,
+        ball=sense.ball,
+        robots=sense.robots,
+        has_ball=sense.has_ball,
+        role=role,
+    )
 
 
 @dataclass(frozen=True)

@@ -32,9 +32,9 @@ from typing import Any, get_args
 import numpy as np
 
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.schemas.messages import Cmd, Order, Pose, Report, Sense
+from arena.schemas.messages import Cmd, Order, Report, Sense
 from arena.schemas.vocabulary import RefCommandName
-from arena.strategies.base import RobotContext, Strategy, TeamContext
+from arena.strategies.base import RobotContext, Strategy, TeamContext, report_of
 
 PREFIX = "policy:"
 COMMANDS: tuple[str, ...] = get_args(RefCommandName)
@@ -258,17 +258,7 @@ class LearnerBrain:
         return to_cmd(tick, self.action, self.view, self.discrete)
 
     def report(self, tick: int, sense: Sense | None) -> Report:
-        if sense is None:
-            return Report(tick=tick, robot=self.n, pose=Pose(x=0.0, y=0.0, theta=0.0), role=self.role)
-        return Report(
-            tick=tick,
-            robot=self.n,
-            pose=sense.pose,
-            ball=sense.ball,
-            robots=sense.robots,
-            has_ball=sense.has_ball,
-            role=self.role,
-        )
+        return report_of(tick, self.n, sense, self.role)
 
 
 # ------------------------------------------------------------------ policies

@@ -37,7 +37,7 @@ from arena.rules import setpieces
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.schemas.vocabulary import other_team
-from arena.strategies.base import RobotContext, Strategy, TeamContext
+from arena.strategies.base import RobotContext, Strategy, TeamContext, report_of
 from arena.strategies.roles import referee_fields
 
 PLAY_COMMANDS = frozenset({"START"})
@@ -129,17 +129,7 @@ class SimpleRobot:
 
     # ------------------------------------------------------------------ report
     def report(self, tick: int, sense: Sense | None) -> Report:
-        if sense is None:
-            return Report(tick=tick, robot=self.n, pose=Pose(x=0.0, y=0.0, theta=0.0), role=self.role)
-        return Report(
-            tick=tick,
-            robot=self.n,
-            pose=sense.pose,
-            ball=sense.ball,
-            robots=sense.robots,
-            has_ball=sense.has_ball,
-            role=self.role,
-        )
+        return report_of(tick, self.n, sense, self.role)
 
     # -------------------------------------------------------------------- step
     def step(self, tick: int, sense: Sense | None, order: Order | None) -> Cmd:

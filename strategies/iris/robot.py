@@ -10,10 +10,10 @@ outfield robot with the ball (handling.py, attack.py) or without it
 from __future__ import annotations
 
 from arena.navigation import get
-from arena.schemas.messages import Cmd, Order, Pose, Report, Sense
+from arena.schemas.messages import Cmd, Order, Report, Sense
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import roles as R
-from arena.strategies.base import RobotContext
+from arena.strategies.base import RobotContext, report_of
 from arena.strategies.iris.attack import AttackMixin
 from arena.strategies.iris.defense import DefenseMixin
 from arena.strategies.iris.handling import HandlingMixin
@@ -64,18 +64,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
 
     def report(self, tick: int, sense: Sense | None) -> Report:
-        if sense is None:
-            pose = self.view.pose or (0.0, 0.0, 0.0)
-            return Report(tick=tick, robot=self.n, pose=Pose(x=pose[0], y=pose[1], theta=pose[2]), role=self.role)
-        return Report(
-            tick=tick,
-            robot=self.n,
-            pose=sense.pose,
-            ball=sense.ball,
-            robots=sense.robots,
-            has_ball=sense.has_ball,
-            role=self.role,
-        )
+        return report_of(tick, self.n, sense, self.role, self.view.pose or (0.0, 0.0, 0.0))
 
     def step(self, tick: int, sense: Sense | None, order: Order | None) -> Cmd:
         view = self.view
