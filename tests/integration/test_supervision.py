@@ -59,7 +59,7 @@ def test_ctrl_c_or_sigterm_stops_every_process(reap, sig, code, said):
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == code, err
-    assert err.strip().splitlines()[-1] == f"arena match: {said}; every process of the match was stopped"
+    assert err.strip().splitlines()[-1] == f"arena match: {said}; every process of the match was stopped", err
     assert "Traceback" not in err
     survivors = [p for p in kids if alive(p)]
     assert survivors == [], f"orphans: {survivors}"
