@@ -22,8 +22,8 @@ from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.schemas.messages import Base, Summary
-from arena.schemas.validate import nonfinite
+from arena.schemas.messages import Summary
+from arena.schemas.validate import first_problem, nonfinite
 
 # What a cut-off file can raise inside a record: short reads, a chunk that does
 # not decompress, a CRC that does not match.
@@ -81,7 +81,7 @@ class Recording:
             except (msgspec.DecodeError, msgspec.ValidationError):
                 self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
                 continue
-            problem = nonfinite(p, msg) or _too_large(msg, "")
+            problem = nonfinite(p, msg) or first_problem(msg, _too_large)
             if problem:
                 raise RecordingError(
                     f"{self.path}: a {topic} frame (tick {msg.tick}) is not what a match sends: {problem}"
@@ -96,18 +96,8 @@ MAX_MAGNITUDE = 1e9
 
 
 def _too_large(value: object, path: str) -> str | None:
-    if type(value) in (float, int):
-        return f"{path or 'value'} = {value:g} is beyond {MAX_MAGNITUDE:g}" if abs(value) > MAX_MAGNITUDE else None
-    if isinstance(value, Base):
-        for name in value.__struct_fields__:
-            problem = _too_large(getattr(value, name), f"{path}.{name}" if path else name)
-            if problem:
-                return problem
-    elif isinstance(value, list | tuple):
-        for i, item in enumerate(value):
-            problem = _too_large(item, f"{path}[{i}]")
-            if problem:
-                return problem
+    if type(value) in (float, int) and abs(value) > MAX_MAGNITUDE:
+        return f"{path or 'value'} = {value:g} is beyond {MAX_MAGNITUDE:g}"
     return None
 
 

@@ -20,6 +20,7 @@ Two things, for every message type:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import msgspec
 
@@ -33,30 +34,36 @@ from arena.schemas.messages import Base, Cmd, EngineEvents, Referee
 _CLASSES = bytes(1 if b in (0xCA, 0xCB) else 2 if b in (0x7F, 0xFF) else 0 for b in range(256))
 
 
-def _walk(value: object, path: str) -> str | None:
-    if type(value) is float:
-        return None if math.isfinite(value) else f"{path or 'value'} is not finite"
+def first_problem(value: object, leaf: Callable[[object, str], str | None], path: str = "") -> str | None:
+    """What `leaf(x, path)` says of the first of `value`'s scalars it has something to say of, walking
+    struct fields, lists, tuples and dicts (a field's path as `robots[2].x`), or None."""
     if isinstance(value, Base):
         for name in value.__struct_fields__:
-            problem = _walk(getattr(value, name), f"{path}.{name}" if path else name)
+            problem = first_problem(getattr(value, name), leaf, f"{path}.{name}" if path else name)
             if problem:
                 return problem
     elif isinstance(value, list | tuple):
         for i, item in enumerate(value):
-            problem = _walk(item, f"{path}[{i}]")
+            problem = first_problem(item, leaf, f"{path}[{i}]")
             if problem:
                 return problem
     elif isinstance(value, dict):
         for k, item in value.items():
-            problem = _walk(item, f"{path}[{k!r}]")
+            problem = first_problem(item, leaf, f"{path}[{k!r}]")
             if problem:
                 return problem
+    else:
+        return leaf(value, path)
     return None
+
+
+def _not_finite(value: object, path: str) -> str | None:
+    return f"{path or 'value'} is not finite" if type(value) is float and not math.isfinite(value) else None
 
 
 def nonfinite(raw: bytes, msg: Base) -> str | None:
     """The first non-finite float in `msg` (decoded from `raw`), or None."""
-    return _walk(msg, "") if suspect(raw) else None
+    return first_problem(msg, _not_finite) if suspect(raw) else None
 
 
 def suspect(raw: bytes) -> bool:
