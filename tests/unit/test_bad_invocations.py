@@ -4,10 +4,20 @@ A table of bad invocations across every subcommand. Each must print exactly
 one line on stderr, never a traceback, and exit with the documented code
 (arena/cli.py: 2 for a user error). `{tmp}` is an empty directory, `{file}` a
 file with garbage in it, `{busy}` a TCP port that something already listens on.
+
+The first case of every sub-command, and every case marked PROCESS (it opens a
+zenoh session, listens, or starts a match's processes), runs as a real
+`python -m arena` process: its exit code and its whole stderr as a user sees
+them. The others call the same entry point, arena.cli.main, in this process
+(fd-level capture, so a line written by native code counts too) with the same
+assertions: ~0.1 s of interpreter startup less per case.
 """
 
 from __future__ import annotations
 
+import logging
+import os
+import signal
 import socket
 import subprocess
 import sys
@@ -15,6 +25,8 @@ import tempfile
 from pathlib import Path
 
 import pytest
+
+PROCESS = "process"  # a third element: this case runs as a real process
 
 M = ["match", "--home", "BS", "--away", "BS", "--half-time", "1"]
 R = ["run", "robot", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--team", "a", "--robot", "1"]
@@ -34,7 +46,7 @@ BAD = [
     ([*M, "--startup-timeout", "0"], "--startup-timeout: '0'"),
     ([*M, "--listen", "foo"], "--listen foo: not a zenoh endpoint"),
     ([*M, "--listen", "tcp/127.0.0.1:99999"], "a port in 0..65535"),
-    ([*M, "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use"),
+    ([*M, "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use", PROCESS),
     ([*M, "--robots", "0"], "--robots must be between 1 and 6"),
     ([*M, "--robots", "lots"], "invalid int value"),
     (["match", "--home", "tiki-taka", "--away", "BS"], "unknown strategy 'tiki-taka'"),
@@ -58,7 +70,7 @@ BAD = [
     ([*M, "--half", "5"], "--half 5; did you mean --half-time? (see arena match --help)"),  # was taken as --half-time
     ([*M, "--halftime", "5"], "did you mean --half-time?"),
     ([*M, "--seeed=3"], "unrecognized arguments: --seeed=3; did you mean --seed?"),
-    ([*M, "--listen", "tcp/0.0.0.0:{busy}"], "cannot listen on tcp/0.0.0.0:"),  # was named as tls/0.0.0.0:P
+    ([*M, "--listen", "tcp/0.0.0.0:{busy}"], "cannot listen on tcp/0.0.0.0:", PROCESS),  # was named as tls/0.0.0.0:P
     ([*M, "--credentials", "{file}"], "is not a directory"),
     # arena credentials
     (["credentials", "show", "{tmp}"], "holds no credentials: arena credentials init"),
@@ -84,7 +96,7 @@ BAD = [
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
     (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),
-    (["run", "router", "--match", "m", "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use"),
+    (["run", "router", "--match", "m", "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use", PROCESS),
     (["run", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "the following arguments are required: kind"),
     # arena up
     (["up", "/nonexistent/compose.yaml"], "cannot read"),
@@ -183,7 +195,11 @@ BAD = [
         ],
         "cannot read --credentials /nonexistent.json5",
     ),
-    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_ball"}}'], "cannot connect to"),
+    (
+        ["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_ball"}}'],
+        "cannot connect to",
+        PROCESS,
+    ),
     # arena strategies
     (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
@@ -209,12 +225,56 @@ def garbage(tmp_path_factory):
     return path
 
 
-@pytest.mark.parametrize(("args", "needle"), BAD, ids=[" ".join(a)[:60] for a, _ in BAD])
-def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, busy_port, garbage, tmp_path):
+def _cases() -> list[tuple[list[str], str, bool]]:
+    """BAD as (args, needle, in a process): the first case of each sub-command, and the PROCESS ones."""
+    seen: set[str] = set()
+    cases = []
+    for args, needle, *process in BAD:
+        first = (args[:1] or [""])[0] not in seen
+        seen.add((args[:1] or [""])[0])
+        cases.append((args, needle, first or process == [PROCESS]))
+    return cases
+
+
+CASES = _cases()
+
+
+def in_process(argv: list[str], capfd) -> subprocess.CompletedProcess:
+    """`arena ARGV` through `python -m arena`'s entry point, arena.cli.main, in this process.
+
+    What a command sets for its whole process is put back afterwards: the SIGTERM handler
+    (arena/cli.py), the root logger (`arena run`), ZENOH_RUNTIME (runtime/session.py)."""
+    from arena import cli
+
+    root = logging.getLogger()
+    handlers, level, sigterm, env = root.handlers[:], root.level, signal.getsignal(signal.SIGTERM), dict(os.environ)
+    capfd.readouterr()
+    try:
+        code = cli.main(argv)
+    except SystemExit as exc:  # as `raise SystemExit(main())` in arena/__main__.py would end
+        code = exc.code
+    finally:
+        root.handlers[:], root.level = handlers, level
+        signal.signal(signal.SIGTERM, sigterm)
+        os.environ.clear()
+        os.environ.update(env)
+    out, err = capfd.readouterr()
+    return subprocess.CompletedProcess(["arena", *argv], code, out, err)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle", "process"),
+    CASES,
+    ids=[("process: " if process else "") + " ".join(a)[:60] for a, _, process in CASES],
+)
+def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_port, garbage, tmp_path, capfd):
     from arena.scenarios.library import LIBRARY
 
     argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY) for a in args]
-    r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
+    if process:
+        r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
+    else:
+        r = in_process(argv, capfd)
     assert "Traceback" not in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert needle.format(busy=busy_port, file=garbage, tmp=tmp_path) in r.stderr, r.stderr
@@ -225,9 +285,11 @@ def test_the_table_covers_every_subcommand():
     from arena.cli import parser
 
     sub = next(a for a in parser()._actions if a.dest == "command")
-    covered = {args[0] for args, _ in BAD if args}
+    covered = {args[0] for args, *_ in BAD if args}
     assert set(sub.choices) - covered == set(), "every subcommand needs bad invocations in the table"
     assert len(BAD) >= 40
+    in_a_process = {args[0] for args, _, process in CASES if args and process}
+    assert in_a_process == covered, "every subcommand needs a case run as a real process"
 
 
 def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, capsys):
@@ -302,8 +364,19 @@ def test_no_parser_takes_an_abbreviated_flag():
     assert [name for name, p in sub.choices.items() if p.allow_abbrev] == []
 
 
-def test_a_jobs_of_0_is_said_to_mean_the_default():
+def test_a_jobs_of_0_is_said_to_mean_the_default(capfd):
     """`--jobs 0` silently meant "one per core", which no help text said."""
     for cmd, flag, means in (("tournament", "--jobs", "one per core"), ("facts", "--workers", "up to 2")):
-        out = subprocess.run([sys.executable, "-m", "arena", cmd, "--help"], capture_output=True, text=True).stdout
-        assert f"0 (the default): {means}" in " ".join(out.split()), (cmd, flag)
+        r = in_process([cmd, "--help"], capfd)
+        assert r.returncode == 0 and f"0 (the default): {means}" in " ".join(r.stdout.split()), (cmd, flag)
+
+
+def test_a_malformed_listen_is_said_before_a_process_is_forked(monkeypatch):
+    """`arena match --listen foo` forked the match's ten processes, then refused the endpoint."""
+    from arena.runtime.config import MatchConfig
+    from arena.runtime.session import EndpointError
+    from arena.tools.launch import forkstart, launcher
+
+    monkeypatch.setattr(forkstart, "starter", lambda *args: pytest.fail("forked before the endpoint was checked"))
+    with pytest.raises(EndpointError, match="--listen foo: not a zenoh endpoint"):
+        launcher.play_match(MatchConfig(), listen="foo")

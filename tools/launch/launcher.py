@@ -33,7 +33,7 @@ from arena.runtime.credentials import (
     secure_endpoint,
 )
 from arena.runtime.provision import provision
-from arena.runtime.session import EndpointError, NetConfig, open_session
+from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.runtime.version import PACKAGES
 from arena.schemas.keys import Keys, routes
@@ -165,6 +165,8 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
     tools/launch/faults.py); with `strict`, it raises MatchError instead, as does a
     match that cannot start.
     """
+    if listen:  # a malformed endpoint is said before the match's processes are forked
+        check_endpoint("--listen", listen)
     t_start = time.monotonic()
     launched = time.time()
     compile_sources()
