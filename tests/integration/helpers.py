@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+import logging
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -14,6 +16,31 @@ from pathlib import Path
 import pytest
 
 ARENA = [sys.executable, "-m", "arena"]
+
+
+def arena_in_process(argv: list[str], capfd) -> subprocess.CompletedProcess:
+    """`arena ARGV` through `python -m arena`'s entry point, arena.cli.main, in this process: what a
+    process would have said (stdout, stderr: fd-level, so native code's lines count too) and its exit code.
+    For a test of a command's output; what is about the process (its exit, a traceback) needs a real one.
+
+    What a command sets for its whole process is put back afterwards: the SIGTERM handler
+    (arena/cli.py), the root logger (`arena run`), ZENOH_RUNTIME (runtime/session.py)."""
+    from arena import cli
+
+    root = logging.getLogger()
+    handlers, level, sigterm, env = root.handlers[:], root.level, signal.getsignal(signal.SIGTERM), dict(os.environ)
+    capfd.readouterr()
+    try:
+        code = cli.main(argv)
+    except SystemExit as exc:  # as `raise SystemExit(main())` in arena/__main__.py would end
+        code = exc.code
+    finally:
+        root.handlers[:], root.level = handlers, level
+        signal.signal(signal.SIGTERM, sigterm)
+        os.environ.clear()
+        os.environ.update(env)
+    out, err = capfd.readouterr()
+    return subprocess.CompletedProcess(["arena", *argv], code, out, err)
 
 
 def system_program(*names: str, install: str) -> str:

@@ -15,9 +15,6 @@ assertions: ~0.1 s of interpreter startup less per case.
 
 from __future__ import annotations
 
-import logging
-import os
-import signal
 import socket
 import subprocess
 import sys
@@ -25,6 +22,8 @@ import tempfile
 from pathlib import Path
 
 import pytest
+
+from tests.integration.helpers import arena_in_process
 
 PROCESS = "process"  # a third element: this case runs as a real process
 
@@ -239,29 +238,6 @@ def _cases() -> list[tuple[list[str], str, bool]]:
 CASES = _cases()
 
 
-def in_process(argv: list[str], capfd) -> subprocess.CompletedProcess:
-    """`arena ARGV` through `python -m arena`'s entry point, arena.cli.main, in this process.
-
-    What a command sets for its whole process is put back afterwards: the SIGTERM handler
-    (arena/cli.py), the root logger (`arena run`), ZENOH_RUNTIME (runtime/session.py)."""
-    from arena import cli
-
-    root = logging.getLogger()
-    handlers, level, sigterm, env = root.handlers[:], root.level, signal.getsignal(signal.SIGTERM), dict(os.environ)
-    capfd.readouterr()
-    try:
-        code = cli.main(argv)
-    except SystemExit as exc:  # as `raise SystemExit(main())` in arena/__main__.py would end
-        code = exc.code
-    finally:
-        root.handlers[:], root.level = handlers, level
-        signal.signal(signal.SIGTERM, sigterm)
-        os.environ.clear()
-        os.environ.update(env)
-    out, err = capfd.readouterr()
-    return subprocess.CompletedProcess(["arena", *argv], code, out, err)
-
-
 @pytest.mark.parametrize(
     ("args", "needle", "process"),
     CASES,
@@ -274,7 +250,7 @@ def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_por
     if process:
         r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
     else:
-        r = in_process(argv, capfd)
+        r = arena_in_process(argv, capfd)
     assert "Traceback" not in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert needle.format(busy=busy_port, file=garbage, tmp=tmp_path) in r.stderr, r.stderr
@@ -367,7 +343,7 @@ def test_no_parser_takes_an_abbreviated_flag():
 def test_a_jobs_of_0_is_said_to_mean_the_default(capfd):
     """`--jobs 0` silently meant "one per core", which no help text said."""
     for cmd, flag, means in (("tournament", "--jobs", "one per core"), ("facts", "--workers", "up to 2")):
-        r = in_process([cmd, "--help"], capfd)
+        r = arena_in_process([cmd, "--help"], capfd)
         assert r.returncode == 0 and f"0 (the default): {means}" in " ".join(r.stdout.split()), (cmd, flag)
 
 

@@ -1,4 +1,8 @@
-"""Bad input on the command line: one line, exit code 2, never a traceback."""
+"""Bad input on the command line: one line, exit code 2, never a traceback.
+
+The last case runs as a real `arena` process; the others, and the help texts, through the same
+entry point in this process (tests/unit/test_bad_invocations.py has a real process per sub-command).
+"""
 
 from __future__ import annotations
 
@@ -6,6 +10,8 @@ import subprocess
 import sys
 
 import pytest
+
+from tests.integration.helpers import arena_in_process
 
 
 def arena(*args: str) -> subprocess.CompletedProcess:
@@ -57,23 +63,23 @@ def arena(*args: str) -> subprocess.CompletedProcess:
         (["frobnicate"], "invalid choice"),
     ],
 )
-def test_bad_input_is_one_line_and_exit_2(args, needle):
-    r = arena(*args)
+def test_bad_input_is_one_line_and_exit_2(args, needle, capfd):
+    r = arena(*args) if args == ["frobnicate"] else arena_in_process(args, capfd)
     assert r.returncode == 2, r.stderr
     assert needle in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "Traceback" not in r.stderr
 
 
-def test_help_texts_show_examples():
+def test_help_texts_show_examples(capfd):
     for cmd in ("match", "run", "up", "bench", "review", "replay"):
-        r = arena(cmd, "--help")
+        r = arena_in_process([cmd, "--help"], capfd)
         assert r.returncode == 0 and "examples:" in r.stdout
 
 
-def test_arena_up_help_says_how_long_it_plays_and_which_variables_change_it():
+def test_arena_up_help_says_how_long_it_plays_and_which_variables_change_it(capfd):
     """`arena up` played 2 x 300 s, and ARENA_HALF_TIME was documented only in a compose.yaml comment."""
-    out = arena("up", "--help").stdout
+    out = arena_in_process(["up", "--help"], capfd).stdout
     assert "2 x 300 s" in out
     for var in ("ARENA_HALF_TIME", "ARENA_HOME", "ARENA_AWAY", "ARENA_SEED", "ARENA_LINK", "ARENA_MATCH"):
         assert var in out, var
