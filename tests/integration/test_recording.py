@@ -26,7 +26,10 @@ from tests.unit.test_recording import check_mismatch_at, records_in_file_order
 
 SEED = 4
 BASE = ("match", "--home", "BS", "--away", "AD", "--half-time", "8", "--seed", str(SEED), "--link", "wifi")
-LONG = ("match", "--home", "BS", "--away", "BS", "--half-time", "120", "--seed", "3")
+# Long enough that the recorder is signalled mid-match: 200 or 400 kB written is about tick 150 or 200
+# of the 1,500, the lockstep a few hundred ticks ahead; a longer match only waits longer after the signal.
+LONG_HALF = 15
+LONG = ("match", "--home", "BS", "--away", "BS", "--half-time", str(LONG_HALF), "--seed", "3")
 
 
 @pytest.fixture(scope="module")
@@ -128,7 +131,7 @@ def test_sigkill_of_the_recorder_leaves_a_file_review_reads_and_calls_truncated(
     assert r.returncode == 0, r.stderr
     review = json.loads(r.stdout)
     assert review["truncated"] and not review["complete"]
-    assert 50 <= review["ticks"] < 12000
+    assert 50 <= review["ticks"] < 2 * LONG_HALF * 50  # dt 0.02 s: cut before the last tick
     human = subprocess.run([*ARENA, "review", str(path)], capture_output=True, text=True, timeout=120)
     assert human.returncode == 0 and "truncated" in human.stdout
 

@@ -13,8 +13,9 @@ import pytest
 from tests.integration.helpers import ARENA, arena_json, cmdline, descendants, spawn, wait_for
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "3", "--half-time", "2", "--seed", "5", "--jobs", "1")
-# One process plays a match of 2 x 2 s in a blink: long enough to be interrupted in the middle.
-INPROCESS = ("--engine", "inprocess", "--half-time", "60")
+# One process plays a match of 2 x 2 s in a blink; 2 x 20 s takes it about a second, so the
+# signal sent once the first match is in lands in the second or third (the test polls every 50 ms).
+INPROCESS = ("--engine", "inprocess", "--half-time", "20")
 
 
 @pytest.mark.parametrize(

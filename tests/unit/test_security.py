@@ -108,6 +108,20 @@ def test_the_mac_is_keyed_blake2b_over_key_nul_payload():
     assert ring.verifier("robot/a/1", "arena/m/summary/robot/a/1") is None  # no key: accepted as before
 
 
+def test_a_signer_and_a_verifier_reused_frame_after_frame_give_exactly_tag():
+    """They hash the key and the key expression once and copy that state per frame: no state may leak
+    from one frame into the next, and each stays bound to its own key expression."""
+    key = bytes(range(32))
+    ring = Keyring("engine", {"engine": key})
+    sign = ring.signer("arena/m/engine/events")
+    ok = ring.verifier("engine", "arena/m/engine/events")
+    other = ring.signer("arena/m/world")
+    for payload in (b"", b"\x82", b"\x82" * 5000, b"\x00\x01", b""):
+        assert sign(payload) == tag(key, "arena/m/engine/events", payload)
+        assert other(payload) == tag(key, "arena/m/world", payload) != sign(payload)
+        assert ok(payload, sign(payload)) and not ok(payload, other(payload)) and not ok(payload + b"x", sign(payload))
+
+
 def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_read_them():
     key = f"{P}operator"
     puts = {p for p in principals(NAMES) if key in permissions(p, P, 3).get("put/ingress", [])}
