@@ -141,8 +141,9 @@ class FoxgloveClient:
         """Client message data: opcode 0x01, the channel id, the payload."""
         self.ws.send(struct.pack("<BI", 0x01, channel_id) + payload)
 
-    def messages(self, seconds: float):
-        """Yield (topic, log time, payload) for `seconds`, or until the server closes."""
+    def messages(self, seconds: float, until=None):
+        """Yield (topic, log time, payload) for `seconds`, or until the server closes, or until
+        `until()` holds after a frame has been handled (a `parameterValues` reply, say)."""
         end = time.monotonic() + seconds
         while (left := end - time.monotonic()) > 0:
             try:
@@ -153,6 +154,8 @@ class FoxgloveClient:
                 return
             if got is not None:
                 yield got
+            if until is not None and until():
+                return
 
     def close(self) -> None:
         self.ws.close()

@@ -144,3 +144,18 @@ def wait_until_playing(endpoint: str, match: str, timeout: float = 60.0) -> None
         referee = session.declare_subscriber(f"arena/{match}/referee", zenoh.handlers.FifoChannel(1000))
         wait_for(lambda: referee.try_recv(), timeout, "the match to start")
         referee.undeclare()
+
+
+def wait_until_joined(endpoint: str, match: str, process: str, timeout: float = 60.0) -> None:
+    """Block until `process` (e.g. robot/a/1) holds its liveliness token in the match."""
+    import zenoh
+
+    from arena.runtime.session import NetConfig, open_session
+    from arena.schemas.keys import Keys
+
+    with open_session(NetConfig(mode="client", connect=(endpoint,))) as session:
+        token = session.liveliness().declare_subscriber(
+            Keys(match).alive(process), zenoh.handlers.FifoChannel(16), history=True
+        )
+        wait_for(lambda: token.try_recv(), timeout, f"{process} to join")
+        token.undeclare()

@@ -21,8 +21,30 @@ def seed7_logs(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def seed7(seed7_logs):
-    return arena_json(*BASE, "--seed", "7", "--logs", str(seed7_logs))
+def seed7_watched(seed7_logs):
+    """The seed-7 match, every process's log kept, with /proc watched while it runs:
+    (its JSON, the `arena run` pids seen alive at once, their kinds)."""
+    proc = spawn(*BASE, "--seed", "7", "--logs", str(seed7_logs), "--json")
+    try:
+
+        def running():
+            pids = {p for p in descendants(proc.pid) if " -m arena run " in cmdline(p)}
+            return pids if len(pids) == 10 else None
+
+        seen = wait_for(running, 60, "ten live `arena run` processes")
+        kinds = sorted(cmdline(p).split(" -m arena run ")[1].split()[0] for p in seen)
+        out, err = proc.communicate(timeout=240)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    return json.loads(out), seen, kinds
+
+
+@pytest.fixture(scope="module")
+def seed7(seed7_watched):
+    return seed7_watched[0]
 
 
 def test_a_clean_match_logs_no_traceback(seed7, seed7_logs):
@@ -33,20 +55,9 @@ def test_a_clean_match_logs_no_traceback(seed7, seed7_logs):
         assert "Traceback" not in log.read_text(), f"{log.name}:\n{log.read_text()[-2000:]}"
 
 
-def test_every_process_is_its_own_live_os_process(reap):
+def test_every_process_is_its_own_live_os_process(seed7_watched):
     """Watch /proc while the match runs: ten `arena run` processes, all alive at once."""
-    proc = spawn(*BASE, "--seed", "7", "--json")
-    reap.append(proc)
-
-    def running():
-        pids = {p for p in descendants(proc.pid) if " -m arena run " in cmdline(p)}
-        return pids if len(pids) == 10 else None
-
-    seen = wait_for(running, 60, "ten live `arena run` processes")
-    kinds = sorted(cmdline(p).split(" -m arena run ")[1].split()[0] for p in seen)
-    out, err = proc.communicate(timeout=240)
-    assert proc.returncode == 0, err
-    result = json.loads(out)
+    result, seen, kinds = seed7_watched
     reported = {p["pid"] for p in result["processes"]}
     assert reported == seen, "the JSON's pids are the processes seen running"
     assert kinds == ["basestation"] * 2 + ["engine", "referee"] + ["robot"] * 6
@@ -109,10 +120,13 @@ def test_congested_wifi_drops_at_the_preset_rate(seed7):
 
 
 def test_realtime_paces_to_the_wall_clock():
+    """4 s of play, held to the same 20 % (0.8 s either way): an unpaced match (200 ticks take well
+    under a second) fails, as does one paced more than 20 % too fast or too slow."""
     t0 = time.monotonic()
-    r = arena_json("match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "5", "--seed", "1")
+    r = arena_json("match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "1")
     wall = time.monotonic() - t0
-    assert r["play_wall_seconds"] == pytest.approx(10.0, rel=0.20)
+    assert r["ticks"] == 200 and r["sim_seconds"] == pytest.approx(4.0)
+    assert r["play_wall_seconds"] == pytest.approx(4.0, rel=0.20)
     assert r["rtf"] == pytest.approx(1.0, rel=0.20)
-    assert wall < 10.0 * 1.2 + 6.0, "start-up should add seconds, not more"
+    assert wall < 4.0 * 1.2 + 6.0, "start-up should add seconds, not more"
     assert r["events"]["END_GAME"] == 1

@@ -15,6 +15,7 @@ import socket
 import subprocess
 import threading
 import time
+from subprocess import PIPE
 
 from mcap.reader import make_reader
 
@@ -131,7 +132,7 @@ def in_order(seq: list, wanted: list) -> bool:
 def test_two_base_stations_in_a_realtime_match(tmp_path):
     port = free_port()
     mcap_path = tmp_path / "match.mcap"
-    args = ["match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "5", "--seed", "4"]
+    args = ["match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "4"]
     args += ["--refbox", f"tcp/127.0.0.1:{port}", "--refbox-protocol", "b=legacy", "--refbox-wait", "2"]
     args += ["--record", str(mcap_path), "--json"]
     match = subprocess.Popen([*ARENA, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -170,7 +171,8 @@ def test_two_base_stations_in_a_realtime_match(tmp_path):
     assert result["refbox"]["worldstate_errors"]["a"] == bad
     for reason, n in bad.items():
         assert result["rejected_reasons"][f"worldstate-{reason}"] == n
-    assert cyan.sent["good"] >= 50 and result["ticks"] == 500
+    # 4 s of play at 10 Hz: about 40 sent, 30 of them good (the bad ones come at n = 3, 4, 7, 14, 17, ...)
+    assert cyan.sent["good"] >= 20 and result["ticks"] == 200
 
     # The good ones are in the MCAP, on team a's channel.
     with open(mcap_path, "rb") as f:
@@ -178,14 +180,17 @@ def test_two_base_stations_in_a_realtime_match(tmp_path):
     assert topics.count("refbox/a/worldstate") == cyan.sent["good"]
     assert topics.count("refbox/b/worldstate") == 0
 
-    review = subprocess.run([*ARENA, "review", str(mcap_path)], capture_output=True, text=True, timeout=120)
-    assert review.returncode == 0, review.stderr
-    assert "worldstate accuracy, team a" in review.stdout and "team b (" not in review.stdout
+    # The table and the JSON: two `arena review` processes at once.
+    reviews = [
+        subprocess.Popen([*ARENA, "review", str(mcap_path), *flag], stdout=PIPE, stderr=PIPE, text=True)
+        for flag in ((), ("--json",))
+    ]
+    (table, table_err), (as_json, json_err) = (r.communicate(timeout=120) for r in reviews)
+    assert [r.returncode for r in reviews] == [0, 0], table_err + json_err
+    assert "worldstate accuracy, team a" in table and "team b (" not in table
     for row in ("robot 0 position", "robot 2 heading", "ball position", "ageMs", "recall", "precision"):
-        assert row in review.stdout, row
-    scored = json.loads(
-        subprocess.run([*ARENA, "review", str(mcap_path), "--json"], capture_output=True, text=True, timeout=120).stdout
-    )["worldstate_accuracy"]["a"]
+        assert row in table, row
+    scored = json.loads(as_json)["worldstate_accuracy"]["a"]
     assert scored["worldstates"] == cyan.sent["good"] and scored["age_ms"]["max"] <= 22
 
 

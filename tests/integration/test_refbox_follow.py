@@ -57,8 +57,8 @@ class FakeRefBox(threading.Thread):
         with conn:
             try:
                 conn.sendall(json.dumps({"command": "WELCOME", "targetTeam": CYAN}).encode() + b"\0")
-                for command, target in SCRIPT:
-                    time.sleep(0.1)
+                for command, target in SCRIPT:  # 0.7 s in all: well inside the match's 2 s
+                    time.sleep(0.05)
                     conn.sendall(json.dumps({"command": command, "targetTeam": target}).encode() + b"\0")
             except OSError:
                 return  # the check's connection, closed at once
@@ -70,7 +70,7 @@ def test_refbox_follow_plays_the_scripted_commands(tmp_path):
     refbox.start()
     path = tmp_path / "follow.mcap"
     result = arena_json(
-        *("match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "5"),
+        *("match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "1", "--seed", "5"),
         *("--refbox-follow", f"127.0.0.1:{refbox.port}", "--record", str(path)),
     )
     assert refbox.peer == "127.0.0.1"
@@ -104,7 +104,7 @@ def test_an_unreachable_refbox_is_said_before_the_match_plays_and_voids_it():
     """It was silent while the match played, said `never connected` only in the report, and exited 0."""
     port = free_port()
     match = subprocess.Popen(
-        [*ARENA, "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "5",
+        [*ARENA, "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "1", "--seed", "5",
          "--refbox-follow", f"127.0.0.1:{port}", "--json"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip

@@ -10,16 +10,16 @@ from __future__ import annotations
 
 import json
 import subprocess
-import time
 
 from tests.integration.foxglove_client import FoxgloveClient, log_entry, scene_entities
-from tests.integration.helpers import ARENA, arena_json, free_ports
+from tests.integration.helpers import ARENA, free_ports, spawn, wait_until_joined
 
 ROBOTS = {f"robot/{t}/{n}" for t in "ab" for n in range(3)}
 
 
 def start_live(reap: list, match: str, *flags: str):
-    """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1).
+    """`arena match ... --live PORT --external a/1` in the background; returns (popen, ws url, start robot a/1,
+    the match's router endpoint).
 
     Both processes go on `reap` (conftest.py), which kills and reaps what a failed test left running."""
     port, zport = free_ports(2)
@@ -40,7 +40,7 @@ def start_live(reap: list, match: str, *flags: str):
         reap.append(robot := subprocess.Popen(robot_argv, stderr=subprocess.DEVNULL))
         return robot
 
-    return proc, f"ws://127.0.0.1:{port}", start_robot
+    return proc, f"ws://127.0.0.1:{port}", start_robot, endpoint
 
 
 def connect(url: str, proc: subprocess.Popen) -> FoxgloveClient:
@@ -63,7 +63,7 @@ def finish(proc: subprocess.Popen, robot: subprocess.Popen | None) -> dict:
 
 def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command(reap):
     # --secure: the viewer is the read-only `viewer` principal of the match's access control
-    proc, url, start_robot = start_live(reap, "viewer-rt", "--realtime", "--half-time", "5", "--secure")
+    proc, url, start_robot, _ = start_live(reap, "viewer-rt", "--realtime", "--half-time", "3", "--secure")
     client = connect(url, proc)
     assert {"/scene", "/referee_log", "/match"} <= set(client.channels)
     assert client.channels["/scene"]["schemaName"] == "foxglove.SceneUpdate"
@@ -84,8 +84,10 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command(r
             last_match = json.loads(payload)
     client.close()
     result = finish(proc, robot)
-    assert result["realtime"] and result["ticks"] == 500
-    assert full >= 40, f"only {full} complete scene updates"
+    assert result["realtime"] and result["ticks"] == 300
+    # 6 s of play at up to SCENE_HZ (30) updates a second from a viewer that runs behind the match's
+    # processes (lower_priority): at least 4 a second come through, as 40 in 10 s did
+    assert full >= 24, f"only {full} complete scene updates"
     assert beliefs == {"seen", "p_ball"}, "the robots' perceived ball and the base stations' P_ball are drawn"
     commands = sum(result["events"].values())
     assert len(referee_logs) == commands, (referee_logs, result["events"])
@@ -94,25 +96,43 @@ def test_live_realtime_match_streams_the_scene_and_one_log_per_referee_command(r
     assert last_match["stage"] == "END_GAME"
 
 
+def tick_of(payload: bytes) -> int:
+    return json.loads(payload)["tick"]
+
+
 def test_pause_step_resume_over_the_protocol_keeps_the_digest(reap):
-    reference = arena_json("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--seed", "5")
-    proc, url, start_robot = start_live(reap, "viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0")
+    # The reference plays meanwhile: the live match stands paused most of the time.
+    reference = spawn("match", "--home", "BS", "--away", "BS", "--half-time", "2", "--seed", "5", "--json")
+    reap.append(reference)
+    proc, url, start_robot, endpoint = start_live(
+        reap, "viewer-pause", "--half-time", "2", "--seed", "5", "--pace", "0"
+    )
     client = connect(url, proc)
     assert "parameters" in client.info["capabilities"]
     client.subscribe("/match")
     client.set_parameters(paused=True)
-    time.sleep(0.3)
-    robot = start_robot()  # the match starts, and holds before tick 0
-    held = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+    held = [tick_of(p) for _, _, p in client.messages(60, until=lambda: client.parameters.get("paused") is True)]
+    assert client.parameters.get("paused") is True, "the viewer answered the pause"
+    robot = start_robot()
+    wait_until_joined(endpoint, "viewer-pause", "robot/a/1")  # the match starts, and holds before tick 0
+    held += [tick_of(p) for _, _, p in client.messages(1.0)]  # unpaced, a match that plays shows ticks at once
     assert held == [], f"the engine played while paused: {held[-3:]}"
     client.set_parameters(step=10)  # ticks 0..9
-    stepped = [json.loads(p)["tick"] for _, _, p in client.messages(3.0)]
+    stepped = []
+    for _, _, p in client.messages(60):
+        stepped.append(tick_of(p))
+        if stepped[-1] >= 9:
+            break
+    stepped += [tick_of(p) for _, _, p in client.messages(1.0)]  # and no tick after 9 comes
     assert stepped and max(stepped) == 9, stepped[-5:]
     assert client.parameters.get("paused") is True
     client.set_parameters(paused=False)
-    after = [json.loads(p)["tick"] for _, _, p in client.messages(60)]
+    after = [tick_of(p) for _, _, p in client.messages(60)]
     client.close()
     result = finish(proc, robot)
+    out, err = reference.communicate(timeout=120)
+    assert reference.returncode == 0, err[-3000:]
+    reference = json.loads(out)
     # unpaced, the viewer shows at most SCENE_HZ frames a second, and a late world frame may be dropped
     assert after and 10 < after[-1] <= result["ticks"] == reference["ticks"]
     assert result["digest"] == reference["digest"]
