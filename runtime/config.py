@@ -29,6 +29,7 @@ MAX_PERCEPTION_LATENCY = 25  # [ticks] 0.5 s at 50 Hz: far beyond any real visio
 MAX_DT = 0.1  # [s] a control tick of at most 100 ms (10 Hz): slower is no robot's control loop
 MAX_SUBSTEPS = 100  # physics steps per tick
 MAX_PERIOD_S = 1.0  # [s] the Wi-Fi, referee and world periods: slower plays no recognisable match
+MIN_LEASE, MAX_LEASE = 0.5, 600.0  # [s] zenoh's keep-alive goes out every quarter lease: not faster than 125 ms
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
@@ -175,6 +176,13 @@ class TimingParams:
     # is alive but silent. Long, because everyone downstream of a stalled peer
     # waits too and must not be taken for dead.
     wait_timeout: float = 60.0
+    # The zenoh link lease of every process that opens its session knowing this configuration
+    # (runtime/session.py): a hung process's liveliness token vanishes this long after it was
+    # last heard. 2 s lost healthy peers on an overloaded host; 0.5 s at least.
+    lease: float = 6.0  # [s] wall: a process unheard this long (SIGSTOP, power loss, cut cable) is gone
+    # `arena match` waits for every summary (a summary is put again for up to 5 s until acknowledged).
+    summary_grace: float = 6.0  # [s] wall: for the summary of a process that exited or whose token vanished
+    finish_grace: float = 10.0  # [s] wall: for the last summary, once every other process has sent its own
 
     def frames_per_message(self, realtime: bool = False) -> int:
         """`sense`/`cmd` frames per message: `batch`, or L when 0; always 1 in real time.
@@ -362,10 +370,12 @@ class MatchConfig:
                 f"--batch must be 0 (auto) or 1..{max(1, t.perception_latency)} (at most the perception "
                 f"latency, else the engine and the robots would wait for each other), got {t.batch}"
             )
-        for name in ("startup_timeout", "wait_timeout"):
+        for name in ("startup_timeout", "wait_timeout", "summary_grace", "finish_grace"):
             value = getattr(t, name)
             if not (math.isfinite(value) and value > 0):
                 raise ConfigError(f"timing.{name} must be a finite number of seconds > 0, got {value}")
+        if not (math.isfinite(t.lease) and MIN_LEASE <= t.lease <= MAX_LEASE):
+            raise ConfigError(f"timing.lease must be {MIN_LEASE:g} to {MAX_LEASE:g} s, got {t.lease}")
         if self.robot.model not in ("omni4", "omni3"):
             raise ConfigError(f"robot.model must be omni4 or omni3, got {self.robot.model!r}")
         if not 0 <= self.seed < 2**63:

@@ -18,7 +18,9 @@ token vanishes within milliseconds, a hung one's (SIGSTOP, power loss, cut
 cable) when its lease expires. The lease is 6 s instead of zenoh's 10 s; keep-
 alives only flow on links that carry nothing else, so the lockstep traffic
 pays nothing for it. A 2 s lease lost healthy peers on an overloaded host
-(docs/performance.md, "Measurements behind design choices").
+(docs/performance.md, "Measurements behind design choices"). A match's
+`timing.lease` sets it for every process that opens its session knowing the
+configuration (`arena match`'s router and children, `arena run --config`).
 """
 
 from __future__ import annotations
@@ -95,6 +97,7 @@ class NetConfig:
     multicast: bool = False  # multicast scouting; off keeps matches apart
     extra: tuple[tuple[str, str], ...] = field(default=())  # (json5 path, json5 value) from --cfg
     base: str = ""  # a credentials fragment (JSON), the starting point (runtime/credentials.py)
+    lease: float = 6.0  # [s] the link lease: unheard this long, a peer is gone (the match's `timing.lease`)
 
     def zenoh_config(self) -> zenoh.Config:
         c = zenoh.Config.from_json5(self.base) if self.base else zenoh.Config()
@@ -107,7 +110,7 @@ class NetConfig:
             # open a direct link to us; nothing outside this machine can.
             listen = ["tcp/127.0.0.1:0"]
         c.insert_json5("listen/endpoints", json.dumps(listen))
-        c.insert_json5("transport/link/tx/lease", "6000")
+        c.insert_json5("transport/link/tx/lease", str(round(self.lease * 1000)))
         c.insert_json5("transport/link/tx/keep_alive", "4")
         if self.mode == "router" and not self.multicast and not self.connect:
             # zenoh 1.10 starts a router with a plain sleep of `scouting/delay` (500 ms by

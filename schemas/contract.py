@@ -341,7 +341,7 @@ stopped for that tick, not the match.
 fields: `seed`, `robots` (per team, goalkeeper 0 included), `home`, `away`
 (strategy names), `half_time` [s], `timing` (`dt` [s], `comm_period`,
 `referee_period`, `world_period`, `perception_latency`, `batch` [ticks],
-`wait_timeout`, `startup_timeout` [s], `substeps`), `robot` (`model`, `wheel_base`, `wheel_radius`,
+`wait_timeout`, `startup_timeout`, `lease`, `summary_grace`, `finish_grace` [s], `substeps`), `robot` (`model`, `wheel_base`, `wheel_radius`,
 `max_wheel_speed`, `max_speed`, `max_omega`, `kick_max_speed`, ... in SI
 units), `field` (geometry, as in FieldSpec), `ball`, `sensor`, `rules`,
 `link` and `link_overrides` (the link emulation), `external`, `realtime`,

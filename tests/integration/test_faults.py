@@ -215,18 +215,24 @@ def test_a_strategy_that_returns_nan_every_100_ticks_plays_to_the_end(reap, tmp_
     assert "out-of-sequence" not in result["rejected_reasons"]
 
 
-def test_a_robot_stopped_for_10_s_alone_is_blamed(reap, tmp_path):
-    """Issue 20: SIGSTOP robot a/1 for 10 s. It used to list engine and basestation/a as dead too."""
+def test_a_robot_stopped_beyond_its_lease_alone_is_blamed(reap, tmp_path):
+    """Issue 20: SIGSTOP robot a/1 for 10 s. It used to list engine and basestation/a as dead too.
+
+    10 s was 1.7 times the 6 s lease; here the match's `timing.lease` is 3 s (a --config file) and
+    the robot is stopped for twice that, so every peer's lease on it expires well before it resumes."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     mcap = tmp_path / "stop10.mcap"
-    proc = spawn(*MATCH, "--half-time", "60", "--seed", "3", "--match", "stop10", "--listen", endpoint,
-                 "--record", str(mcap))  # fmt: skip
+    config = tmp_path / "quick.toml"
+    lease = 3.0
+    config.write_text(f"[timing]\nlease = {lease}\n")
+    proc = spawn(*MATCH, "--config", str(config), "--half-time", "60", "--seed", "3", "--match", "stop10",
+                 "--listen", endpoint, "--record", str(mcap))  # fmt: skip
     reap.append(proc)
     victim = child(proc.pid, "--team a --robot 1")
     wait_for_tick(endpoint, "stop10", 1000, proc)
     os.kill(victim, signal.SIGSTOP)
     try:
-        proc.wait(10)
+        proc.wait(2 * lease)
     except subprocess.TimeoutExpired:
         pass
     os.kill(victim, signal.SIGCONT)
@@ -285,10 +291,13 @@ sys.exit(main(sys.argv[1:]))
 
 
 def test_an_external_robot_that_never_sends_its_summary_is_named_within_the_bound(reap, tmp_path):
-    """Issue 20: `arena match` used to wait for it forever."""
+    """Issue 20: `arena match` used to wait for it forever. The bound is `timing.finish_grace` (10 s by
+    default), set shorter from a --config file."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    proc = spawn(*MATCH, "--half-time", "10", "--seed", "4", "--match", "mute", "--listen", endpoint,
-                 "--external", "a/1")  # fmt: skip
+    config = tmp_path / "quick.toml"
+    config.write_text("[timing]\nfinish_grace = 2.0\n")
+    proc = spawn(*MATCH, "--config", str(config), "--half-time", "10", "--seed", "4", "--match", "mute",
+                 "--listen", endpoint, "--external", "a/1")  # fmt: skip
     reap.append(proc)
     # Start it with the command the launcher prints (its credentials included), through the patched main.
     line = ""
@@ -300,7 +309,7 @@ def test_an_external_robot_that_never_sends_its_summary_is_named_within_the_boun
     code, result, err = finish(proc, 120)
     assert code == 0, err
     [fault] = result["faults"]
-    assert fault["process"] == "robot/a/1" and "sent no summary within 10 s" in fault["reason"]
+    assert fault["process"] == "robot/a/1" and "sent no summary within 2 s" in fault["reason"]
     assert result["outcome"] == "completed_with_faults" and result["ticks"] == 1000
     assert result["distance_m"]["a/1"] > 0.5, "it did play"
     assert "fault: robot/a/1" in err

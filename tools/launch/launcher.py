@@ -221,7 +221,8 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 job = run_job(p, match, connect, str(cfg_path), record, live_host, str(cred_paths[str(p)]))
                 log_path = logs / (str(p).replace("/", "_") + ".log")
                 children.append(Child(str(p), p, starter.fork(job, log_path), log_path))  # type: ignore[arg-type]
-        with open_router(NetConfig(mode="router", listen=(endpoint,), extra=router_extra), listen) as session:
+        router_net = NetConfig(mode="router", listen=(endpoint,), extra=router_extra, lease=cfg.timing.lease)
+        with open_router(router_net, listen) as session:
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
             watch_spoofing(transport, keys, announce)

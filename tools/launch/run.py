@@ -145,6 +145,8 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     except (ConfigError, ValueError) as exc:
         print(f"arena run: error: {exc}", file=sys.stderr)
         return 2
+    if cfg is not None:  # known before the session opens: its lease is the match's
+        net = dataclasses.replace(net, lease=cfg.timing.lease)
     timeout = job.startup_timeout if job.startup_timeout is not None else 60.0
     host = job.host or "127.0.0.1"
     return main_guarded(

@@ -135,24 +135,18 @@ def watch_spoofing(transport: ZenohTransport, keys: Keys, announce) -> None:
 RING = 1024
 
 
-# [s] a process whose liveliness token vanished, or that exited, gets this long
-# for its summary to arrive (a summary is re-sent for up to 5 s until acked).
-SUMMARY_GRACE = 6.0
-# [s] once every other process has finished, the last ones must finish within this.
-FINISH_GRACE = 10.0
-
-
 def supervision_deadline(cfg: MatchConfig) -> float:
     """[s] wall: the longest a whole match may take before the launcher gives up.
 
     Start-up (`startup_timeout`), the match at a real-time factor of at least
     0.2 in lockstep (1 in real time), one last-resort watchdog wait
-    (`wait_timeout`) and the summaries' grace. 2 x 60 s in lockstep: 30 + 600 +
-    60 + 16 = 706 s; the typical match takes a tenth of that.
+    (`wait_timeout`) and the summaries' grace (`summary_grace`, `finish_grace`).
+    2 x 60 s in lockstep: 30 + 600 + 60 + 16 = 706 s; the typical match takes a
+    tenth of that.
     """
     t = cfg.timing
     play = cfg.total_ticks * t.dt * (1.0 if cfg.realtime else 5.0)
-    return t.startup_timeout + play + t.wait_timeout + SUMMARY_GRACE + FINISH_GRACE
+    return t.startup_timeout + play + t.wait_timeout + t.summary_grace + t.finish_grace
 
 
 def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way a process can end
@@ -202,6 +196,8 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
     by_name = {c.name: c for c in children}
     exit_seen: dict[str, float] = {}
     engine_done = last_summary = 0.0
+    # [s] a process whose liveliness token vanished, or that exited, gets this long for its summary.
+    grace = cfg.timing.summary_grace
 
     def fail(name: str, why: str, into: dict[str, str]) -> None:
         c = by_name.get(name)
@@ -274,9 +270,9 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
                     seen = exit_seen.setdefault(name, now)
                     if code != 0:
                         fail(name, exit_reason(code), got.crashed)
-                    elif now - seen > SUMMARY_GRACE:
+                    elif now - seen > grace:
                         fail(name, "exited without a summary", got.crashed)
-                elif name in gone_at and now - gone_at[name] > SUMMARY_GRACE:
+                elif name in gone_at and now - gone_at[name] > grace:
                     what = "stopped responding" if c is not None else "left"
                     fail(name, f"{what}: its liveliness token vanished before its summary", got.lost)
             left = waiting - set(got.summaries)
@@ -284,7 +280,8 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
                 # The engine has played its last tick. A process that alone is still
                 # missing has every input it will ever get; several may wait on each
                 # other, at worst for one last-resort watchdog wait.
-                bound = FINISH_GRACE if len(left) == 1 else cfg.timing.wait_timeout + FINISH_GRACE
+                finish = cfg.timing.finish_grace
+                bound = finish if len(left) == 1 else cfg.timing.wait_timeout + finish
                 if now - max(engine_done, last_summary) > bound:
                     for name in sorted(left):
                         fail(name, f"sent no summary within {bound:g} s of the match's end", got.missing)
