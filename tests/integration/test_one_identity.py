@@ -41,26 +41,28 @@ def test_a_robot_started_before_the_match_without_its_file_is_refused_at_connect
         "arena run: error: refused by match 'early': match 'early' needs robot/a/1's own --credentials file "
         "(every frame of its processes is authenticated): start it with the command arena match printed"
     )
-    # A typo in --match is told with the match the router does host.
-    typo = subprocess.run(
+    # A typo in --match is told with the match the router does host. It waits out its 2 s while
+    # a second engine started by hand (the match's own is running) is refused too (issue 36).
+    typo = subprocess.Popen(
         [*ARENA, "run", "robot", "--match", "eraly", "--team", "a", "--robot", "1", "--connect", sock]
         + ["--startup-timeout", "2"],
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
         text=True,
-        timeout=120,
     )
-    assert typo.returncode == 2, typo.stderr
-    assert typo.stderr.strip().splitlines()[-1] == (
-        f"arena run: error: gave up after 2 s waiting for match 'eraly' to start at {sock}; "
-        "the router hosts match 'early'"
-    ), typo.stderr
-    # A second engine started by hand (the match's own is running) is refused too (issue 36).
+    reap.append(typo)
     engine = subprocess.run(
         [*ARENA, "run", "engine", "--match", "early", "--connect", sock, "--home", "BS", "--away", "BS"],
         capture_output=True,
         text=True,
         timeout=120,
     )
+    typo_err = typo.communicate(timeout=120)[1]
+    assert typo.returncode == 2, typo_err
+    assert typo_err.strip().splitlines()[-1] == (
+        f"arena run: error: gave up after 2 s waiting for match 'eraly' to start at {sock}; "
+        "the router hosts match 'early'"
+    ), typo_err
     assert engine.returncode == 2, engine.stderr
     assert "engine is already running in match 'early' (started by arena match, pid" in engine.stderr, engine.stderr
     robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)

@@ -267,6 +267,8 @@ def record_path(text: str, fresh: bool = False) -> str:
 
 
 REFUSED_AFTER = 6.0  # [s] listening but not connected this long is a refusal: zenoh retries a connect every <= 4 s
+ROUTER_RETRY_S = 0.25  # [s] wall: pause between attempts to reach a router that is not there yet
+REFUSED_TWICE_S = 1.0  # [s] wall: a router refusing us this long after its first refusal is not one still starting
 
 
 def refused_by(connect: tuple[str, ...]) -> str | None:
@@ -353,14 +355,15 @@ def hosted_elsewhere(session, keys: Keys) -> str:
 def open_until(net: NetConfig, timeout: float, where: str, tell, refused):
     """Open the session; a client retries until `timeout` while no router answers at its endpoint.
 
-    A router that listens and refuses us twice, 1 s apart (not one still starting), is a
-    refusal with its cause (`refused(ep)`), unless it takes us without the password of a
-    credentials file provisioned once (a plain match's router)."""
+    A router that listens and refuses us twice, REFUSED_TWICE_S apart (not one still starting),
+    is a refusal with its cause (`refused(ep)`), unless it takes us without the password of a
+    credentials file provisioned once (a plain match's router). Attempts are ROUTER_RETRY_S
+    apart, so a process started before its router connects within that of the router's start."""
     for ep in net.connect:
         check_endpoint("--connect", ep)
     deadline = time.monotonic() + timeout
     told = False
-    refused_once = False
+    refused_since: float | None = None  # the first refusal of this run of refusals
     while True:
         try:
             return open_session(net)
@@ -378,17 +381,18 @@ def open_until(net: NetConfig, timeout: float, where: str, tell, refused):
                     else:
                         tell(f"{ep} is not a secure match's router: connected without the password")
                         return session
-                if refused_once:  # twice in a row, 1 s apart: not a router still starting
-                    raise refused(ep) from None
-                refused_once = True
+                now = time.monotonic()
+                if refused_since is not None and now - refused_since >= REFUSED_TWICE_S:
+                    raise refused(ep) from None  # refused all along: not a router still starting
+                refused_since = refused_since if refused_since is not None else now
             else:
-                refused_once = False
-            if time.monotonic() + 1.0 > deadline:
+                refused_since = None
+            if time.monotonic() + ROUTER_RETRY_S > deadline:
                 raise StartupError(f"gave up after {timeout:g} s: no router at {where}") from None
             if not told and ep is None:
                 tell(f"waiting: no router at {where} (retrying for up to {timeout:g} s)")
                 told = True
-            time.sleep(1.0)
+            time.sleep(ROUTER_RETRY_S)
 
 
 def with_policy(cfg: MatchConfig, team: str, policy: str) -> MatchConfig:
