@@ -20,6 +20,7 @@ Two shapes of process:
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import gc
 import hashlib
@@ -27,7 +28,7 @@ import logging
 import os
 import threading
 import time
-from collections.abc import Callable, Generator
+from collections.abc import Callable, Generator, Iterator
 from typing import Any, TypeVar
 
 from arena.runtime import seeds
@@ -49,10 +50,30 @@ M = TypeVar("M", bound=msgs.Base)
 def settle_heap() -> None:
     """Everything built so far lives for the whole match: keep it out of the
     collector's way (the tick loop allocates only short-lived, acyclic objects
-    that reference counting frees)."""
+    that reference counting frees). A process of its own calls it before its first tick."""
     gc.collect()
     gc.freeze()
     gc.set_threshold(50_000, 50, 100)
+
+
+@contextlib.contextmanager
+def match_heap() -> Iterator[None]:
+    """`settle_heap` for a match played among its caller's objects (the in-process engine).
+
+    The caller's heap is frozen as it is, after a young collection only: a full one scanned all
+    of it before every match, ~40 ms in a process with matplotlib loaded, a fifth of a 2 x 4 s
+    match. The match's own objects are built after the freeze and stay the collector's, so one
+    full collection at the end, which scans only them, frees the cycles the match leaves; then
+    the caller's heap is the collector's again.
+    """
+    gc.collect(1)
+    gc.freeze()
+    gc.set_threshold(50_000, 50, 100)
+    try:
+        yield
+    finally:
+        gc.collect()
+        gc.unfreeze()
 
 
 class StartupError(RuntimeError):
@@ -195,9 +216,9 @@ class Peer:
         """`play`, as a generator: it yields the waits of a cooperative driver's loop (runtime/coop.py
         `play`); under a blocking driver it yields nothing. Returns the Summary."""
         try:
-            if not self.cooperative:
+            if not self.cooperative:  # under the cooperative driver its runner settles the heap (`match_heap`)
                 self.barrier()
-            settle_heap()
+                settle_heap()
             self.play_started = time.time()
             t0 = time.perf_counter()
             yield from self.loop()

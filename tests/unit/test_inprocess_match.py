@@ -113,3 +113,18 @@ def test_ctrl_c_in_process_leaves_a_whole_recording_that_says_it_was_stopped(tmp
         inprocess._play(MatchConfig(half_time=1.0, home="BS", away="BS"), (), record=str(path))
     rec = load(str(path))
     assert not rec.truncated and rec.meta["recording"]["interrupted"] == "SIGINT"
+
+
+def test_a_match_collects_its_own_cycles_and_leaves_nothing_frozen(monkeypatch):
+    """The caller's heap is frozen without a full collection before the match (runtime/node.py
+    `match_heap`); the cycles the match leaves are collected as it returns, and nothing stays frozen."""
+    import gc
+
+    full = []
+    collect = gc.collect
+    collect()  # the caller's garbage so far: frozen with the caller's heap, not the match's to collect
+    monkeypatch.setattr(gc, "collect", lambda generation=2: full.append(generation) or collect(generation))
+    play_in_process(MatchConfig(seed=1, half_time=0.5), watch=())
+    assert full == [1, 2], "one young collection before, one full collection (of the match's objects) after"
+    assert gc.get_freeze_count() == 0
+    assert collect() == 0, "the match's cycles were collected as it returned"

@@ -17,7 +17,6 @@ MCAP message records as the distributed recorder.
 
 from __future__ import annotations
 
-import gc
 import os
 import time
 from typing import TYPE_CHECKING
@@ -26,7 +25,7 @@ from arena.processes import node_class
 from arena.runtime import coop
 from arena.runtime.config import MatchConfig
 from arena.runtime.coop import CoopBus, NodeFailed, Task
-from arena.runtime.node import killed_at
+from arena.runtime.node import killed_at, match_heap
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
 
@@ -43,6 +42,11 @@ class InprocessError(RuntimeError):
 
 def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     """`record`: the recorder's MCAP path ("" for none); the other nodes get only `cfg.tap`."""
+    with match_heap():  # a worker plays many matches: what this one leaves is collected as it returns
+        return _play_here(cfg, watch, record)
+
+
+def _play_here(cfg: MatchConfig, watch: tuple[str, ...], record: str):
     cfg = cfg.replace(tap=bool(record))
     bus = CoopBus()
     keys = Keys("inprocess")
@@ -76,7 +80,6 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
     if recorder is not None:
         recorder.finish()
         summaries["recorder"] = recorder.conclude()
-    gc.unfreeze()  # a worker plays many matches: let this one's objects go
     frames = {}
     for name, ch in taps.items():
         got = []
