@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
@@ -37,6 +38,13 @@ def tournament(*extra: str) -> tuple[str, ...]:
     return ("tournament", "--legs", "1", "--half-time", "10", "--seed", "3", *extra)
 
 
+def at_once(*commands: tuple[str, ...]) -> list[dict]:
+    """`arena_json` of each command, all running at the same time (each is its own `arena` process,
+    and much of a Ray tournament is waiting on Ray); the results in the order given."""
+    with ThreadPoolExecutor(max_workers=len(commands)) as pool:
+        return list(pool.map(lambda args: arena_json(*args), commands))
+
+
 def digests(summary: dict) -> dict[str, str]:
     return {m["id"]: m["digest"] for m in summary["matches"]}
 
@@ -57,9 +65,11 @@ def test_two_nodes_same_digests_as_local_jobs(cluster, tmp_path):
     """Fast: 2 matches, one per node, with either engine; digests equal to the local run's."""
     c, _ = cluster
     args = tournament("--strategies", "BS,AD", "--legs", "2", "--half-time", "5")
-    local = arena_json(*args, "--jobs", "2", "--out", str(tmp_path / "local"))
-    remote = arena_json(*args, "--ray", c.address, "--out", str(tmp_path / "ray"))
-    inproc = arena_json(*args, "--ray", c.address, "--engine", "inprocess", "--out", str(tmp_path / "inproc"))
+    local, remote, inproc = at_once(
+        (*args, "--jobs", "2", "--out", str(tmp_path / "local")),
+        (*args, "--ray", c.address, "--out", str(tmp_path / "ray")),
+        (*args, "--ray", c.address, "--engine", "inprocess", "--out", str(tmp_path / "inproc")),
+    )
     assert digests(remote) == digests(local) == digests(inproc) and len(digests(local)) == 2
     assert {m["engine"] for m in inproc["matches"]} == {"inprocess"}
     check_tables(remote, 2)
@@ -132,8 +142,10 @@ def test_worker_node_removed_mid_task(cluster, local_six, tmp_path, reap):
 
 def test_ray_alone_starts_a_local_instance_and_stops_it(tmp_path):
     args = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--engine", "inprocess")
-    summary = arena_json(*args, "--jobs", "1", "--ray", "--out", str(tmp_path / "ray"))
-    local = arena_json(*args, "--jobs", "1", "--out", str(tmp_path / "local"))
+    summary, local = at_once(
+        (*args, "--jobs", "1", "--ray", "--out", str(tmp_path / "ray")),
+        (*args, "--jobs", "1", "--out", str(tmp_path / "local")),
+    )
     assert digests(summary) == digests(local) and len(digests(local)) == 1
     assert "played on node" in (tmp_path / "ray" / "logs" / f"{summary['matches'][0]['id']}.log").read_text()
 
