@@ -384,16 +384,24 @@ class RecorderNode(Observer):
         return got
 
     def _finished(self) -> bool:
+        """Has every peer sent its last batch and its summary, or been gone for GONE_GRACE_S?
+
+        Every peer is looked at on every poll, so that a peer's grace runs from when its token
+        vanished, not from when every peer before it in the list had finished."""
         now = time.monotonic()
+        done = True
         for name in self.peers:
+            gone = name in self.gone
+            if gone:
+                since = self._gone_since.setdefault(name, now)
+            else:
+                self._gone_since.pop(name, None)  # back (a stopped process that resumed), or never gone
             if name in self.finals and name in self.summaries:
                 continue
-            if name in self.gone:
-                since = self._gone_since.setdefault(name, now)
-                if name in self.summaries or now - since >= GONE_GRACE_S:
-                    continue
-            return False
-        return True
+            if gone and (name in self.summaries or now - since >= GONE_GRACE_S):
+                continue
+            done = False
+        return done
 
     # ----------------------------------------------------------------- output
     def _write_ready(self, watermark: int) -> None:
