@@ -29,7 +29,7 @@ def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
         "--away",
         "BS",
         "--half-time",
-        "20",
+        "5",  # what it checks holds at every tick: 500 of them as well as 2000
         "--seed",
         "4",
         "--external",
@@ -63,8 +63,8 @@ def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
 
 
 @contextmanager
-def _client_of_a_match(tmp_path, reap, match_id: str, seed: int):
-    """Start a 2 x 20 s BS v BS match on a socket in `tmp_path`; yield (the match process, a client session)."""
+def _client_of_a_match(tmp_path, reap, match_id: str, seed: int, half_time: int):
+    """Start a 2 x `half_time` s BS v BS match on a socket in `tmp_path`; yield (the match process, a client session)."""
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     match = spawn(
         "match",
@@ -73,7 +73,7 @@ def _client_of_a_match(tmp_path, reap, match_id: str, seed: int):
         "--away",
         "BS",
         "--half-time",
-        "20",
+        str(half_time),
         "--seed",
         str(seed),
         "--match",
@@ -107,12 +107,12 @@ def _result(match) -> dict:
 
 
 def _put_during_a_match(tmp_path, reap, match_id: str, seed: int, key: str, sender: str, payloads) -> dict:
-    """Play a 2 x 20 s match; once it is under way, put `payloads(tick)` on `key` with `sender`'s MAC.
+    """Play a 2 x 5 s match; once it is under way, put `payloads(tick)` on `key` with `sender`'s MAC.
     Returns the match JSON.
 
     `tick` is the tick of the first referee frame heard: the match is at or past it.
     """
-    with _client_of_a_match(tmp_path, reap, match_id, seed) as (match, session):
+    with _client_of_a_match(tmp_path, reap, match_id, seed, half_time=5) as (match, session):
         # Wait until the match is being played: the referee has sent a frame. Stop
         # listening before publishing: on the referee key we would hear ourselves.
         referee = session.declare_subscriber(f"arena/{match_id}/referee", zenoh.handlers.FifoChannel(1000))
@@ -141,7 +141,7 @@ def test_garbage_on_a_robots_cmd_key_is_rejected_and_the_match_goes_on(tmp_path,
     log = (tmp_path / "logs" / "engine.log").read_text()
     assert "rejected input on arena/noisy/robot/a/1/cmd: malformed" in log
     assert "out-of-sequence" in log
-    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
+    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 500
 
 
 def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path, reap):
@@ -157,7 +157,7 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
     """
     decode = msgspec.msgpack.Decoder(Referee).decode
     rounds = 0
-    with _client_of_a_match(tmp_path, reap, "refnoise", 6) as (match, session):
+    with _client_of_a_match(tmp_path, reap, "refnoise", 6, half_time=10) as (match, session):
         referee = session.declare_subscriber("arena/refnoise/referee", zenoh.handlers.FifoChannel(1000))
         # REMOTE: our own subscriber above does not hear the bad frames.
         pub = session.declare_publisher(
@@ -201,7 +201,7 @@ def test_bad_referee_commands_are_rejected_by_engine_and_base_stations(tmp_path,
         assert "rejected input on arena/refnoise/referee: forged: not from referee" in log, process
     assert "rejected input on arena/refnoise/referee: forged: not from referee" in (logs / "engine.log").read_text()
     assert result["forged"]["referee"] >= 3 * rounds, result["forged"]
-    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 2000
+    assert result["events"]["END_GAME"] == 1 and result["ticks"] == 1000
 
 
 def test_arena_up_runs_the_compose_file_as_local_processes():

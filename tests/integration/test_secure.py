@@ -18,14 +18,21 @@ import zenoh
 from mcap.reader import make_reader
 
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, Referee, Summary, TapBatch, TapFrame, encode
-from tests.integration.helpers import ARENA, arena_json, free_port, spawn, wait_for
+from tests.integration.helpers import ARENA, free_port, spawn, wait_for
 
 GAME = ("--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "4")
 
 
 @pytest.fixture(scope="module")
 def baseline() -> dict:
-    return arena_json("match", *GAME)
+    """`arena match GAME --json`, unattacked, played by the in-process engine: the digests, score, events
+    and message counts of the distributed one (tests/integration/test_engines.py), no processes started."""
+    from arena import cli
+    from arena.commands._live import full_config
+    from arena.tools.launch import inprocess
+
+    cfg, _ = full_config(cli.parser("match").parse_args(["match", *GAME]))
+    return json.loads(json.dumps(inprocess.play_match(cfg).to_dict()))
 
 
 def _client(fragment: dict | None, endpoint: str) -> zenoh.Config:
