@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import faulthandler
+import functools
 import json
 import math
 import os
@@ -121,6 +122,7 @@ def _leaves(value, kind, path=()):
         yield list(path)
 
 
+@functools.cache  # built once per type, not once per drawn frame (`frames` draws it by flatmap)
 def payloads(msg_type: type, huge: bool) -> st.SearchStrategy[bytes]:
     shape = SHAPES[msg_type]
     enc = msgspec.msgpack.encode
@@ -158,6 +160,20 @@ def payloads(msg_type: type, huge: bool) -> st.SearchStrategy[bytes]:
 
 def frames(huge: bool) -> st.SearchStrategy[tuple[str, int, bytes]]:
     return st.sampled_from(TARGETS).flatmap(lambda t: payloads(t[1], huge).map(lambda p: (t[0], t[2], p)))
+
+
+def drawn(n: int, huge: bool) -> list[tuple[str, int, bytes]]:
+    """The (key, receivers, payload) that hypothesis draws, derandomized: the same ones every run."""
+    out: list[tuple[str, int, bytes]] = []
+
+    @settings(max_examples=n, deadline=None, database=None, derandomize=True, phases=[Phase.generate],
+              suppress_health_check=list(HealthCheck))  # fmt: skip
+    @given(frames(huge))
+    def draw(frame):
+        out.append(frame)
+
+    draw()
+    return out
 
 
 class Launcher:
@@ -217,6 +233,8 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
                         "--seed", str(CFG["seed"]), "--link", CFG["link"], "--external", "a/0",
                         "--match", match_id, "--listen", endpoint, "--credentials", str(creds),
                         "--json")  # fmt: skip
+    # Drawn while the match starts: the same frames in the same order as drawing each before its put.
+    batches = [(drawn(n, False), False), *([(drawn(n_huge, True), True)] if n_huge else [])]
     # The launcher prints the command that starts a/0 (with its credentials): start it exactly so, later.
     command = launcher.line("arena run robot", 60).split()
     sent = {"count": 0, "frames": 0, "too-large": 0, "big": 0}
@@ -247,24 +265,14 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
             for key, _, _ in TARGETS
         }
 
-        def inject(n: int, huge: bool) -> None:
-            @settings(max_examples=n, deadline=None, database=None, derandomize=True, phases=[Phase.generate],
-                      suppress_health_check=list(HealthCheck))  # fmt: skip
-            @given(frames(huge))
-            def put(frame):
-                key, receivers, payload = frame
+        for batch, huge in batches:
+            for key, receivers, payload in batch:
                 pubs[key].put(payload, attachment=tag(own_key[key], f"arena/{match_id}/{key}", payload))
                 sent["count"] += receivers
                 sent["frames"] += 1
                 sent["big"] += huge
                 if len(payload) > MAX_FRAME_BYTES:
                     sent["too-large"] += receivers
-
-            put()
-
-        inject(n, False)
-        if n_huge:
-            inject(n_huge, True)
         # Counted whenever they arrive, even after the start: no payload is at a tick anybody expects.
         # But a process counts only what it reads before it ends, and a put returns once queued: up
         # to thousands of small payloads can still sit in the links' buffers, more than a receiver
