@@ -25,15 +25,21 @@ def recv_until_closed(sock: socket.socket, timeout: float = 5.0) -> bytes:
         out += data
 
 
-def read_for(sock: socket.socket, seconds: float) -> bytes:
-    sock.settimeout(0.05)
-    out, end = b"", time.monotonic() + seconds
-    while time.monotonic() < end:
-        try:
-            out += sock.recv(4096)
-        except TimeoutError:
-            pass
+def read_through(sock: socket.socket, end: bytes, timeout: float = 5.0) -> bytes:
+    """All `sock` receives up to `end`, which the test had the server send last: the server sends in the
+    order it was told to, so nothing it sent before `end` can still be on its way (a byte too many fails
+    the comparison, or never ends with `end`)."""
+    sock.settimeout(timeout)
+    out = b""
+    while not out.endswith(end):
+        data = sock.recv(4096)
+        if not data:
+            return out
+        out += data
     return out
+
+
+STOP = b'{"command":"STOP","targetTeam":""}\0'  # the last command a test sends, to know the rest has come
 
 
 def test_unknown_team_gets_reset_and_is_disconnected():
@@ -53,38 +59,44 @@ def test_table_side_protocol_target_and_a_third_connection_refused():
     server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x", teams=table), LOG)
     try:
         b = socket.create_connection(("127.0.0.1", server.port))
-        assert read_for(b, 0.3) == b"W"
+        assert read_through(b, b"W") == b"W"
         with socket.create_connection(("127.0.0.1", server.port)) as again:  # side b is taken
             assert b"RESET" in recv_until_closed(again)
         server.broadcast("KICKOFF", "b")
         server.broadcast("START", "b")
         server.broadcast("IS_ALIVE", "b", 2)  # no legacy character: skipped
-        assert read_for(b, 0.3) == b"ks"
+        server.broadcast("STOP")
+        assert read_through(b, b"S") == b"ksS"  # nothing for IS_ALIVE
         assert server.counts["not-in-legacy-protocol"] == 1
     finally:
+        b.close()  # first: the server's close waits (0.5 s) for a base station that does not hang up
         server.close(linger=0)
-        b.close()
 
 
 def test_no_table_first_is_a_second_is_b_swap_and_worldstates():
     server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x", swap=True, protocol_b="legacy"), LOG)
     try:
         a = socket.create_connection(("127.0.0.1", server.port))
-        assert json.loads(read_for(a, 0.3).rstrip(b"\0")) == {"command": "WELCOME", "targetTeam": "224.16.32.202"}
+        assert json.loads(read_through(a, b"\0").rstrip(b"\0")) == {"command": "WELCOME", "targetTeam": "224.16.32.202"}
         b = socket.create_connection(("127.0.0.1", server.port))
-        assert read_for(b, 0.3) == b"W"
+        assert read_through(b, b"W") == b"W"
         server.broadcast("CORNER", "a")  # a is magenta when swapped
-        assert read_for(b, 0.3) == b"c"
-        assert b'"targetTeam":"224.16.32.202"' in read_for(a, 0.1)
+        server.broadcast("STOP")
+        assert read_through(b, b"S") == b"cS"
+        corner, stop, rest = read_through(a, STOP).split(b"\0")
+        assert b'"targetTeam":"224.16.32.202"' in corner and stop + b"\0" == STOP and rest == b""
         a.sendall(b'{"type":"worldstate"}\0{oops\0')
-        time.sleep(0.3)
-        results = server.drain()
+        results: list = []
+        deadline = time.monotonic() + 5.0
+        while len(results) < 2 and time.monotonic() < deadline:  # both messages read
+            results += server.drain()
+            time.sleep(0.005)
         assert [(t, r.reason) for t, _, r, _ in results] == [("a", "missing-key"), ("a", "malformed-json")]
         assert dict(server.errors["a"]) == {"missing-key": 1, "malformed-json": 1}
     finally:
-        server.close(linger=0)
-        a.close()
+        a.close()  # first: the server's close waits (0.5 s) for a base station that does not hang up
         b.close()
+        server.close(linger=0)
 
 
 def ws(tick: int, doc: dict) -> Worldstate:
