@@ -51,13 +51,14 @@ def play_with_a_silent_robot(reap, tmp_path, secure) -> dict:
     """Issue 20: it used to give ticks 0, the engine dead and exit 0 after every watchdog fired at once.
 
     Its base station waits for the report, everyone downstream waits for the base station. A short
-    wait_timeout (4 s, from a --config file) keeps the test short; with it, every process announces
-    its wait, so only the base station, whose sender owes the frame, gives up. With --secure, the
+    wait_timeout (2 s, from a --config file; 60 s by default) keeps the test short: the match stalls
+    for about twice that. With it, every process announces its wait (after a quarter of it), so only
+    the base station, whose sender owes the frame, gives up. With --secure, the
     router's access control lets each process declare its own waiting tokens and read everyone's.
     """
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
     config = tmp_path / "quick.toml"
-    config.write_text("[timing]\nwait_timeout = 4.0\n")
+    config.write_text("[timing]\nwait_timeout = 2.0\n")
     proc = spawn(*MATCH, "--config", str(config), "--half-time", "10", "--seed", "4", "--match", "noreport",
                  "--listen", endpoint, "--external", "a/1", secure)  # fmt: skip
     reap.append(proc)
