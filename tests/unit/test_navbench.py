@@ -18,6 +18,7 @@ import pytest
 
 from arena.navigation import fsfm
 from arena.tools.experiments import navbench as nb
+from tests.integration.helpers import arena_in_process
 
 MINI = """
 [[scenario]]
@@ -138,7 +139,7 @@ def test_a_missing_file_is_named(tmp_path):
 
 
 def test_the_cli_reports_a_missing_file_in_one_line_with_exit_2():
-    r = arena("bench", "nav", "--scenarios", "/nonexistent/scenarios.toml")
+    r = arena("bench", "nav", "--scenarios", "/nonexistent/scenarios.toml")  # a real process: its exit and stderr
     assert r.returncode == 2, r.stderr
     assert r.stderr.strip() == "arena bench: error: --scenarios /nonexistent/scenarios.toml: no such file"
 
@@ -219,8 +220,8 @@ def test_plain_apf_does_not_reach_the_goal_in_gnron(minima):
 
 
 # ------------------------------------------------------------------ output
-def test_json_has_the_issues_shape():
-    r = arena("bench", "nav", "--trials", "1", "--only", "static,SAROG", "--json")
+def test_json_has_the_issues_shape(capfd):
+    r = arena_in_process(["bench", "nav", "--trials", "1", "--only", "static,SAROG", "--json"], capfd)
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert {"results", "mapf", "timing", "methods"} <= set(out)

@@ -11,6 +11,7 @@ import pytest
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.runtime.pace import Pacer, WireGate
 from arena.schemas.messages import Control, encode
+from tests.integration.helpers import arena_in_process
 
 
 def test_unpaced_and_unpaused_every_tick_is_ready():
@@ -86,12 +87,11 @@ def test_a_live_match_has_a_viewer_process():
     "flags",
     [["--pace", "2"], ["--live", "8765", "--realtime", "--pace", "2"], ["--live", "99999"], ["--live", "x"]],
 )
-def test_cli_rejects_bad_live_flags_with_one_line_and_exit_2(flags):
-    r = subprocess.run(
-        [sys.executable, "-m", "arena", "match", "--home", "BS", "--away", "BS", *flags],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+def test_cli_rejects_bad_live_flags_with_one_line_and_exit_2(flags, capfd):
+    argv = ["match", "--home", "BS", "--away", "BS", *flags]
+    if flags == ["--pace", "2"]:  # one as a real process; the others through its entry point here
+        r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
+    else:
+        r = arena_in_process(argv, capfd)
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr

@@ -335,22 +335,14 @@ def test_bad_flags_are_one_line_and_exit_2(files, tmp_path_factory, capsys, argv
     assert message in err and err.count("\n") == 1, err
 
 
-def test_a_recording_with_a_kill_step_is_refused_by_replay_with_its_reason(tmp_path):
+def test_a_recording_with_a_kill_step_is_refused_by_replay_with_its_reason(tmp_path, capfd):
     """A kill step cuts its process's loop short; replay would drive it on and every node after would differ."""
-    import subprocess
-    import sys
-
     from arena.scenarios.library import RULES
+    from tests.integration.helpers import arena_in_process
 
     mcap = tmp_path / "r19.mcap"
     file = str(RULES / "19-dead-robot.scenario.toml")
-    run = [sys.executable, "-m", "arena", "scenario", "run", file, "--seed", "0", "--record", str(mcap)]
-    assert subprocess.run(run, capture_output=True, text=True, timeout=120).returncode == 0
-    r = subprocess.run(
-        [sys.executable, "-m", "arena", "replay", str(mcap), "--process", "all"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    assert arena_in_process(["scenario", "run", file, "--seed", "0", "--record", str(mcap)], capfd).returncode == 0
+    r = arena_in_process(["replay", str(mcap), "--process", "all"], capfd)
     assert r.returncode == 2, r.stderr
     assert "scenario killed robot/a/1 at tick 50 (a kill step): only matches without one replay" in r.stderr, r.stderr

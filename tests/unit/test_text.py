@@ -9,6 +9,7 @@ import sys
 from rich.console import Console
 
 from arena.tools.review import report
+from tests.integration.helpers import arena_in_process
 
 
 def arena(*args: str) -> subprocess.CompletedProcess:
@@ -66,15 +67,15 @@ def test_version_matches_the_package():
     assert r.returncode == 0 and r.stdout.strip() == f"arena {version('soccer-arena')}"
 
 
-def test_strategies_lists_name_alias_source_and_conformance():
-    r = arena("strategies", "chase", "BS", "--json")
+def test_strategies_lists_name_alias_source_and_conformance(capfd):
+    r = arena_in_process(["strategies", "chase", "BS", "--json"], capfd)
     assert r.returncode == 0, r.stderr
     rows = {row["name"]: row for row in json.loads(r.stdout)["strategies"]}
     assert set(rows) == {"chase", "basic-static"}
     assert rows["basic-static"]["aliases"] == ["BS"]
     assert rows["basic-static"]["source"] == "built-in arena.strategies.iris"
     assert rows["chase"]["conformance"] == "passes"
-    listed = json.loads(arena("strategies", "--no-check", "--json").stdout)["strategies"]
+    listed = json.loads(arena_in_process(["strategies", "--no-check", "--json"], capfd).stdout)["strategies"]
     assert {"basic-static", "basic-dynamic", "advance-static", "advance-dynamic", "chase"} <= {
         x["name"] for x in listed
     }
