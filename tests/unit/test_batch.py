@@ -9,6 +9,7 @@ batch size must leave every digest as it is.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 
 import msgpack
@@ -91,6 +92,7 @@ def test_frames_per_message_is_the_latency_unless_given_and_one_in_real_time():
     assert dataclasses.replace(timing, perception_latency=0).frames_per_message() == 1
 
 
+@functools.cache  # (0, 1) is every latency's "another latency": played once
 def _digests(latency: int, batch: int) -> dict[str, str]:
     timing = dataclasses.replace(MatchConfig().timing, perception_latency=latency, batch=batch)
     cfg = MatchConfig(home="AD", away="BS", half_time=2.0, seed=5, link="congested-wifi", timing=timing)
