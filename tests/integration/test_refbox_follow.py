@@ -104,7 +104,7 @@ def test_an_unreachable_refbox_is_said_before_the_match_plays_and_voids_it():
     """It was silent while the match played, said `never connected` only in the report, and exited 0."""
     port = free_port()
     match = subprocess.Popen(
-        [*ARENA, "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "1", "--seed", "5",
+        [*ARENA, "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "0.5", "--seed", "5",
          "--refbox-follow", f"127.0.0.1:{port}", "--json"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
