@@ -327,7 +327,7 @@ def test_two_senders_on_one_key_are_flagged_as_possible_spoofing(reap, tmp_path)
     from arena.schemas.messages import Cmd, Sense, encode
 
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    proc = spawn(*MATCH, "--half-time", "20", "--seed", "4", "--match", "spoof", "--listen", endpoint)
+    proc = spawn(*MATCH, "--half-time", "10", "--seed", "4", "--match", "spoof", "--listen", endpoint)
     reap.append(proc)
     decode = msgspec.msgpack.Decoder(Sense).decode
 

@@ -72,9 +72,14 @@ def spawn(name: str, pid: ProcessId, argv: list[str], log_dir: Path, env: dict[s
 
 
 def stop_all(children: list[Child], grace: float = 3.0) -> None:
+    """SIGTERM every child still running, SIGKILL any still there `grace` seconds later.
+
+    Each gets SIGCONT after its SIGTERM, as a service manager does: a stopped child (SIGSTOP,
+    the hung process of a fault) then ends on its SIGTERM at once instead of at the SIGKILL."""
     for c in children:
         if c.popen.poll() is None:
             c.popen.send_signal(signal.SIGTERM)
+            c.popen.send_signal(signal.SIGCONT)
     deadline = time.monotonic() + grace
     for c in children:
         left = max(0.0, deadline - time.monotonic())

@@ -1,0 +1,29 @@
+"""`stop_all`, the end of every match the launcher started: SIGTERM, then SIGKILL after a grace."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from arena.runtime.config import ProcessId
+from arena.tools.launch.children import Child, stop_all
+
+
+def test_a_stopped_child_ends_on_its_sigterm_at_once_not_at_the_sigkill(tmp_path):
+    """A SIGSTOPped child (the hung process of a fault) kept its SIGTERM pending, so the launcher
+    waited the whole grace and killed it; it now gets SIGCONT too, as from a service manager."""
+    popen = subprocess.Popen([sys.executable, "-c", "import time; print('up', flush=True); time.sleep(60)"],
+                             stdout=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        assert popen.stdout.readline() == "up\n"
+        os.kill(popen.pid, signal.SIGSTOP)
+        t0 = time.monotonic()
+        stop_all([Child("robot/a/1", ProcessId("robot", "a", 1), popen, tmp_path / "log")], grace=30.0)
+        assert time.monotonic() - t0 < 10.0, "it waited for the grace to end"
+        assert popen.returncode == -signal.SIGTERM, "ended by its SIGTERM, not killed"
+    finally:
+        popen.kill()
+        popen.communicate()
