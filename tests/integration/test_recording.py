@@ -21,7 +21,7 @@ from arena.processes.recorder import data_topics
 from arena.recording.reader import load
 from arena.runtime.config import MatchConfig
 from arena.tools.launch.inprocess import play_in_process
-from tests.integration.helpers import ARENA, arena_json, cmdline, descendants, spawn, wait_for
+from tests.integration.helpers import ARENA, alive, arena_json, cmdline, descendants, spawn, wait_for
 from tests.unit.test_recording import check_mismatch_at, records_in_file_order
 
 SEED = 4
@@ -111,34 +111,48 @@ def _recorder_of(proc: subprocess.Popen) -> int:
 
 
 def _signal_the_recorder_mid_match(path, reap, sig: int, size: int) -> subprocess.Popen:
-    """Start a long recorded match, wait until the file holds `size` bytes, signal the recorder."""
+    """Start a long recorded match, wait until the file holds `size` bytes, signal the recorder
+    and wait until it has exited: nothing writes the file after that, while the match plays on."""
     match = spawn(*LONG, "--record", str(path), "--json")
     reap.append(match)
     recorder = _recorder_of(match)
     wait_for(lambda: path.exists() and path.stat().st_size > size, 120, f"{size} bytes in the file")
     os.kill(recorder, sig)
+    wait_for(lambda: not alive(recorder), 60, "the signalled recorder to exit")
+    assert match.poll() is None, "the match had ended before its recorder was signalled"
     return match
+
+
+def _review(path, reap, *args: str) -> subprocess.Popen:
+    """`arena review` of the recorder's file, started now (it runs beside the rest of the match)."""
+    proc = subprocess.Popen(
+        [*ARENA, "review", str(path), *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    reap.append(proc)
+    return proc
 
 
 def test_sigkill_of_the_recorder_leaves_a_file_review_reads_and_calls_truncated(tmp_path, reap):
     path = tmp_path / "killed.mcap"
     match = _signal_the_recorder_mid_match(path, reap, signal.SIGKILL, 400_000)
+    as_json, as_text = _review(path, reap, "--json"), _review(path, reap)
     _, err = match.communicate(timeout=60)
     # Play goes on without recording: a fault, flagged, exit 0 (issue 15; --strict would stop the match).
     assert match.returncode == 0, err
     assert "fault: recorder" in err and "Traceback" not in err
-    r = subprocess.run([*ARENA, "review", str(path), "--json"], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    review = json.loads(r.stdout)
+    out, review_err = as_json.communicate(timeout=120)
+    assert as_json.returncode == 0, review_err
+    review = json.loads(out)
     assert review["truncated"] and not review["complete"]
     assert 50 <= review["ticks"] < 2 * LONG_HALF * 50  # dt 0.02 s: cut before the last tick
-    human = subprocess.run([*ARENA, "review", str(path)], capture_output=True, text=True, timeout=120)
-    assert human.returncode == 0 and "truncated" in human.stdout
+    human = as_text.communicate(timeout=120)[0]
+    assert as_text.returncode == 0 and "truncated" in human
 
 
 def test_sigterm_of_the_recorder_finishes_the_file(tmp_path, reap):
     path = tmp_path / "stopped.mcap"
     match = _signal_the_recorder_mid_match(path, reap, signal.SIGTERM, 200_000)
+    as_text = _review(path, reap)
     match.communicate(timeout=60)
     with open(path, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
@@ -146,10 +160,10 @@ def test_sigterm_of_the_recorder_finishes_the_file(tmp_path, reap):
     rec = load(str(path))
     assert not rec.truncated and not rec.complete
     assert rec.meta["recording"]["interrupted"] == "SIGTERM"
-    human = subprocess.run([*ARENA, "review", str(path)], capture_output=True, text=True, timeout=120)
-    assert human.returncode == 0, human.stderr
-    assert "stopped recording: the recorder was stopped by SIGTERM after" in human.stdout, human.stdout
-    assert "missed" not in human.stdout and "gap:" not in human.stdout, "a stop is not a gap"
+    human, human_err = as_text.communicate(timeout=120)
+    assert as_text.returncode == 0, human_err
+    assert "stopped recording: the recorder was stopped by SIGTERM after" in human, human
+    assert "missed" not in human and "gap:" not in human, "a stop is not a gap"
 
 
 def test_a_recorder_started_by_hand_fetches_the_configuration(tmp_path, reap):
