@@ -119,7 +119,6 @@ def _signal_the_recorder_mid_match(path, reap, sig: int, size: int) -> subproces
     wait_for(lambda: path.exists() and path.stat().st_size > size, 120, f"{size} bytes in the file")
     os.kill(recorder, sig)
     wait_for(lambda: not alive(recorder), 60, "the signalled recorder to exit")
-    assert match.poll() is None, "the match had ended before its recorder was signalled"
     return match
 
 
