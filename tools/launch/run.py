@@ -488,6 +488,8 @@ def run(
                 else "every process is here: playing"
             )
             node.play()
+            if ref_sub is not None:  # the referee's last frame may come after our own last tick
+                await_last_referee(last_ref, cfg.total_ticks, LAST_REFEREE_S)
         finally:
             if ref_sub is not None:
                 ref_sub.undeclare()
@@ -514,6 +516,26 @@ def observer_settings(
         live = port if port is not None else (8765 if attached else cfg.live)
         return cfg.replace(live=live), {"host": host, "attached": attached}
     return cfg, {}
+
+
+LAST_REFEREE_S = 1.0  # [s] wall: a process started by hand waits up to this long for the referee's last frame
+
+
+def await_last_referee(last_ref: list[bytes], total_ticks: int, timeout: float) -> None:
+    """Until the newest referee frame in `last_ref` is of tick `total_ticks` (END_GAME), at most `timeout`.
+
+    The final score line of a process started by hand reports it: a robot's own last tick may come
+    before the referee's last frame arrives (it said `match over at tick 295 (SECOND_HALF)`)."""
+    decode = msgspec.msgpack.Decoder(Referee).decode
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        newest = last_ref[-1:]  # the subscriber replaces it from zenoh's thread
+        try:
+            if newest and decode(newest[0]).tick >= total_ticks:
+                return
+        except (msgspec.DecodeError, msgspec.ValidationError):
+            return  # final_score says so
+        time.sleep(0.01)
 
 
 def final_score(last_ref: list[bytes], cfg: MatchConfig) -> str:
