@@ -47,9 +47,9 @@ def test_an_event_or_a_notify_ends_a_wait_without_the_time_moving():
         with cond:
             cond.notify_all()
 
-    threading.Timer(0.02, notify).start()
     t0 = time.monotonic()
-    with cond:
+    with cond:  # the timer starts with `cond` held: its notify cannot come before the wait (it hung under load)
+        threading.Timer(0.02, notify).start()
         clock.wait_on(cond, 3600.0)
     assert time.monotonic() - t0 < 5.0 and clock.monotonic() == 5.0
 
