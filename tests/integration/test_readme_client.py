@@ -29,8 +29,7 @@ def test_the_readme_client_imports_nothing_of_the_project():
 
 def test_a_client_written_from_the_readme_plays_robot_a1_and_its_digest_is_verified(tmp_path, reap):
     endpoint = f"unixsock-stream/{tmp_path}/router.sock"
-    # 2 x 4 s: every stage and command it checks is on the wire, as in a longer match
-    match = spawn("match", "--home", "BS", "--away", "BS", "--half-time", "4", "--seed", "4",
+    match = spawn("match", "--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "4",
                   "--external", "a/1", "--match", "readme", "--listen", endpoint, "--json")  # fmt: skip
     reap.append(match)
     line = ""
