@@ -16,18 +16,7 @@ from tests.integration.helpers import ARENA, free_port, spawn, wait_for, wait_un
 
 
 def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, tmp_path):
-    from tests.integration.foxglove_client import FoxgloveClient, pb_fields
-
-    def ball_xy(scene: bytes) -> tuple[float, float] | None:
-        """The ball of a foxglove.SceneUpdate: entity (2) "ball" (id 3), sphere (9), pose (1), position (1), x (1), y (2)."""
-        for entity in (v for n, _, v in pb_fields(scene) if n == 2):
-            fields = pb_fields(entity)
-            if (3, 2, b"ball") in fields:
-                sphere = next(v for n, _, v in fields if n == 9)
-                pose = next(v for n, _, v in pb_fields(sphere) if n == 1)
-                xyz = dict((n, v) for n, _, v in pb_fields(next(v for n, _, v in pb_fields(pose) if n == 1)))
-                return xyz.get(1, 0.0), xyz.get(2, 0.0)
-        return None
+    from tests.integration.foxglove_client import FoxgloveClient, log_entry
 
     port, live, mcap = free_port(), free_port(), tmp_path / "op.mcap"
     endpoint = f"tcp/127.0.0.1:{port}"
@@ -38,7 +27,7 @@ def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, 
     reap.append(match)
     client = FoxgloveClient(f"ws://127.0.0.1:{live}", timeout=60)
     assert "clientPublish" in client.info["capabilities"]
-    client.subscribe("/scene")
+    client.subscribe("/referee_log")
     wait_until_playing(endpoint, "op")  # the engine listens from its start
     teleport = '{"type": "teleport_ball", "x": 3.3, "y": -2.2, "vx": 0, "vy": 0}'
     corner = '{"type": "referee", "command": "CORNER", "team": "b"}'
@@ -47,13 +36,14 @@ def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, 
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert op.returncode == 0 and "sent 2 action(s) to arena/op/operator" in op.stdout, op.stderr
-    # The engine applies what it received at its next tick: the second teleport goes once the scene
-    # shows the first, so each has a tick, and a world frame, of its own.
-    for _, _, scene in client.messages(30):
-        if (xy := ball_xy(scene)) is not None and abs(xy[0] - 3.3) < 0.1 and abs(xy[1] + 2.2) < 0.1:
+    # The engine and the referee apply what they received at their next tick: the second teleport goes
+    # once the viewer has logged the corner that came in the same message as the first, so that each
+    # teleport has a tick, and a world frame, of its own.
+    for _, _, entry in client.messages(30):
+        if (said := log_entry(entry))["name"] == "referee" and said["message"].startswith("CORNER"):
             break
     else:
-        raise AssertionError("the scene never showed the ball where `arena operator` put it")
+        raise AssertionError("the viewer never logged the corner `arena operator` forced")
     channel = client.advertise("/operator", "arena.Operator")
     client.publish(channel, b'{"actions": [{"type": "teleport_ball", "x": -3.3, "y": 2.2, "vx": 0, "vy": 0}]}')
     client.publish(channel, b'{"actions": [{"type": "teleport_bal"}]}')  # refused, counted
