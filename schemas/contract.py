@@ -312,7 +312,10 @@ and KICKOFF at tick 0, HALF_TIME, SECOND_HALF and KICKOFF in one tick at half
 time, and END_GAME, PARK, GAMEOVER at tick `total_ticks`, so the `stage`
 values that occur on the wire are `FIRST_HALF`, `SECOND_HALF` and
 `END_GAME`; `PRE_GAME` and `HALF_TIME` are in the type (the RefBox's own
-names) but are never sent.
+names) but are never sent. A robot's own last tick can come before the
+referee's frame of tick `total_ticks` arrives (that tick needs only the sense
+of tick `total_ticks - L`): a client that reports the final stage waits for
+that frame (`arena run` waits up to 1 s).
 
 **Wheels.** `Cmd.mode = "wheels"` gives one angular speed [rad/s] per wheel;
 the wheel count, order and sign come from the configuration's `robot.model`.

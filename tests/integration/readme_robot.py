@@ -77,9 +77,13 @@ def main(argv: list[str]) -> int:
         stages: set[str] = set()
         commands: set[str] = set()
 
+        ended = threading.Event()  # the referee's frame of tick total_ticks: END_GAME
+
         def on_referee(sample: zenoh.Sample) -> None:
             ref = msgpack.unpackb(sample.payload.to_bytes())
             stages.add(ref["stage"])
+            if ref["stage"] == "END_GAME":
+                ended.set()
             commands.update(c["name"] for c in ref.get("commands", []))
 
         keep = [
@@ -190,6 +194,7 @@ def main(argv: list[str]) -> int:
             summary_pub.put(payload, attachment=attachment)
             if not collector.is_set() or acked.wait(0.25) or time.monotonic() > give_up:
                 break
+        ended.wait(1.0)  # our last tick can come before the referee's last frame (schemas/README.md)
         print(
             json.dumps(
                 {
