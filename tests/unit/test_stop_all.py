@@ -9,7 +9,7 @@ import sys
 import time
 
 from arena.runtime.config import ProcessId
-from arena.tools.launch.children import Child, stop_all
+from arena.tools.launch.children import Child, stop_all, stopped_on_error
 
 
 def test_a_stopped_child_ends_on_its_sigterm_at_once_not_at_the_sigkill(tmp_path):
@@ -27,3 +27,29 @@ def test_a_stopped_child_ends_on_its_sigterm_at_once_not_at_the_sigkill(tmp_path
     finally:
         popen.kill()
         popen.communicate()
+
+
+def test_the_children_are_stopped_before_what_encloses_the_block_closes(tmp_path):
+    """The launcher's router `with`: on Ctrl-C or SIGTERM the children end while the router still
+    serves their links; a zenoh router closed under live links could panic after the last line."""
+    popen = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    seen_at_close: list[int | None] = []
+
+    class Router:
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            seen_at_close.append(popen.poll())
+
+    try:
+        children = [Child("robot/a/1", ProcessId("robot", "a", 1), popen, tmp_path / "log")]
+        try:
+            with Router(), stopped_on_error(children):
+                raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            pass
+        assert seen_at_close == [-signal.SIGTERM], "the child was still running when the router closed"
+    finally:
+        popen.kill()
+        popen.wait()

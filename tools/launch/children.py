@@ -3,11 +3,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -88,3 +90,17 @@ def stop_all(children: list[Child], grace: float = 3.0) -> None:
         except subprocess.TimeoutExpired:
             c.popen.kill()
             c.popen.wait()
+
+
+@contextlib.contextmanager
+def stopped_on_error(children: list[Child]) -> Iterator[None]:
+    """`stop_all` if the block raises (Ctrl-C, SIGTERM, a failure), before what encloses it closes.
+
+    Inside the router's `with`: the children end while the router still serves their links, as
+    at a match's normal end. A zenoh router closed under ten live links could panic in its
+    receive threads, and their messages came after the launcher's last line."""
+    try:
+        yield
+    except BaseException:
+        stop_all(children)
+        raise

@@ -38,7 +38,7 @@ from arena.runtime.transport import ZenohTransport
 from arena.runtime.version import PACKAGES
 from arena.schemas.keys import Keys, routes
 from arena.tools.launch import forkstart
-from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all
+from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all, stopped_on_error
 from arena.tools.launch.claims import Claims
 from arena.tools.launch.joins import Joins, instructions
 from arena.tools.launch.result import MatchResult, assemble, startup_seconds
@@ -222,7 +222,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 log_path = logs / (str(p).replace("/", "_") + ".log")
                 children.append(Child(str(p), p, starter.fork(job, log_path), log_path))  # type: ignore[arg-type]
         router_net = NetConfig(mode="router", listen=(endpoint,), extra=router_extra, lease=cfg.timing.lease)
-        with open_router(router_net, listen) as session:
+        with open_router(router_net, listen) as session, stopped_on_error(children):
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
             watch_spoofing(transport, keys, announce)
