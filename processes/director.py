@@ -23,7 +23,17 @@ import math
 import msgspec
 
 from arena.runtime.config import MatchConfig
-from arena.schemas.messages import Condition, Operator, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot
+from arena.schemas.messages import (
+    Cmd,
+    Condition,
+    ControlRobot,
+    Operator,
+    Referee,
+    RefereeOverride,
+    Step,
+    TeleportBall,
+    TeleportRobot,
+)
 from arena.sim.physics import Physics
 
 _OPERATOR = msgspec.msgpack.Decoder(Operator)
@@ -48,11 +58,15 @@ class Director:
         self.waiting = [s for s in mine if s.at < 0 and s.when is not None]  # conditions not yet met
         self.fired = 0  # steps done
         self.seen: set[str] = set()  # referee commands the engine has applied
+        self.driven: dict[tuple[str, int], tuple[int, Cmd]] = {}  # ControlRobot: robot -> (last tick, command)
+        self.moved: list[dict[str, object]] = []  # teleports put elsewhere (safely, or onto another robot)
+        self.tick = 0
 
     def observe(self, frame: Referee) -> None:
         self.seen.update(c.name for c in frame.commands)
 
     def act(self, k: int) -> None:
+        self.tick = k
         due = self.at.pop(k, [])
         if self.waiting:
             met = [s for s in self.waiting if self.holds(s.when)]
@@ -61,8 +75,20 @@ class Director:
                 due += met
         for step in due:
             self.fired += 1
+            placed: list[tuple[str, int]] = []  # robots this step put down, in order
             for action in step.actions:
                 self.apply(action)
+                if isinstance(action, TeleportRobot) and action.present and not action.by_force:
+                    self.unstack((action.team, action.robot), placed)
+                    placed.append((action.team, action.robot))
+
+    def drive(self, k: int) -> None:
+        """The robots under a `ControlRobot` at tick k get its command instead of their process's."""
+        for (team, n), (last, cmd) in list(self.driven.items()):
+            if k > last:
+                del self.driven[(team, n)]
+            else:
+                self.physics.set_command(team, n, cmd)
 
     def holds(self, c: Condition) -> bool:
         ph = self.physics
@@ -88,6 +114,18 @@ class Director:
                 self.teleport_ball(action)
             case TeleportRobot():
                 self.teleport_robot(action)
+            case ControlRobot():
+                a = action
+                cmd = Cmd(
+                    tick=self.tick,
+                    vx=a.vx,
+                    vy=a.vy,
+                    omega=a.omega,
+                    kick_speed=a.kick_speed,
+                    kick_lob=a.kick_lob,
+                    dribbler=a.dribbler,
+                )
+                self.driven[(a.team, a.robot)] = (self.tick + a.ticks - 1, cmd)
 
     def teleport_ball(self, a: TeleportBall) -> None:
         ph = self.physics
@@ -100,7 +138,14 @@ class Director:
             vx, vy = (v * (x - x0) / d, v * (y - y0) / d) if d > 0 else (0.0, 0.0)
             ph.teleport_ball(x0, y0, 0.0, vx, vy, 0.0)
             return
-        ph.teleport_ball(x, y, a.z, vx0 if a.vx is None else a.vx, vy0 if a.vy is None else a.vy, a.vz)
+        if a.safely:
+            r = self.cfg.ball.radius
+            nx, ny = free_spot(x, y, r, self.bodies(skip=None, ball=False), self.cfg)
+            if (nx, ny) != (x, y):
+                self.moved.append({"tick": self.tick, "ball": True, "x": round(nx, 3), "y": round(ny, 3)})
+            x, y = nx, ny
+        z, vz = (0.0, 0.0) if a.roll else (a.z, a.vz)
+        ph.teleport_ball(x, y, z, vx0 if a.vx is None else a.vx, vy0 if a.vy is None else a.vy, vz)
 
     def teleport_robot(self, a: TeleportRobot) -> None:
         ph = self.physics
@@ -120,9 +165,81 @@ class Director:
             if d > 0:
                 ph.push_robot(a.team, a.robot, v * (x - x0) / d, v * (y - y0) / d)
             return
+        if a.safely:
+            reach = self.cfg.robot.size * math.sqrt(0.5)
+            x, y = self.resettle(
+                (a.team, a.robot), x, y, free_spot(x, y, reach, self.bodies((a.team, a.robot)), self.cfg)
+            )
         pose = (x, y, th0 if a.orientation is None else a.orientation)
         twist = (vx0 if a.vx is None else a.vx, vy0 if a.vy is None else a.vy, w0 if a.omega is None else a.omega)
         ph.teleport_robot(a.team, a.robot, pose, twist)
+
+    def bodies(self, skip: tuple[str, int] | None, ball: bool = True, only=None) -> list[tuple[float, float, float]]:
+        """(x, y, radius) of the robots on the field (but `skip`; of `only`, if given) and the ball."""
+        ph, reach = self.physics, self.cfg.robot.size * math.sqrt(0.5)
+        parked = set(ph.parked())
+        out = []
+        for team in ("a", "b"):
+            for n in range(self.cfg.robots):
+                r = (team, n)
+                if r != skip and r not in parked and (only is None or r in only):
+                    out.append((*ph.robot_pose(team, n)[:2], reach))
+        if ball:
+            bx, by, *_ = ph.ball_state()
+            out.append((bx, by, self.cfg.ball.radius))
+        return out
+
+    def resettle(self, r: tuple[str, int], x: float, y: float, spot: tuple[float, float]) -> tuple[float, float]:
+        if spot != (x, y):
+            self.moved.append(
+                {"tick": self.tick, "robot": f"{r[0]}/{r[1]}", "x": round(spot[0], 3), "y": round(spot[1], 3)}
+            )
+        return spot
+
+    def unstack(self, r: tuple[str, int], placed: list[tuple[str, int]]) -> None:
+        """A robot teleported onto one this step already put down goes to the nearest spot clear of them."""
+        ph = self.physics
+        if r in ph.parked():
+            return
+        x, y, th = ph.robot_pose(*r)
+        reach = self.cfg.robot.size * math.sqrt(0.5)
+        others = self.bodies(r, ball=False, only=set(placed))
+        if any(math.hypot(x - ox, y - oy) < self.cfg.robot.size for ox, oy, _ in others):
+            nx, ny = self.resettle(r, x, y, free_spot(x, y, reach, others, self.cfg))
+            ph.teleport_robot(r[0], r[1], (nx, ny, th), ph.robot_velocity(*r))
+
+
+def free_spot(
+    x: float, y: float, radius: float, bodies: list[tuple[float, float, float]], cfg: MatchConfig
+) -> tuple[float, float]:
+    """SSL `teleport_safely`: (x, y) if a body of `radius` there touches none of `bodies` (x, y, radius),
+    else the nearest such spot on rings round it (every FREE_STEP metres, inside the fence, out of the
+    goals); deterministic. (x, y) if nothing within FREE_RINGS rings fits."""
+    f = cfg.field
+    xmax, ymax = f.length / 2 + f.runoff - radius, f.width / 2 + f.runoff - radius
+    goal_x, goal_y = f.length / 2 - radius, f.goal_width / 2 + radius
+
+    def free(cx: float, cy: float) -> bool:
+        if abs(cx) > xmax or abs(cy) > ymax or (abs(cx) > goal_x and abs(cy) < goal_y):
+            return False
+        return all(math.hypot(cx - bx, cy - by) >= radius + br + FREE_GAP for bx, by, br in bodies)
+
+    if all(math.hypot(x - bx, y - by) >= radius + br for bx, by, br in bodies):
+        return x, y
+    for ring in range(1, FREE_RINGS + 1):
+        rad = ring * FREE_STEP
+        count = 8 * ring
+        for k in range(count):
+            a = (k + 1) // 2 * (2 * math.pi / count) * (1 if k % 2 else -1)
+            cx, cy = x + rad * math.cos(a), y + rad * math.sin(a)
+            if free(cx, cy):
+                return cx, cy
+    return x, y
+
+
+FREE_STEP = 0.05  # [m] between the rings `free_spot` tries
+FREE_RINGS = 80  # up to 4 m away
+FREE_GAP = 0.01  # [m] clearance between bodies put down
 
 
 class OperatorInbox:

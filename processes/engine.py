@@ -258,6 +258,8 @@ class EngineNode(Node):
                     ph.set_command(r[0], r[1], frames[-1])
                 elif ib.dead and r not in self.parked:
                     self.park(r, k)
+            if self.director is not None:
+                self.director.drive(k)  # a scenario's ControlRobot: its command, not the robot's
             t1 = time.perf_counter()
             self.pending_events.extend(ph.step())
             self._work_s.append(work + time.perf_counter() - t1)
@@ -290,6 +292,8 @@ class EngineNode(Node):
                     if peer in self.gone and r not in self.parked:  # its liveliness token vanished
                         self._record_dead(peer, "its liveliness token vanished")
                         self.park(r, k)
+            if self.director is not None:
+                self.director.drive(k)
             self.pending_events.extend(ph.step())
             self.timed(t0)
             delay = start + (k + 1) * dt - time.monotonic()
@@ -308,4 +312,8 @@ class EngineNode(Node):
             "placed": len(self.restarts.placed),
             "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
             "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
-        } | ({"operator": self.operator.log} if self.operator is not None else {})
+        } | ({"operator": self.operator.log} if self.operator is not None else {}) | self.director_extra()
+
+    def director_extra(self) -> dict[str, object]:
+        """Teleports a scenario or the operator asked for that went to another spot (safely, or onto a robot)."""
+        return {"teleports_moved": self.director.moved} if self.director is not None and self.director.moved else {}

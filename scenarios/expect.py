@@ -5,7 +5,11 @@ them). Each judges its window `[from, until]` (seconds; `within` is a
 shorthand for `until`) of the `Trace`: the ground-truth `world` frames (every
 tick), the referee's commands and the processes' digests. A judgement is
 `(passed, tick, detail)`: the tick is where it failed (the first offending
-tick of a "never" kind, the window's last tick of a "happens" kind)."""
+tick of a "never" kind, the window's last tick of a "happens" kind).
+
+An expectation with `when` (a condition as a step's) measures its window from
+the first tick at which the condition holds on the trace; if it never holds,
+the expectation fails there."""
 
 from __future__ import annotations
 
@@ -13,8 +17,21 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from arena.schemas.messages import RefCommand, World
+from arena.scenarios.bounds import check_region
+from arena.schemas.messages import BallEvent, RefCommand, World
 from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
+
+EVENT_KINDS = (
+    "TOUCH",
+    "GOAL",
+    "GOAL_LINE",
+    "TOUCH_LINE",
+    "NO_PROGRESS",
+    "FOUL_PUSHING",
+    "FOUL_DRIBBLING",
+    "ROBOT_DEAD",
+    "ROBOT_STUCK",
+)
 
 
 @dataclass
@@ -26,10 +43,27 @@ class Trace:
     commands: list[RefCommand]
     digests: dict[str, str] = field(default_factory=dict)
     fence: tuple[float, float] = (7.0, 5.0)  # [m] half length and half width inside the fence: beyond is parked
+    events: list[BallEvent] = field(default_factory=list)  # the engine's, in order
+    scores: list[tuple[int, int, int]] = field(default_factory=list)  # (tick, goals of a, of b) per referee frame
 
-    def window(self, e, time_limit: float) -> tuple[int, int]:
-        until = e.within if e.within is not None else (e.until if e.until is not None else time_limit)
-        return int(round(e.from_ / self.dt)), int(round(until / self.dt))
+    def window(self, e, time_limit: float, origin: int = 0) -> tuple[int, int]:
+        until = e.within if e.within is not None else (e.until if e.until is not None else None)
+        last = self.worlds[-1].tick if self.worlds else int(round(time_limit / self.dt))
+        hi = last if until is None else origin + int(round(until / self.dt))
+        return origin + int(round(e.from_ / self.dt)), min(hi, last) if e.when is not None else hi
+
+    def trigger(self, when) -> int | None:
+        """The first tick at which the condition `when` holds on the trace (the referee's commands so far)."""
+        seen: set[str] = set()
+        commands = iter(self.commands)
+        pending = next(commands, None)
+        for w in self.worlds:
+            while pending is not None and pending.tick <= w.tick:
+                seen.add(pending.name)
+                pending = next(commands, None)
+            if holds(when, w, seen):
+                return w.tick
+        return None
 
     def frames(self, lo: int, hi: int) -> list[World]:
         return [w for w in self.worlds if lo <= w.tick <= hi]
@@ -48,6 +82,19 @@ def _pose(w: World, team: str, n: int) -> tuple[float, float] | None:
         if r.team == team and r.robot == n:
             return r.x, r.y
     return None
+
+
+def holds(c, w: World, seen: set[str]) -> bool:
+    """A step's condition (scenarios/model.py `When`) on one world frame; `seen`: the commands given so far."""
+    if c.ball_in is not None and not _in(c.ball_in, w.ball_x, w.ball_y):
+        return False
+    if c.robot_in is not None:
+        p = _pose(w, *_robot(c.robot))
+        if p is None or not _in(c.robot_in, *p):
+            return False
+    if c.command and c.command not in seen:
+        return False
+    return not c.possession or any(r.has_ball and r.team == c.possession for r in w.robots)
 
 
 def _in(region: list[float], x: float, y: float) -> bool:
@@ -159,6 +206,51 @@ def digest(e, t: Trace, lo: int, hi: int) -> Judgement:
     return ok, hi, f"{e.process} digest {got[:16] or 'missing'}"
 
 
+def _fast(e, w: World) -> bool:
+    return math.sqrt(w.ball_vx**2 + w.ball_vy**2 + w.ball_vz**2) > e.speed
+
+
+def _event_matches(ev: BallEvent, e) -> bool:
+    if ev.kind != e.event or (e.team and ev.team != e.team):
+        return False
+    return not e.robot or (ev.team, ev.robot) == _robot(e.robot)
+
+
+def event(e, t: Trace, lo: int, hi: int) -> Judgement:
+    for ev in t.events:
+        if lo <= ev.tick <= hi and _event_matches(ev, e):
+            return True, ev.tick, f"{ev.kind} {ev.team}/{ev.robot} at ({ev.x:.2f}, {ev.y:.2f}) at tick {ev.tick}"
+    return False, hi, f"no such {e.event} in ticks {lo}..{hi}"
+
+
+def never_event(e, t: Trace, lo: int, hi: int) -> Judgement:
+    for ev in t.events:
+        if lo <= ev.tick <= hi and _event_matches(ev, e):
+            return False, ev.tick, f"{ev.kind} {ev.team}/{ev.robot} at tick {ev.tick}"
+    return True, hi, f"no {e.event} in ticks {lo}..{hi}"
+
+
+def last_touch(e, t: Trace, lo: int, hi: int) -> Judgement:
+    """At the window's last tick, the last robot to touch the ball is of `team` (and is `robot`, if given)."""
+    frames = t.frames(lo, hi)
+    if not frames:
+        return False, hi, f"no frame in ticks {lo}..{hi}"
+    w = frames[-1]
+    who = f"{w.last_team}/{w.last_robot}" if w.last_team else "nobody"
+    ok = (not e.team or w.last_team == e.team) and (not e.robot or (w.last_team, w.last_robot) == _robot(e.robot))
+    return ok, w.tick, f"last touched by {who} at tick {w.tick}"
+
+
+def score(e, t: Trace, lo: int, hi: int) -> Judgement:
+    """The score at the window's last tick (by default the run's end) is `score`."""
+    got = (0, 0)
+    for tick, a, b in t.scores:
+        if tick > hi:
+            break
+        got = (a, b)
+    return list(got) == list(e.score), hi, f"score {got[0]}:{got[1]} at tick {hi}"
+
+
 Judge = Callable[..., Judgement]
 KINDS: dict[str, tuple[tuple[str, ...], Judge]] = {
     # kind: (the keys it needs, the judge)
@@ -173,6 +265,12 @@ KINDS: dict[str, tuple[tuple[str, ...], Judge]] = {
     "min_distance": (("distance",), min_distance),
     "not_stuck": (("seconds",), not_stuck),
     "digest": (("process", "digest"), digest),
+    "ball_speed": (("speed",), happens(_fast, "ball faster than the speed")),
+    "ball_never_faster": (("speed",), never(_fast, "ball faster than the speed")),
+    "last_touch": ((), last_touch),
+    "score": (("score",), score),
+    "event": (("event",), event),
+    "never_event": (("event",), never_event),
 }
 
 
@@ -183,12 +281,13 @@ def check_expect(e, robots: int, where: str) -> None:
     for key in KINDS[e.kind][0]:
         if not getattr(e, key):
             raise ValueError(f"{where}.{key}: the kind {e.kind} needs it")
+    check_values(e, where)
     if e.team and e.team not in TEAMS:
         raise ValueError(f"{where}.team: {e.team!r} (a or b)")
     if e.command and e.command not in REF_COMMANDS:
         raise ValueError(f"{where}.command: {e.command!r} is not an MSL RefBox command")
-    if e.region is not None and (len(e.region) != 4 or not all(math.isfinite(v) for v in e.region)):
-        raise ValueError(f"{where}.region: [x0, y0, x1, y1] in metres, got {e.region}")
+    if e.region is not None:
+        check_region(e.region, f"{where}.region")
     for key, r in [("robot", e.robot)] + [(f"robots[{i}]", r) for i, r in enumerate(e.robots)]:
         if r:
             parts = r.split("/")
@@ -202,6 +301,29 @@ def check_expect(e, robots: int, where: str) -> None:
         raise ValueError(f"{where}.from: seconds >= 0, got {e.from_}")
 
 
+def check_values(e, where: str) -> None:
+    """The keys of the newer kinds, and every number in range."""
+    if e.kind == "last_touch" and not (e.team or e.robot):
+        raise ValueError(f"{where}.team: the kind last_touch needs a team or a robot")
+    if e.event and e.event not in EVENT_KINDS:
+        raise ValueError(f"{where}.event: {e.event!r} is not one of {', '.join(EVENT_KINDS)}")
+    if e.score is not None and (len(e.score) != 2 or not all(0 <= v <= 999 for v in e.score)):
+        raise ValueError(f"{where}.score: [goals of a, goals of b], got {e.score}")
+    if not (math.isfinite(e.speed) and 0 <= e.speed <= 100):
+        raise ValueError(f"{where}.speed: [m/s] in [0, 100], got {e.speed}")
+    for key in ("distance", "seconds", "radius"):
+        v = getattr(e, key)
+        if not (math.isfinite(v) and 0 <= v <= 1000):
+            raise ValueError(f"{where}.{key}: a number in [0, 1000], got {v}")
+
+
 def judge(e, trace: Trace, time_limit: float) -> Judgement:
-    lo, hi = trace.window(e, time_limit)
+    origin = 0
+    if e.when is not None:
+        found = trace.trigger(e.when)
+        if found is None:
+            last = trace.worlds[-1].tick if trace.worlds else 0
+            return False, last, "its `when` never held"
+        origin = found
+    lo, hi = trace.window(e, time_limit, origin)
     return KINDS[e.kind][1](e, trace, lo, hi)

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import msgspec
 from msgspec import Struct
 
+from arena.rules.referee_box import TEAM_COMMANDS
 from arena.runtime.config import (
     DEFAULT_PERCEPTION_LATENCY,
     ConfigError,
@@ -31,8 +31,23 @@ from arena.runtime.config import (
     ScenarioParams,
 )
 from arena.runtime.links import resolve
+from arena.scenarios import files
+from arena.scenarios.bounds import (
+    MAX_RULE,
+    MAX_SCORE,
+    MAX_TIME_LIMIT,
+    check_ball,
+    check_control,
+    check_region,
+    check_robot,
+    check_spot,
+    finite,
+)
+from arena.scenarios.draws import Draw
+from arena.scenarios.draws import resolve as resolve_draws
 from arena.schemas.messages import (
     Condition,
+    ControlRobot,
     KillProcess,
     RefereeOverride,
     Region,
@@ -45,6 +60,7 @@ from arena.schemas.vocabulary import REF_COMMANDS, TEAMS
 from arena.strategies import registry
 
 SUFFIX = ".scenario.toml"
+DEFAULTS = MatchConfig()  # the field, robot and timing a scenario plays with
 
 
 class ScenarioError(ValueError):
@@ -53,6 +69,9 @@ class ScenarioError(ValueError):
 
 class Spec(Struct, kw_only=True, forbid_unknown_fields=True):
     """File tables: an unknown key is an error (a typo must not pass silently)."""
+
+
+Num = float | Draw  # a number of `start` or `step`: given, or drawn per run (scenarios/draws.py)
 
 
 class Substitute(Spec):
@@ -74,38 +93,54 @@ class Play(Spec):
 
 
 class BallSpec(Spec):
-    x: float | None = None
-    y: float | None = None
-    z: float = 0.0
-    vx: float | None = None
-    vy: float | None = None
-    vz: float = 0.0
+    x: Num | None = None
+    y: Num | None = None
+    z: Num = 0.0
+    vx: Num | None = None
+    vy: Num | None = None
+    vz: Num = 0.0
     by_force: bool = False
+    safely: bool = False
+    roll: bool = False
 
 
 class RobotSpec(Spec):
     robot: str
-    x: float | None = None
-    y: float | None = None
-    theta: float | None = None
-    vx: float | None = None
-    vy: float | None = None
-    omega: float | None = None
+    x: Num | None = None
+    y: Num | None = None
+    theta: Num | None = None
+    vx: Num | None = None
+    vy: Num | None = None
+    omega: Num | None = None
     present: bool = True
     by_force: bool = False
+    safely: bool = False
 
 
 class RefereeSpec(Spec):
     command: str = "START"
     team: str = ""
-    x: float | None = None
-    y: float | None = None
+    x: Num | None = None
+    y: Num | None = None
     robot: str = ""
+
+
+class ControlSpec(Spec):
+    """SSL `RobotControl`: a robot driven with these body-frame velocities, kick and dribbler for `seconds`."""
+
+    robot: str
+    seconds: Num
+    vx: Num = 0.0
+    vy: Num = 0.0
+    omega: Num = 0.0
+    kick_speed: Num = 0.0
+    kick_lob: bool = False
+    dribbler: bool = False
 
 
 class Start(Spec):
     stage: str = "FIRST_HALF"
-    clock: float = 0.0
+    clock: Num = 0.0
     score: list[int] = msgspec.field(default_factory=lambda: [0, 0])
     attack_dir_a: int = 1
     referee: RefereeSpec = msgspec.field(default_factory=RefereeSpec)
@@ -127,7 +162,7 @@ class LinkSpec(Spec):
 
 
 class StepSpec(Spec):
-    at: float | None = None
+    at: Num | None = None
     when: When | None = None
     link: LinkSpec | None = None
     kill: list[str] = []
@@ -135,6 +170,7 @@ class StepSpec(Spec):
     robots: list[RobotSpec] = []
     referee: RefereeSpec | None = None
     park: list[str] = []
+    control: list[ControlSpec] = []
 
 
 class Expect(Spec):
@@ -153,6 +189,10 @@ class Expect(Spec):
     radius: float = 0.2
     process: str = ""
     digest: str = ""
+    speed: float = 0.0
+    event: str = ""
+    score: list[int] | None = None
+    when: When | None = None
 
 
 class ScenarioSpec(Spec):
@@ -174,8 +214,7 @@ class FileSpec(Spec):
 def region(values: list[float] | None, where: str) -> Region | None:
     if values is None:
         return None
-    if len(values) != 4 or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{where}: a region is [x0, y0, x1, y1] in metres, got {values}")
+    check_region(values, where)
     return Region(x0=values[0], y0=values[1], x1=values[2], y1=values[3])
 
 
@@ -187,13 +226,15 @@ def robot_id(text: str, robots: int, where: str) -> tuple[str, int]:
 
 
 def ball_action(b: BallSpec, where: str) -> TeleportBall:
-    if b.z < 0:
-        raise ValueError(f"{where}.z: the ball's height must be >= 0 m, got {b.z}")
-    return TeleportBall(x=b.x, y=b.y, z=b.z, vx=b.vx, vy=b.vy, vz=b.vz, by_force=b.by_force)
+    check_ball(b, DEFAULTS, where)
+    return TeleportBall(
+        x=b.x, y=b.y, z=b.z, vx=b.vx, vy=b.vy, vz=b.vz, by_force=b.by_force, safely=b.safely, roll=b.roll
+    )
 
 
 def robot_action(r: RobotSpec, robots: int, where: str) -> TeleportRobot:
     team, n = robot_id(r.robot, robots, f"{where}.robot")
+    check_robot(r, DEFAULTS, where)
     return TeleportRobot(
         team=team,
         robot=n,
@@ -205,6 +246,23 @@ def robot_action(r: RobotSpec, robots: int, where: str) -> TeleportRobot:
         omega=r.omega,
         present=r.present,
         by_force=r.by_force,
+        safely=r.safely,
+    )
+
+
+def control_action(c: ControlSpec, robots: int, dt: float, time_limit: float, where: str) -> ControlRobot:
+    team, n = robot_id(c.robot, robots, f"{where}.robot")
+    check_control(c, DEFAULTS, time_limit, where)
+    return ControlRobot(
+        team=team,
+        robot=n,
+        ticks=max(1, int(round(c.seconds / dt))),
+        vx=c.vx,
+        vy=c.vy,
+        omega=c.omega,
+        kick_speed=c.kick_speed,
+        kick_lob=c.kick_lob,
+        dribbler=c.dribbler,
     )
 
 
@@ -215,6 +273,9 @@ def referee_action(r: RefereeSpec, robots: int, where: str) -> RefereeOverride:
         raise ValueError(f"{where}.team: {r.team!r} (a, b or empty)")
     if r.command in ("FREEKICK", "THROWIN", "DROP_BALL") and (r.x is None or r.y is None):
         raise ValueError(f"{where}: {r.command} needs the ball spot x and y")
+    if r.command in TEAM_COMMANDS and not r.team:
+        raise ValueError(f"{where}.team: {r.command} needs the team it is for (a or b)")
+    check_spot(r.x, r.y, DEFAULTS, where)
     n = robot_id(r.robot, robots, f"{where}.robot")[1] if r.robot else -1
     if (r.command in ("YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR_OUT")) != (n >= 0):
         raise ValueError(f"{where}.robot: cards and REPAIR_OUT need a robot, other commands none")
@@ -232,10 +293,23 @@ class Scenario:
     dt: float
     home: str  # the strategies' canonical names (strategies/registry.py)
     away: str
+    ranged: bool = False  # some number of `start` or `step` is drawn per run (scenarios/draws.py)
+    subs: tuple[Step, ...] = ()  # the substitution's steps (they depend on no draw)
+    notes: tuple[str, ...] = ()  # what the user should know though nothing is wrong
 
     @property
     def name(self) -> str:
         return self.spec.name
+
+    def drawn(self, seed: int) -> dict[str, float | int]:
+        """The numbers drawn for the run at `seed`, by their key in the file (`start.ball.x`); {} without ranges."""
+        return resolve_draws(self.spec, seed)[1] if self.ranged else {}
+
+    def params_at(self, seed: int) -> ScenarioParams:
+        if not self.ranged:
+            return self.params
+        spec = resolve_draws(self.spec, seed)[0]
+        return start_params(spec, self.dt, f"scenario[{self.index}]", subs=list(self.subs))
 
     def config(self, seed: int = 0, base: MatchConfig | None = None) -> MatchConfig:
         """The match every engine plays for this scenario: `base` (default values if None) with what
@@ -252,7 +326,7 @@ class Scenario:
             external=tuple(p.external),
             timing=dataclasses.replace(base.timing, perception_latency=p.perception_latency),
             rules=dataclasses.replace(base.rules, **p.rules),
-            scenario=self.params,
+            scenario=self.params_at(seed),
         )
 
     def ticks(self, seconds: float) -> int:
@@ -269,8 +343,9 @@ def start_steps(st: Start, robots: int, where: str) -> list[Step]:
     return [Step(at=0, actions=actions)]
 
 
-def step_actions(s: StepSpec, robots: int, where: str) -> list:
-    """What a step does, in a fixed order: robots, parked robots, the ball, the referee, the links."""
+def step_actions(s: StepSpec, robots: int, where: str, dt: float = 0.01, time_limit: float = 0.0) -> list:
+    """What a step does, in a fixed order: robots, parked robots, the ball, the referee, the links,
+    the kills, the robots driven."""
     actions: list = [robot_action(r, robots, f"{where}.robots[{i}]") for i, r in enumerate(s.robots)]
     for i, name in enumerate(s.park):
         team, n = robot_id(name, robots, f"{where}.park[{i}]")
@@ -290,8 +365,9 @@ def step_actions(s: StepSpec, robots: int, where: str) -> list:
             raise ValueError(f"{where}.link: {exc}") from None
         actions.append(SetLink(preset=s.link.preset, overrides=s.link.overrides))
     actions += kill_actions(s, robots, where)
+    actions += [control_action(c, robots, dt, time_limit, f"{where}.control[{i}]") for i, c in enumerate(s.control)]
     if not actions:
-        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee, park, link or kill)")
+        raise ValueError(f"{where}: a step does nothing (give ball, robots, referee, park, link, kill or control)")
     return actions
 
 
@@ -329,10 +405,10 @@ def condition(w: When, robots: int, where: str) -> Condition:
     return cond
 
 
-def step_of(s: StepSpec, robots: int, dt: float, where: str) -> Step:
+def step_of(s: StepSpec, robots: int, dt: float, where: str, time_limit: float = 0.0) -> Step:
     if (s.at is None) == (s.when is None):
         raise ValueError(f"{where}: give exactly one of `at` (seconds) and `when` (a condition)")
-    actions = step_actions(s, robots, where)
+    actions = step_actions(s, robots, where, dt, time_limit)
     if s.at is not None:
         if not (math.isfinite(s.at) and s.at >= 0):
             raise ValueError(f"{where}.at: seconds >= 0, got {s.at}")
@@ -347,34 +423,52 @@ def check_rules(p: Play, where: str) -> None:
     for key, value in p.rules.items():
         if key not in known:
             raise ValueError(f"{where}.play.rules.{key}: not a rule parameter (docs/rules.md: {', '.join(known)})")
-        if not (math.isfinite(value) and value >= 0) or (known[key] == "int" and value != int(value)):
-            raise ValueError(f"{where}.play.rules.{key}: a number >= 0 (a whole one for counts), got {value}")
+        if not (math.isfinite(value) and 0 <= value <= MAX_RULE) or (known[key] == "int" and value != int(value)):
+            raise ValueError(
+                f"{where}.play.rules.{key}: a number in [0, {MAX_RULE:g}] (a whole one for counts), got {value}"
+            )
     p.rules = {k: int(v) if known[k] == "int" else float(v) for k, v in p.rules.items()}
 
 
-def start_params(spec: ScenarioSpec, dt: float, where: str, base: Path = Path(".")) -> ScenarioParams:
-    """The engine's and the referee's share of `start` and `step` (time limit, clock, stage, steps)."""
+def run_end(spec: ScenarioSpec, dt: float) -> tuple[float, str]:
+    """The run's last moment [s] and why: `time_limit`, or the match's end when `start.clock` comes first."""
+    clock = spec.start.clock if spec.start is not None else 0.0
+    left = 2 * spec.play.half_time - clock  # type: ignore[operator]
+    if round(left / dt) < round(spec.time_limit / dt):
+        return left, f"the match ends {left:g} s in (start.clock {clock:g} s of 2 x {spec.play.half_time:g} s)"
+    return spec.time_limit, f"time_limit {spec.time_limit:g} s"
+
+
+def start_params(
+    spec: ScenarioSpec, dt: float, where: str, base: Path = Path("."), subs: list[Step] | None = None
+) -> ScenarioParams:
+    """The engine's and the referee's share of `start` and `step` (time limit, clock, stage, steps).
+    `subs`: the substitution's steps, if already read (they depend on no draw)."""
     p, st = spec.play, spec.start
-    steps = [step_of(s, p.robots, dt, f"{where}.step[{i}]") for i, s in enumerate(spec.step)]
+    if st is not None:
+        finite(st.clock, f"{where}.start.clock", 0.0, 2 * p.half_time, " s (the match's time)")  # type: ignore[arg-type]
+    end, why = run_end(spec, dt)
+    steps = [step_of(s, p.robots, dt, f"{where}.step[{i}]", end) for i, s in enumerate(spec.step)]
     ticks = int(round(spec.time_limit / dt))
     for i, step in enumerate(steps):
-        if step.at > ticks:
+        if step.at > round(end / dt):
             raise ValueError(
-                f"{where}.step[{i}].at: {spec.step[i].at:g} s is after the run's end "
-                f"(time_limit {spec.time_limit:g} s): the step would never happen"
+                f"{where}.step[{i}].at: {spec.step[i].at:g} s is after the run's end ({why}): the step would never happen"
             )
+    if subs is None:
+        subs = substitution(spec, ticks, dt, where, base)[0]
     if st is None:
-        return ScenarioParams(ticks=ticks, steps=tuple(steps + substitution(spec, ticks, dt, where, base)))
+        return ScenarioParams(ticks=ticks, steps=tuple(steps + subs))
     if st.stage not in ("FIRST_HALF", "SECOND_HALF"):
         raise ValueError(f"{where}.start.stage: FIRST_HALF or SECOND_HALF, got {st.stage!r}")
-    if len(st.score) != 2 or min(st.score) < 0:
-        raise ValueError(f"{where}.start.score: [goals of a, goals of b], got {st.score}")
+    if len(st.score) != 2 or min(st.score) < 0 or max(st.score) > MAX_SCORE:
+        raise ValueError(f"{where}.start.score: [goals of a, goals of b], each 0..{MAX_SCORE}, got {st.score}")
     if st.attack_dir_a not in (1, -1):
         raise ValueError(f"{where}.start.attack_dir_a: 1 or -1, got {st.attack_dir_a}")
-    steps += substitution(spec, ticks, dt, where, base)
+    steps += subs
     return ScenarioParams(
         ticks=ticks,
-        clock=int(round(st.clock / dt)),
+        clock=int(round(st.clock / dt)),  # type: ignore[operator]
         stage=st.stage,
         score=(st.score[0], st.score[1]),
         attack_dir_a=st.attack_dir_a,
@@ -382,26 +476,39 @@ def start_params(spec: ScenarioSpec, dt: float, where: str, base: Path = Path(".
     )
 
 
-def substitution(spec: ScenarioSpec, ticks: int, dt: float, where: str, base: Path) -> list[Step]:
+def substitution(spec: ScenarioSpec, ticks: int, dt: float, where: str, base: Path) -> tuple[list[Step], str]:
     """Replay with substitution: one team's robots follow their recorded poses, teleported every tick
-    from the recording's tick `from / dt` on; the other team and the ball play live."""
+    from the recording's tick `from / dt` on; the other team and the ball play live.
+    Returns the steps and a note when the recording ends before the run does."""
     sub, robots = spec.play.substitute, spec.play.robots
     if sub is None:
-        return []
+        return [], ""
     from arena.recording.reader import RecordingError, load
     from arena.schemas.messages import World
 
     if sub.team not in TEAMS:
         raise ValueError(f"{where}.play.substitute.team: {sub.team!r} (a or b)")
+    finite(sub.from_, f"{where}.play.substitute.from", 0.0, 1e6, " s")
     path = base / sub.recording  # relative to the scenario file
     try:
+        files.regular_file(str(path), "recording")
         worlds = load(str(path), keep={"world"}).decoded("world", World)
+    except ValueError as exc:
+        raise ValueError(f"{where}.play.substitute.recording: {path}: {exc}") from None
     except (RecordingError, OSError) as exc:
         raise ValueError(f"{where}.play.substitute.recording: {exc}") from None
     first = int(round(sub.from_ / dt))
     by_tick = {w.tick - first: w for w in worlds if first <= w.tick <= first + ticks}
     if 0 not in by_tick:
         raise ValueError(f"{where}.play.substitute.from: the recording has no world frame at {sub.from_} s")
+    last = max(by_tick)
+    end = int(round(run_end(spec, dt)[0] / dt))
+    note = ""
+    if last < end:
+        note = (
+            f"{where}.play.substitute: the recording ends {last * dt:g} s into the run (of {end * dt:g} s); "
+            f"from there team {sub.team} plays live"
+        )
     steps = []
     for k, w in sorted(by_tick.items()):
         acts = [
@@ -413,18 +520,22 @@ def substitution(spec: ScenarioSpec, ticks: int, dt: float, where: str, base: Pa
         ]
         if acts:
             steps.append(Step(at=k, actions=acts))
-    return steps
+    return steps, note
 
 
-def check_window(e: Expect, time_limit: float, where: str) -> None:
-    """The window `from` .. `within`/`until` lies inside the run and is not empty."""
+def check_window(e: Expect, spec: ScenarioSpec, where: str) -> None:
+    """The window `from` .. `within`/`until` lies inside the run and is not empty (with a `when` trigger
+    the window counts from the trigger's tick, and the run's end cuts it)."""
     if e.within is not None and e.until is not None:
         raise ValueError(f"{where}: give `within` or `until`, not both (they are the same)")
     key, end = ("within", e.within) if e.within is not None else ("until", e.until)
-    dt = MatchConfig().timing.dt
-    if end is not None and round(end / dt) > round(time_limit / dt):
-        raise ValueError(f"{where}.{key}: {end:g} s is after the run's end (time_limit {time_limit:g} s)")
-    end = time_limit if end is None else end
+    dt = DEFAULTS.timing.dt
+    last, why = run_end(spec, dt)
+    if e.when is None and end is not None and round(end / dt) > round(last / dt):
+        raise ValueError(f"{where}.{key}: {end:g} s is after the run's end ({why})")
+    if e.when is None and round(e.from_ / dt) > round(last / dt):
+        raise ValueError(f"{where}.from: {e.from_:g} s is after the run's end ({why})")
+    end = last if end is None else end
     if round(e.from_ / dt) > round(end / dt):
         raise ValueError(f"{where}.from: {e.from_:g} s is after the window's end ({end:g} s)")
 
@@ -432,10 +543,18 @@ def check_window(e: Expect, time_limit: float, where: str) -> None:
 def check_expectations(spec: ScenarioSpec, where: str) -> None:
     from arena.scenarios.expect import check_expect
 
+    processes = {str(p) for p in DEFAULTS.replace(robots=spec.play.robots, external=()).processes()}
     names = set()
     for i, e in enumerate(spec.expect):
         check_expect(e, spec.play.robots, f"{where}.expect[{i}]")
-        check_window(e, spec.time_limit, f"{where}.expect[{i}]")
+        check_window(e, spec, f"{where}.expect[{i}]")
+        if e.when is not None:
+            condition(e.when, spec.play.robots, f"{where}.expect[{i}].when")
+        if e.kind == "digest" and e.process not in processes:
+            raise ValueError(
+                f"{where}.expect[{i}].process: {e.process!r} is not a process of this match "
+                f"({', '.join(sorted(processes))})"
+            )
         if e.name in names:
             raise ValueError(f"{where}.expect[{i}].name: {e.name!r} is used twice")
         names.add(e.name)
@@ -453,35 +572,70 @@ def play_error(message: str, where: str) -> str:
     return f"{where}.play: {message}"
 
 
-def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
-    """Validate one scenario table (raises ValueError naming the key below `scenario[i]`)."""
-    where = f"scenario[{index}]"
-    dt = MatchConfig().timing.dt
+def check_play(spec: ScenarioSpec, where: str) -> tuple[str, str]:
+    """What plays: the strategies' canonical names; the link preset and the match's numbers checked."""
     p = spec.play
-    if not (math.isfinite(spec.time_limit) and spec.time_limit > 0):
-        raise ValueError(f"{where}.time_limit: a positive number of seconds, got {spec.time_limit}")
-    if not 0.0 <= spec.min_pass <= 1.0:
-        raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
-    check_rules(p, where)
-    params = start_params(spec, dt, where, Path(path).parent)
-    check_expectations(spec, where)
     names = []
     for side in ("home", "away"):
         try:
             names.append(registry.resolve_name(getattr(p, side)))
         except ConfigError as exc:
             raise ValueError(f"{where}.play.{side}: {exc}") from None
-    sc = Scenario(spec=spec, path=path, index=index, params=params, dt=dt, home=names[0], away=names[1])
     try:
         resolve(p.link, {})
     except ConfigError as exc:
         raise ValueError(f"{where}.play.link: {exc}") from None
     try:
-        sc.config()
+        DEFAULTS.replace(
+            robots=p.robots,
+            half_time=p.half_time,
+            timing=dataclasses.replace(DEFAULTS.timing, perception_latency=p.perception_latency),
+            rules=dataclasses.replace(DEFAULTS.rules, **p.rules),
+        )
     except ConfigError as exc:
         raise ValueError(play_error(str(exc), where)) from None
     for ext in p.external:
         ProcessId.parse(ext)
+    return names[0], names[1]
+
+
+def build(spec: ScenarioSpec, path: str, index: int) -> Scenario:
+    """Validate one scenario table (raises ValueError naming the key below `scenario[i]`).
+
+    A scenario with ranges is validated at both ends of every range (scenarios/draws.py)."""
+    where = f"scenario[{index}]"
+    dt = DEFAULTS.timing.dt
+    if not (math.isfinite(spec.time_limit) and dt <= spec.time_limit <= MAX_TIME_LIMIT):
+        raise ValueError(
+            f"{where}.time_limit: a positive number of seconds, at most {MAX_TIME_LIMIT:g}, got {spec.time_limit}"
+        )
+    if not 0.0 <= spec.min_pass <= 1.0:
+        raise ValueError(f"{where}.min_pass: a fraction in [0, 1], got {spec.min_pass}")
+    check_rules(spec.play, where)
+    home, away = check_play(spec, where)
+    ends = [resolve_draws(spec, None, end, where)[0] for end in ("low", "high", "far")]
+    ranged = ends[0] is not spec
+    fixed = ends[0] if ranged else spec
+    subs, note = substitution(fixed, int(round(spec.time_limit / dt)), dt, where, Path(path).parent)
+    for variant in ends if ranged else [spec]:
+        params = start_params(variant, dt, where, subs=subs)
+        check_expectations(variant, where)
+    sc = Scenario(
+        spec=spec,
+        path=path,
+        index=index,
+        params=params if not ranged else ScenarioParams(),
+        dt=dt,
+        home=home,
+        away=away,
+        ranged=ranged,
+        subs=tuple(subs),
+        notes=(note,) if note else (),
+    )
+    try:
+        sc.config()
+    except ConfigError as exc:
+        raise ValueError(play_error(str(exc), where)) from None
     return sc
 
 
@@ -489,11 +643,12 @@ def load_all(path: str | Path) -> list[Scenario]:
     """Every scenario of one file, validated; raises ScenarioError (one line)."""
     path = str(path)
     try:
-        data = tomllib.loads(Path(path).read_text())
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read it: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not TOML: {exc}") from None
+        data = files.parse(files.read_text(path))
+        files.check_counts(data)
+    except ValueError as exc:
+        raise ScenarioError(f"{path}: {exc}") from None
+    if files.misplaced(data):
+        raise ScenarioError(f"{path}: {files.misplaced(data)}")
     try:
         spec = msgspec.convert(data, FileSpec)
     except msgspec.ValidationError as exc:

@@ -16,6 +16,7 @@ import math
 import shlex
 import sys
 import tempfile
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,7 +24,7 @@ import msgspec
 
 from arena.scenarios.expect import Trace, judge
 from arena.scenarios.model import Scenario
-from arena.schemas.messages import Referee, World
+from arena.schemas.messages import EngineEvents, Referee, World
 
 ENGINES = ("inprocess", "processes")
 Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
@@ -50,12 +51,25 @@ class Verdict:
     score: tuple[int, int]
     ticks: int
     record: str = ""  # the MCAP of a failed run, if written
+    drawn: dict = field(default_factory=dict)  # the numbers drawn for this run (scenarios/draws.py)
+    seconds: float = field(default=0.0, compare=False)  # [s] wall time the run took (not part of the verdict)
 
-    def replay_command(self) -> str:
-        return (
-            f"arena scenario run {shlex.quote(self.path)} --name {shlex.quote(self.scenario)} "
-            f"--seed {self.seed} --engine {self.engine} --record {shlex.quote(self.record or 'run.mcap')}"
+    def record_name(self, directory: str = "scenario-runs") -> str:
+        """Where this run's MCAP goes: one absolute path per file, scenario and seed."""
+        stem = Path(self.path).name.split(".")[0]
+        return str(Path(directory).expanduser().resolve() / f"{stem}-{self.scenario}-seed{self.seed}.mcap")
+
+    def replay_command(self, directory: str = "scenario-runs") -> str:
+        """The command that plays this run again, from any directory. A run already recorded needs no
+        --record (its MCAP is `record`); any other is recorded to its own new file."""
+        cmd = (
+            f"arena scenario run {shlex.quote(str(Path(self.path).resolve()))} --name {shlex.quote(self.scenario)} "
+            f"--seed {self.seed} --engine {self.engine}"
         )
+        return cmd if self.record else f"{cmd} --record {shlex.quote(self.record_name(directory))}"
+
+    def drawn_text(self) -> str:
+        return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.drawn.items())
 
     def to_json(self) -> dict:
         return {
@@ -69,6 +83,8 @@ class Verdict:
             "score": list(self.score),
             "ticks": self.ticks,
             "record": self.record,
+            "drawn": self.drawn,
+            "seconds": round(self.seconds, 3),
         }
 
 
@@ -102,8 +118,9 @@ class Outcome:
     def passed(self) -> bool:
         return bool(self.verdicts) and self.rate >= self.scenario.spec.min_pass
 
-    def describe(self) -> str:
-        """The verdict line; for a failed scenario, per failed expectation its name, tick, seed and replay command."""
+    def describe(self, records: str = "scenario-runs") -> str:
+        """The verdict line; for a failed scenario, per failed expectation its name, tick, seed (with the numbers
+        drawn for it) and the command that replays the run."""
         n = len(self.verdicts)
         lo, hi = wilson(self.passed_runs, n)
         lines = [
@@ -112,10 +129,13 @@ class Outcome:
             f"min_pass {self.scenario.spec.min_pass:g}"
         ]
         for v in self.verdicts if not self.passed else ():
+            drawn = f" ({v.drawn_text()})" if v.drawn else ""
             for f in v.failures:
-                lines.append(f"  seed {v.seed}: expectation {f.name!r} failed at tick {f.tick}: {f.detail}")
+                lines.append(f"  seed {v.seed}{drawn}: expectation {f.name!r} failed at tick {f.tick}: {f.detail}")
             if v.failures:
-                lines.append(f"    replay: {v.replay_command()}")
+                if v.record:
+                    lines.append(f"    recorded: {v.record} (digest {v.digest})")
+                lines.append(f"    replay: {v.replay_command(records)}")
         return "\n".join(lines)
 
     def to_json(self) -> dict:
@@ -131,12 +151,21 @@ class Outcome:
         }
 
 
-def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: dict[str, str]) -> Trace:
+def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: dict[str, str], events) -> Trace:
     cfg = sc.config()
     f = cfg.field
     commands = [c for r in referees for c in r.commands]
     fence = (f.length / 2 + f.runoff, f.width / 2 + f.runoff)
-    return Trace(dt=cfg.timing.dt, worlds=worlds, commands=commands, digests=digests, fence=fence)
+    scores = [(r.tick, r.score_a, r.score_b) for r in referees]
+    return Trace(
+        dt=cfg.timing.dt,
+        worlds=worlds,
+        commands=commands,
+        digests=digests,
+        fence=fence,
+        events=[ev for e in events for ev in e.events],
+        scores=scores,
+    )
 
 
 def combined_digest(cfg, digests: dict[str, str]) -> str:
@@ -152,13 +181,16 @@ def combined_digest(cfg, digests: dict[str, str]) -> str:
 def _inprocess(sc: Scenario, seed: int, record: str):
     from arena.tools.launch.inprocess import play_in_process
 
-    summaries, frames = play_in_process(sc.config(seed), watch=("world", "referee"), record=record)
+    cfg = sc.config(seed)
+    summaries, frames = play_in_process(cfg, watch=("world", "referee", "events"), record=record)
     wdec = msgspec.msgpack.Decoder(World).decode
     rdec = msgspec.msgpack.Decoder(Referee).decode
+    edec = msgspec.msgpack.Decoder(EngineEvents).decode
     worlds = [wdec(p) for p in frames["world"]]
     referees = [rdec(p) for p in frames["referee"]]
+    events = [edec(p) for p in frames["events"]]
     digests = {name: s.digest for name, s in summaries.items() if name != "recorder"}
-    return worlds, referees, digests, combined_digest(sc.config(seed), digests)
+    return worlds, referees, digests, combined_digest(cfg, digests), events
 
 
 def _processes(sc: Scenario, seed: int, record: str):
@@ -170,11 +202,12 @@ def _processes(sc: Scenario, seed: int, record: str):
         # An --external process is started by hand: the launcher says the command to type there.
         announce = lambda text: print(text, file=sys.stderr, flush=True)
         result = play_match(sc.config(seed), record=path, strict=True, announce=announce)
-        rec = load(path, keep={"world", "referee"})
+        rec = load(path, keep={"world", "referee", "engine/events"})
         worlds = rec.decoded("world", World)
         referees = rec.decoded("referee", Referee)
+        events = rec.decoded("engine/events", EngineEvents)
     digests = {k: v for k, v in result.process_digests.items() if k != "recorder"}
-    return worlds, referees, digests, result.digest
+    return worlds, referees, digests, result.digest, events
 
 
 def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:
@@ -185,8 +218,9 @@ def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = ""
     if sc.spec.play.external and engine != "processes":
         raise ValueError(f"{sc.path}: scenario {sc.name!r} has external processes: it needs --engine processes")
     play = _inprocess if engine == "inprocess" else _processes
-    worlds, referees, digests, total = play(sc, seed, record)
-    trace = _trace(sc, worlds, referees, digests)
+    t0 = time.perf_counter()
+    worlds, referees, digests, total, events = play(sc, seed, record)
+    trace = _trace(sc, worlds, referees, digests, events)
     failures = []
     for e in sc.spec.expect:
         ok, tick, detail = judge(e, trace, sc.spec.time_limit)
@@ -204,4 +238,6 @@ def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = ""
         score=(last.score_a, last.score_b) if last else (0, 0),
         ticks=worlds[-1].tick if worlds else 0,
         record=record,
+        drawn=sc.drawn(seed),
+        seconds=time.perf_counter() - t0,
     )

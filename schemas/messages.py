@@ -352,6 +352,12 @@ class TeleportBall(Base, tag="teleport_ball"):
         bool,
         Meta(description="no jump: the ball is rolled towards (x, y) so that rolling friction stops it there"),
     ] = False
+    safely: Annotated[
+        bool, Meta(description="SSL teleport_safely: the nearest spot to (x, y) clear of every robot")
+    ] = False
+    roll: Annotated[
+        bool, Meta(description="SSL roll: on the ground and rolling (z and vz ignored), not flying")
+    ] = False
 
 
 class TeleportRobot(Base, tag="teleport_robot"):
@@ -371,6 +377,25 @@ class TeleportRobot(Base, tag="teleport_robot"):
     by_force: Annotated[
         bool, Meta(description="no jump: the robot is pushed towards (x, y) at up to its max speed")
     ] = False
+    safely: Annotated[
+        bool,
+        Meta(description="SSL teleport_safely: the nearest spot to (x, y) clear of other robots, the ball and goals"),
+    ] = False
+
+
+class ControlRobot(Base, tag="control"):
+    """Drive one robot for `ticks` ticks with these body-frame velocities, kick and dribbler (SSL `RobotControl`);
+    its own process's commands are ignored meanwhile."""
+
+    team: Team
+    robot: Annotated[int, Meta(ge=0, description="robot number")]
+    ticks: Annotated[int, Meta(ge=1, description="[ticks] how long, from the step's tick")]
+    vx: Annotated[float, Meta(description="[m/s] body frame, forward")] = 0.0
+    vy: Annotated[float, Meta(description="[m/s] body frame, left")] = 0.0
+    omega: Annotated[float, Meta(description="[rad/s]")] = 0.0
+    kick_speed: Annotated[float, Meta(ge=0.0, description="[m/s] kick when the ball is in reach; 0: none")] = 0.0
+    kick_lob: Annotated[bool, Meta(description="lob kick instead of a flat kick")] = False
+    dribbler: Annotated[bool, Meta(description="dribbler on")] = False
 
 
 class RefereeOverride(Base, tag="referee"):
@@ -399,7 +424,7 @@ class KillProcess(Base, tag="kill"):
     process: Annotated[str, Meta(description="robot/<team>/<n> or basestation/<team>")]
 
 
-Action = TeleportBall | TeleportRobot | RefereeOverride | SetLink | KillProcess
+Action = TeleportBall | TeleportRobot | RefereeOverride | SetLink | KillProcess | ControlRobot
 
 
 class Region(Base):

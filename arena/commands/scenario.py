@@ -10,7 +10,8 @@ import argparse
 import json
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -23,9 +24,12 @@ examples:
   arena scenario run corner.scenario.toml --engine processes   # every process its own OS process
 
 A run fails when an expectation fails; a scenario fails when its pass rate over the
-seeds is below its min_pass. A failed scenario's failed runs are written as MCAP
-files (--records, default scenario-runs/) for arena review. Exit 0: every scenario
-passed; 1: one failed; 2: a bad file or flag. docs/scenarios.md has the file format."""
+seeds is below its min_pass. On a terminal each run says when it is done; a last line
+counts the scenarios passed and failed. A failed scenario's failed runs are written as
+MCAP files (--records, default scenario-runs/) for arena review, and each failure
+prints the command that replays its run, from any directory. Ctrl-C stops: the runs
+already done are reported. Exit 0: every scenario passed; 1: one failed; 2: a bad file
+or flag; 130: interrupted. docs/scenarios.md has the file format."""
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -114,6 +118,10 @@ def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
         from arena.tools.launch.run import record_path
 
         try:
+            Path(args.record).expanduser().parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ScenarioError(f"--record {args.record}: cannot make its directory ({exc.strerror or exc})") from None
+        try:
             args.record = record_path(args.record, fresh=True)
         except ConfigError as exc:
             raise ScenarioError(str(exc)) from None
@@ -142,24 +150,78 @@ def run(args: argparse.Namespace) -> int:
     except ScenarioError as exc:
         print(f"arena scenario: error: {exc}", file=sys.stderr)
         return 2
+    for sc in scenarios:
+        for note in sc.notes:
+            print(f"arena scenario: note: {sc.path}: {note}", file=sys.stderr)
     items = [(sc, s, args.engine, args.record or "") for sc in scenarios for s in seeds]
-    if args.jobs > 1 and len(items) > 1:
-        with ProcessPoolExecutor(min(args.jobs, len(items)), mp_context=get_context("fork")) as pool:
-            verdicts = list(pool.map(_job, items))
-    else:
-        verdicts = [_job(item) for item in items]
-    outcomes = [Outcome(sc, [v for v in verdicts if v.scenario == sc.name and v.path == sc.path]) for sc in scenarios]
+    t0 = time.monotonic()
+    verdicts, stop = play_all(items, args.jobs, progress(len(items)))
+    outcomes = [
+        Outcome(sc, sorted((v for v in verdicts if v.scenario == sc.name and v.path == sc.path), key=lambda v: v.seed))
+        for sc in scenarios
+    ]
+    outcomes = [o for o in outcomes if o.verdicts]  # interrupted: the scenarios with a finished run
     for o in outcomes:
-        if not o.passed and not args.record:
+        if not o.passed and not args.record and stop is None:
             record_failures(o, args.records)
     if args.junit:
         write_junit(args.junit, outcomes)
+    summary = closing(outcomes, time.monotonic() - t0, len(verdicts), len(items))
     if args.json:
-        print(json.dumps({"passed": all(o.passed for o in outcomes), "scenarios": [o.to_json() for o in outcomes]}))
+        out = {"passed": all(o.passed for o in outcomes) and stop is None, "summary": summary}
+        print(json.dumps(out | {"scenarios": [o.to_json() for o in outcomes]}))
     else:
         for o in outcomes:
-            print(o.describe())
+            print(o.describe(args.records))
+        print(summary, flush=True)
+    if stop is not None:
+        raise stop  # the CLI says "interrupted" and exits 130 (143 for SIGTERM)
     return 0 if all(o.passed for o in outcomes) else 1
+
+
+def play_all(items: list, jobs: int, done) -> tuple[list, KeyboardInterrupt | None]:
+    """Every run, `done(verdict)` as each ends; Ctrl-C (or SIGTERM) stops and returns the runs finished."""
+    from arena.tools.experiments import pools
+
+    verdicts: list = []
+    try:
+        if jobs > 1 and len(items) > 1:
+            pool, stopped = ProcessPoolExecutor(min(jobs, len(items)), mp_context=get_context("fork")), True
+            try:
+                for future in as_completed([pool.submit(_job, item) for item in items]):
+                    verdicts.append(future.result())
+                    done(verdicts[-1])
+                stopped = False
+            finally:
+                pools.stop(pool, now=stopped)
+        else:
+            for item in items:
+                verdicts.append(_job(item))
+                done(verdicts[-1])
+    except KeyboardInterrupt as exc:
+        return verdicts, exc
+    return verdicts, None
+
+
+def progress(total: int):
+    """On a terminal, one line on stderr per run as it ends; piped, nothing (the verdicts follow)."""
+    count = [0]
+
+    def done(v) -> None:
+        count[0] += 1
+        if sys.stderr.isatty():
+            drawn = f" ({v.drawn_text()})" if v.drawn else ""
+            word = "pass" if v.passed else "FAIL"
+            print(f"[{count[0]}/{total}] {word} {v.scenario} seed {v.seed}{drawn}, {v.seconds:.1f} s", file=sys.stderr)
+
+    return done
+
+
+def closing(outcomes: list, seconds: float, finished: int, total: int) -> str:
+    """The last line: scenarios passed and failed, the time, and what an interruption left out."""
+    passed = sum(o.passed for o in outcomes)
+    line = f"{passed} passed, {len(outcomes) - passed} failed in {seconds:.0f} s ({finished} runs)"
+    return line if finished == total else f"{line}; interrupted: {total - finished} of {total} runs not played"
 
 
 def record_failures(o, directory: str, most: int = 3) -> None:
@@ -173,6 +235,8 @@ def record_failures(o, directory: str, most: int = 3) -> None:
         if v.passed or most <= 0:
             continue
         most -= 1
-        path = str(Path(directory) / f"{Path(v.path).name.split('.')[0]}-{v.scenario}-seed{v.seed}.mcap")
+        path = v.record_name(directory)
+        if os.path.exists(path):  # an earlier run's file: this run's recording replaces it
+            os.unlink(path)
         again = run_one(o.scenario, v.seed, v.engine, path)
         o.verdicts[i] = dataclasses.replace(v, record=path if again.digest == v.digest else "")

@@ -139,6 +139,11 @@ class BallFlight:
         """
         self.place_ball(x, y, vx, vy)
         self._pin = None
+        # Put down beyond a line, the ball is out as if it had just crossed it: the next step reports
+        # TOUCH_LINE or GOAL_LINE (never GOAL: it did not cross between the posts), and the referee
+        # decides as for any ball out of play (docs/rules.md rules 10-13).
+        self._out = False
+        self._cross_high = abs(x) > self._half_len
         if z > 0.0 or vz > 0.0:
             self._z, self._vz = z, vz
             self._airborne = True
