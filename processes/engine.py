@@ -306,13 +306,17 @@ class EngineNode(Node):
             self.pacer.stop()
 
     def summary_extra(self) -> dict[str, object]:
-        return {
-            "distance_m": {f"{t}/{n}": round(d, 3) for (t, n), d in sorted(self.physics.distance.items())},
-            "ticks": self.last_tick,
-            "placed": len(self.restarts.placed),
-            "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
-            "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
-        } | ({"operator": self.operator.log} if self.operator is not None else {}) | self.director_extra()
+        return (
+            {
+                "distance_m": {f"{t}/{n}": round(d, 3) for (t, n), d in sorted(self.physics.distance.items())},
+                "ticks": self.last_tick,
+                "placed": len(self.restarts.placed),
+                "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
+                "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
+            }
+            | ({"operator": self.operator.log} if self.operator is not None else {})
+            | self.director_extra()
+        )
 
     def director_extra(self) -> dict[str, object]:
         """Teleports a scenario or the operator asked for that went to another spot (safely, or onto a robot)."""

@@ -355,9 +355,9 @@ class TeleportBall(Base, tag="teleport_ball"):
     safely: Annotated[
         bool, Meta(description="SSL teleport_safely: the nearest spot to (x, y) clear of every robot")
     ] = False
-    roll: Annotated[
-        bool, Meta(description="SSL roll: on the ground and rolling (z and vz ignored), not flying")
-    ] = False
+    roll: Annotated[bool, Meta(description="SSL roll: on the ground and rolling (z and vz ignored), not flying")] = (
+        False
+    )
 
 
 class TeleportRobot(Base, tag="teleport_robot"):
