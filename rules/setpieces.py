@@ -166,6 +166,7 @@ def legal_spot(
     distance: float,
     others: list[tuple[float, float]],
     cfg: MatchConfig,
+    accept=None,
 ) -> tuple[float, float]:
     """The free place nearest to (x, y) at least `distance` from `spot`.
 
@@ -173,8 +174,9 @@ def legal_spot(
     then RING_STEP further out), first in the robot's own direction from the
     spot, then alternately ANGLE_STEP to either side. A candidate must keep
     the robot inside the fence, out of both goals, and clear of every robot
-    in `others` (bounding circles). Deterministic; falls back to (x, y) if
-    nothing fits (never with the default field).
+    in `others` (bounding circles), and pass `accept(x, y)` if given.
+    Deterministic; falls back to (x, y) if nothing fits (never with the
+    default field).
     """
     f, size = cfg.field, cfg.robot.size
     reach = size * math.sqrt(0.5)  # [m] bounding circle radius of the square footprint
@@ -196,7 +198,7 @@ def legal_spot(
             cx, cy = spot[0] + radius * math.cos(a), spot[1] + radius * math.sin(a)
             if abs(cx) > xmax or abs(cy) > ymax or (abs(cx) > goal_x and abs(cy) < goal_y):
                 continue
-            if all(math.hypot(cx - ox, cy - oy) >= gap for ox, oy in others):
+            if all(math.hypot(cx - ox, cy - oy) >= gap for ox, oy in others) and (accept is None or accept(cx, cy)):
                 return cx, cy
     return x, y
 
@@ -218,9 +220,12 @@ def penalty_positions(
     the goal, facing the field. The taker, the taking team's field robot
     nearest to the mark (its keeper if it has no other), stands
     `PENALTY_BEHIND` behind the mark facing the goal. Every other robot
-    leaves the penalty area and keeps `setpiece_distance` from the mark
-    (`legal_spot`, with rings further out until the place is outside the
-    area). Robots already where they may be are not in the list.
+    leaves the penalty area, keeps `setpiece_distance` from the mark and
+    stands inside the field of play, its centre not beyond a line (MSL, as
+    FIFA Law 14: "inside the field of play, outside the penalty area"), found
+    by `legal_spot` with rings further out until the place is outside the area
+    (and, if that place is off the field, the nearest one that is neither).
+    Robots already where they may be are not in the list.
     """
     f, reach = cfg.field, cfg.robot.size * math.sqrt(0.5)
     defender = other_team(taker_team)
@@ -229,6 +234,9 @@ def penalty_positions(
 
     def in_area(x: float, y: float) -> bool:
         return side * x > front - reach and abs(y) < f.penalty_area_width / 2 + reach
+
+    def on_field(x: float, y: float) -> bool:
+        return abs(x) <= f.length / 2 and abs(y) <= f.width / 2
 
     pos = {(t, n): (x, y) for t, n, x, y in robots}
     takers = sorted((math.hypot(x - spot[0], y - spot[1]), n) for t, n, x, y in robots if t == taker_team and n != 0)
@@ -242,13 +250,17 @@ def penalty_positions(
         pos[r] = (x, y)
     d0 = cfg.rules.setpiece_distance
     for t, n, x, y in robots:
-        if (t, n) in fixed or (math.hypot(x - spot[0], y - spot[1]) >= d0 and not in_area(x, y)):
+        if (t, n) in fixed or (math.hypot(x - spot[0], y - spot[1]) >= d0 and not in_area(x, y) and on_field(x, y)):
             continue
         others = [p for r, p in pos.items() if r != (t, n)]
         for ring in range(8):
             nx, ny = legal_spot(x, y, spot, d0 + ring * RING_STEP, others, cfg)
             if not in_area(nx, ny):
                 break
+        if not on_field(nx, ny):  # behind the goal line or beyond a touch line: off the field of play
+            nx, ny = legal_spot(
+                x, y, spot, d0, others, cfg, accept=lambda cx, cy: on_field(cx, cy) and not in_area(cx, cy)
+            )
         pos[(t, n)] = (nx, ny)
         moves.append((t, n, nx, ny, math.nan))  # nan: keeps its heading
     return moves

@@ -96,13 +96,15 @@ def check_counts(data: dict) -> None:
 
 def misplaced(data: dict) -> str:
     """A file whose keys belong in a `[[scenario]]` table but stand at the top: say so."""
-    if "scenario" in data:
-        return ""
     from arena.scenarios.model import ScenarioSpec
 
     keys = [k for k in data if k in ScenarioSpec.__struct_encode_fields__]
     if not keys:
-        return "no [[scenario]] table; a scenario file holds one or more (docs/scenarios.md)"
+        if "scenario" not in data:
+            return "no [[scenario]] table; a scenario file holds one or more (docs/scenarios.md)"
+        if isinstance(data["scenario"], dict) and "name" in data["scenario"]:
+            return "scenario: write [[scenario]] (two brackets: a file may hold several), not [scenario]"
+        return ""
     return (
         f"{', '.join(f'`{k}`' for k in keys)} belong in a [[scenario]] table: "
         "put the line [[scenario]] above them (docs/scenarios.md)"

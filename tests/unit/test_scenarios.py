@@ -14,8 +14,8 @@ from arena.cli import main
 from arena.recording.reader import load as load_recording
 from arena.scenarios import ScenarioError, load, load_all, wilson
 from arena.scenarios.expect import Trace, judge
-from arena.scenarios.model import Expect
-from arena.schemas.messages import RefCommand, RobotState, World
+from arena.scenarios.model import Expect, When
+from arena.schemas.messages import BallEvent, RefCommand, RobotState, World
 
 pytest_plugins = ["pytester"]
 
@@ -94,6 +94,45 @@ def files(tmp_path):
         ),
         # two scenarios of one name: their verdicts were counted together, each twice
         ((ROLL_IN, ROLL_IN + ROLL_IN), "scenario[1].name: 'roll-in' is already scenario[0]'s"),
+        # a PENALTY without its team loaded, was rejected three times at run time, and the scenario passed
+        (
+            ("[scenario.start]", "[[scenario.step]]\nat = 1.0\nreferee = { command = 'PENALTY' }\n[scenario.start]"),
+            "scenario[0].step[0].referee.team: PENALTY needs the team it is for (a or b)",
+        ),
+        # start.clock near the end: the run ends early; a window after that end judged ticks that never ran
+        (
+            ("[scenario.start]", "[scenario.start]\nclock = 599.5"),
+            "scenario[0].expect[0].within: 1 s is after the run's end (the match ends 0.5 s in (start.clock 599.5 s",
+        ),
+        (
+            ("[scenario.start]", "[[scenario.step]]\nat = 1.5\npark = ['a/1']\n[scenario.start]\nclock = 599.0"),
+            "scenario[0].step[0].at: 1.5 s is after the run's end (the match ends 1 s in",
+        ),
+        # a digest of a process that does not exist failed only at run time
+        (
+            ('kind = "goal"\nteam = "a"', 'kind = "digest"\nprocess = "robot/a/9"\ndigest = "ab"'),
+            "scenario[0].expect[0].process: 'robot/a/9' is not a process of this match",
+        ),
+        # a reversed region was silently normalised
+        (
+            ("region = [-0.1, -0.1, 0.1, 0.1]", "region = [0.1, -0.1, -0.1, 0.1]"),
+            "scenario[0].expect[1].region: [x0, y0, x1, y1] with x0 <= x1 and y0 <= y1",
+        ),
+        # numbers out of range reached the physics or ran for ever
+        (("x = 4.0, y = 0.0", "x = 50.0, y = 0.0"), "scenario[0].start.ball.x: a number in [-6.89, 6.89] m (inside"),
+        (("x = 4.0, y = 0.0", "x = nan, y = 0.0"), "scenario[0].start.ball.x: a number in"),
+        (("x = 4.0, y = 0.0", "x = 4.0, y = inf"), "scenario[0].start.ball.y: a number in"),
+        (("vx = 4.0", "vx = 1e308"), "scenario[0].start.ball.vx: a number in [-20, 20] m/s"),
+        (("time_limit = 2.0", "time_limit = 1e308"), "scenario[0].time_limit: a positive number of seconds, at most"),
+        (
+            ('robot = "b/0", present = false', 'robot = "b/0", x = 1e308'),
+            "scenario[0].start.robots[0].x: a number in [-6.775, 6.775] m (inside the fence)",
+        ),
+        # the keys of a scenario at the top of the file: "unknown field `name`" did not say where they belong
+        (
+            ("[[scenario]]\n", ""),
+            "`name`, `time_limit` belong in a [[scenario]] table: put the line [[scenario]] above them",
+        ),
     ],
 )
 def test_a_bad_file_is_one_line_naming_the_key(tmp_path, capsys, change, message):
@@ -129,7 +168,17 @@ def test_wilson_interval():
 # ------------------------------------------------------------ expectations
 def world(tick, bx, by, robots=(), has=None):
     rs = [RobotState(team=t, robot=n, x=x, y=y, theta=0.0, has_ball=(t, n) == has) for t, n, x, y in robots]
-    return World(tick=tick, t=tick * 0.02, ball_x=bx, ball_y=by, robots=rs)
+    last = ("a", 1) if 30 <= tick < 60 else ("b", 1) if tick >= 60 else ("", -1)
+    return World(
+        tick=tick,
+        t=tick * 0.02,
+        ball_x=bx,
+        ball_y=by,
+        ball_vx=0.25 * tick if tick <= 20 else 0.0,
+        robots=rs,
+        last_team=last[0],
+        last_robot=last[1],
+    )
 
 
 TRACE = Trace(
@@ -140,6 +189,11 @@ TRACE = Trace(
     ],
     commands=[RefCommand(name="CORNER", team="a", x=5.75, y=3.75, tick=40), RefCommand(name="GOAL", team="b", tick=90)],
     digests={"engine": "abcdef0123"},
+    events=[
+        BallEvent(kind="TOUCH", tick=30, team="a", robot=1),
+        BallEvent(kind="FOUL_PUSHING", tick=70, team="b", robot=1, x=1.0, y=1.0),
+    ],
+    scores=[(k, 0, 1 if k >= 90 else 0) for k in range(0, 101, 5)],
 )
 
 
@@ -166,6 +220,27 @@ TRACE = Trace(
         (dict(kind="not_stuck", seconds=1.0, robots=["a/1"]), True, 100),
         (dict(kind="digest", process="engine", digest="abcd"), True, 100),
         (dict(kind="digest", process="engine", digest="abce"), False, 100),
+        (dict(kind="ball_speed", speed=4.0), True, 17),
+        (dict(kind="ball_speed", speed=4.0, until=0.3), False, 15),
+        (dict(kind="ball_never_faster", speed=6.0), True, 100),
+        (dict(kind="ball_never_faster", speed=2.0), False, 9),
+        (dict(kind="last_touch", team="b"), True, 100),
+        (dict(kind="last_touch", team="a", until=1.0), True, 50),
+        (dict(kind="last_touch", robot="a/1"), False, 100),
+        (dict(kind="score", score=[0, 1]), True, 100),
+        (dict(kind="score", score=[0, 1], until=1.0), False, 50),
+        (dict(kind="event", event="FOUL_PUSHING", team="b"), True, 70),
+        (dict(kind="event", event="FOUL_PUSHING", robot="b/2"), False, 100),
+        (dict(kind="never_event", event="TOUCH", until=0.5), True, 25),
+        (dict(kind="never_event", event="TOUCH"), False, 30),
+        # windows from a trigger: the first tick a holds the ball is 51
+        (dict(kind="ball_in", region=[5.0, -1.0, 6.0, 1.0], when=When(possession="a")), True, 51),
+        (dict(kind="ball_in", region=[5.5, -1.0, 6.0, 1.0], when=When(possession="a"), **{"from_": 0.1}), True, 56),
+        (dict(kind="ball_never_in", region=[5.0, -1.0, 6.0, 1.0], when=When(possession="a")), False, 51),
+        (dict(kind="goal", team="b", when=When(possession="a"), within=0.7), False, 86),
+        (dict(kind="goal", team="b", when=When(possession="a"), within=0.8), True, 90),
+        (dict(kind="never_command", command="GOAL", when=When(command="CORNER")), False, 90),
+        (dict(kind="possession", team="a", when=When(possession="b")), False, 100),
     ],
 )
 def test_each_kind_judges_its_window(fields, ok, tick):
