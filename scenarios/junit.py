@@ -17,7 +17,8 @@ def classname(path: str) -> str:
     except ValueError:
         pass
     text = p.as_posix().lstrip("/")
-    return text[: -len(".scenario.toml")] if text.endswith(".scenario.toml") else text
+    text = text[: -len(".scenario.toml")] if text.endswith(".scenario.toml") else text
+    return text.replace("/", ".")
 
 
 def write_junit(path: str, outcomes: list) -> None:

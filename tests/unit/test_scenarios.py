@@ -364,7 +364,7 @@ def test_every_key_and_kind_is_documented():
 
     text = DOC.read_text()
     specs = [model.Play, model.Substitute, model.BallSpec, model.RobotSpec, model.RefereeSpec, model.Start]
-    specs += [model.When, model.StepSpec, model.LinkSpec, model.Expect, model.ScenarioSpec]
+    specs += [model.When, model.StepSpec, model.LinkSpec, model.Expect, model.ScenarioSpec, model.ControlSpec]
     missing = [
         f"{cls.__name__}.{f.encode_name}"
         for cls in specs
