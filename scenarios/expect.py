@@ -48,9 +48,9 @@ class Trace:
 
     def window(self, e, time_limit: float, origin: int = 0) -> tuple[int, int]:
         until = e.within if e.within is not None else (e.until if e.until is not None else None)
-        last = self.worlds[-1].tick if self.worlds else int(round(time_limit / self.dt))
-        hi = last if until is None else origin + int(round(until / self.dt))
-        return origin + int(round(e.from_ / self.dt)), min(hi, last) if e.when is not None else hi
+        last = int(round(time_limit / self.dt))  # the run's end (a run judged mid-way has not reached it)
+        hi = last if until is None else min(last, origin + int(round(until / self.dt)))
+        return origin + int(round(e.from_ / self.dt)), hi
 
     def trigger(self, when) -> int | None:
         """The first tick at which the condition `when` holds on the trace (the referee's commands so far)."""

@@ -22,8 +22,9 @@ from pathlib import Path
 
 import msgspec
 
+from arena.scenarios.draws import resolve as resolve_draws
 from arena.scenarios.expect import Trace, judge
-from arena.scenarios.model import Scenario
+from arena.scenarios.model import Scenario, run_end
 from arena.schemas.messages import EngineEvents, Referee, World
 
 ENGINES = ("inprocess", "processes")
@@ -222,8 +223,9 @@ def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = ""
     worlds, referees, digests, total, events = play(sc, seed, record)
     trace = _trace(sc, worlds, referees, digests, events)
     failures = []
+    end = run_end(resolve_draws(sc.spec, seed)[0], sc.dt)[0]  # time_limit, or the match's end if sooner
     for e in sc.spec.expect:
-        ok, tick, detail = judge(e, trace, sc.spec.time_limit)
+        ok, tick, detail = judge(e, trace, end)
         if not ok:
             failures.append(Failure(e.name, tick, detail))
     last = referees[-1] if referees else None
