@@ -204,7 +204,7 @@ class Director:
         x, y, th = ph.robot_pose(*r)
         reach = self.cfg.robot.size * math.sqrt(0.5)
         others = self.bodies(r, ball=False, only=set(placed))
-        if any(math.hypot(x - ox, y - oy) < self.cfg.robot.size for ox, oy, _ in others):
+        if any(math.hypot(x - ox, y - oy) < OVERLAP * self.cfg.robot.size for ox, oy, _ in others):
             nx, ny = self.resettle(r, x, y, free_spot(x, y, reach, others, self.cfg))
             ph.teleport_robot(r[0], r[1], (nx, ny, th), ph.robot_velocity(*r))
 
@@ -240,6 +240,7 @@ def free_spot(
 FREE_STEP = 0.05  # [m] between the rings `free_spot` tries
 FREE_RINGS = 80  # up to 4 m away
 FREE_GAP = 0.01  # [m] clearance between bodies put down
+OVERLAP = 0.9  # two robots whose centres are closer than this many sizes were put onto each other (not a slop)
 
 
 class OperatorInbox:

@@ -22,6 +22,8 @@ examples:
   arena scenario run "$(arena scenario library)" --seeds 3 --junit report.xml   # the shipped library
   arena scenario run corner.scenario.toml --name corner-attack --seed 4 --record run.mcap   # replay one run
   arena scenario run corner.scenario.toml --engine processes   # every process its own OS process
+  arena scenario run "$(arena scenario library)/behaviour/corner-routine.scenario.toml" --seeds 100 --jobs 2
+                                                               # a pass rate over randomised starts
 
 A run fails when an expectation fails; a scenario fails when its pass rate over the
 seeds is below its min_pass. On a terminal each run says when it is done; a last line
@@ -30,6 +32,9 @@ MCAP files (--records, default scenario-runs/) for arena review, and each failur
 prints the command that replays its run, from any directory. Ctrl-C stops: the runs
 already done are reported. Exit 0: every scenario passed; 1: one failed; 2: a bad file
 or flag; 130: interrupted. docs/scenarios.md has the file format."""
+
+
+CATCH_SIGTERM = True  # SIGTERM stops as Ctrl-C does: the runs done are reported (arena/cli.py)
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
