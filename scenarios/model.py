@@ -141,7 +141,7 @@ class ControlSpec(Spec):
 class Start(Spec):
     stage: str = "FIRST_HALF"
     clock: Num = 0.0
-    score: list[int] = msgspec.field(default_factory=lambda: [0, 0])
+    score: list[int | Draw] = msgspec.field(default_factory=lambda: [0, 0])
     attack_dir_a: int = 1
     referee: RefereeSpec = msgspec.field(default_factory=RefereeSpec)
     ball: BallSpec | None = None
@@ -158,7 +158,7 @@ class When(Spec):
 
 class LinkSpec(Spec):
     preset: str
-    overrides: dict[str, dict[str, float]] = {}
+    overrides: dict[str, dict[str, Num]] = {}
 
 
 class StepSpec(Spec):

@@ -241,3 +241,18 @@ def test_non_regular_files_are_refused_not_waited_on(tmp_path, capsys):
     assert main(["scenario", "run", str(hostile(sub, "s.scenario.toml", text))]) == 2
     err = capsys.readouterr().err
     assert "play.substitute.recording:" in err and "not a regular file" in err, err
+
+
+def test_a_score_and_a_link_parameter_may_be_ranges_too(tmp_path):
+    path = tmp_path / "s.scenario.toml"
+    path.write_text(
+        '[[scenario]]\nname = "x"\ntime_limit = 1.0\n[scenario.start]\nscore = [{ int = [0, 3] }, 1]\n'
+        '[[scenario.step]]\nat = 0.5\nlink = { preset = "wifi", overrides = { wifi = { latency_ms = '
+        "{ uniform = [10.0, 80.0] } } } }\n"
+    )
+    sc = load(path)
+    drawn = sc.drawn(1)
+    assert set(drawn) == {"start.score[0]", "step[0].link.overrides.wifi.latency_ms"}
+    assert run_one(sc, 1).score == (drawn["start.score[0]"], 1)
+    link = sc.config(1).scenario.steps[-1].actions[0]
+    assert link.overrides["wifi"]["latency_ms"] == pytest.approx(drawn["step[0].link.overrides.wifi.latency_ms"])
