@@ -166,9 +166,13 @@ def test_ranges_are_drawn_per_seed_the_same_on_every_rerun_and_reported(tmp_path
     assert f"seed 0 (start.ball.x={d0['start.ball.x']:g}, " in capsys.readouterr().out
 
 
-def test_the_engines_agree_on_a_ranged_scenario(tmp_path):
+def test_the_engines_agree_on_a_ranged_scenario_with_control_and_safe_teleports(tmp_path):
     path = tmp_path / "r.scenario.toml"
-    path.write_text(RANGED)
+    extra = (
+        '[[scenario.step]]\nat = 0.1\ncontrol = [{ robot = "b/1", seconds = 0.3, vx = { uniform = [0.5, 1.5] } }]\n'
+        'robots = [{ robot = "a/0", x = 0.0, y = 0.0, safely = true }, { robot = "b/0", x = 0.0, y = 0.0 }]\n'
+    )
+    path.write_text(RANGED.replace("[[scenario.expect]]", extra + "[[scenario.expect]]"))
     sc = load(path)
     a, b = run_one(sc, 2, "inprocess"), run_one(sc, 2, "processes")
     assert (a.digest, a.passed, a.drawn) == (b.digest, b.passed, b.drawn)
