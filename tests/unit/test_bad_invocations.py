@@ -3,7 +3,8 @@
 A table of bad invocations across every subcommand. Each must print exactly
 one line on stderr, never a traceback, and exit with the documented code
 (arena/cli.py: 2 for a user error). `{tmp}` is an empty directory, `{file}` a
-file with garbage in it, `{busy}` a TCP port that something already listens on.
+file with garbage in it, `{busy}` a TCP port that something already listens on;
+`{bin}`, `{fifo}`, `{deep}` and `{huge}` are the hostile files of `HOSTILE`.
 
 The first case of every sub-command, and every case marked PROCESS (it opens a
 zenoh session, listens, or starts a match's processes), runs as a real
@@ -174,6 +175,12 @@ BAD = [
     (["config", "--check", "/nonexistent.toml"], "cannot read"),
     (["config", "--check", "{file}"], "not valid TOML"),
     (["match", "--config", "{file}"], "not valid TOML"),
+    (["match", "--config", "{bin}"], "is not a text file (byte 0 is not UTF-8"),  # was internal error, exit 1
+    (["match", "--config", "{fifo}"], "is not a regular file"),  # was a hang
+    (["match", "--config", "/dev/zero"], "is not a regular file"),  # was a read without end
+    (["match", "--config", "{tmp}"], "is a directory: give a file"),
+    (["match", "--config", "{deep}"], "nests arrays or tables too deep"),  # was RecursionError
+    (["config", "--check", "{huge}"], "robot.mass must be at most 1000 kg, got 1e+308"),  # was accepted
     (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
@@ -224,6 +231,24 @@ def garbage(tmp_path_factory):
     return path
 
 
+HOSTILE = {
+    "bin": b"\x89MCAP0\r\n\xff\x00" * 64,  # a recording named by mistake
+    "deep": b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "huge": b"[robot]\nmass = 1e308\n",
+}
+
+
+@pytest.fixture(scope="module")
+def hostile(tmp_path_factory) -> dict[str, str]:
+    import os
+
+    d = tmp_path_factory.mktemp("hostile")
+    for name, data in HOSTILE.items():
+        (d / f"{name}.toml").write_bytes(data)
+    os.mkfifo(d / "fifo.toml")
+    return {name: str(d / f"{name}.toml") for name in (*HOSTILE, "fifo")}
+
+
 def _cases() -> list[tuple[list[str], str, bool]]:
     """BAD as (args, needle, in a process): the first case of each sub-command, and the PROCESS ones."""
     seen: set[str] = set()
@@ -243,10 +268,10 @@ CASES = _cases()
     CASES,
     ids=[("process: " if process else "") + " ".join(a)[:60] for a, _, process in CASES],
 )
-def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_port, garbage, tmp_path, capfd):
+def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_port, garbage, hostile, tmp_path, capfd):
     from arena.scenarios.library import LIBRARY
 
-    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY) for a in args]
+    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY, **hostile) for a in args]
     if process:
         r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
     else:
