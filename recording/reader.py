@@ -22,6 +22,7 @@ from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from arena.runtime.config import ConfigError, MatchConfig
+from arena.runtime.userfile import json_nesting
 from arena.schemas.messages import Summary
 from arena.schemas.validate import first_problem, nonfinite
 
@@ -81,7 +82,7 @@ class Recording:
             except (msgspec.DecodeError, msgspec.ValidationError):
                 self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
                 continue
-            problem = nonfinite(p, msg) or first_problem(msg, _too_large)
+            problem = nonfinite(p, msg) or first_problem(msg, _too_large) or _too_deep(msg)
             if problem:
                 raise RecordingError(
                     f"{self.path}: a {topic} frame (tick {msg.tick}) is not what a match sends: {problem}"
@@ -93,6 +94,18 @@ class Recording:
 # [any unit] the largest number a review accepts in a decoded frame: positions are metres within a
 # field's fence, speeds m/s, times s, ticks a few 100,000; 1e308 m overflowed the plots' pixels.
 MAX_MAGNITUDE = 1e9
+
+
+# [levels] the deepest JSON a frame may carry (a worldstate's text): the bridge records none deeper
+# (rules/refbox_protocol.py MAX_DEPTH), and Python's JSON parser recurses once per level.
+MAX_JSON_DEPTH = 32
+
+
+def _too_deep(msg: object) -> str | None:
+    text = getattr(msg, "json", None)
+    if isinstance(text, str) and (depth := json_nesting(text)) > MAX_JSON_DEPTH:
+        return f"its JSON nests {depth} levels deep, more than {MAX_JSON_DEPTH}"
+    return None
 
 
 def _too_large(value: object, path: str) -> str | None:

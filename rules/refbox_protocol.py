@@ -35,10 +35,10 @@ import json
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from itertools import accumulate
 
 from arena.runtime.config import ConfigError
 from arena.runtime.config import RefboxTeam as TeamEntry
+from arena.runtime.userfile import json_nesting
 
 PORT = 28097  # the RefBox's base-station port
 MAX_UNTERMINATED = 100_000  # [characters] the RefBox discards a message this long without its NUL
@@ -229,28 +229,10 @@ class WorldstateResult:
     detail: str = ""
 
 
-# Bytes that are not brackets: deleted before counting. UTF-8 never puts an ASCII byte inside a
-# multi-byte character, so counting on the encoded bytes counts exactly the brackets of the text.
-_NOT_BRACKETS = bytes(b for b in range(256) if b not in b"[]{}")
-_STEP = {ord("["): 1, ord("{"): 1, ord("]"): -1, ord("}"): -1}
-
-
 def nesting(raw: str) -> int:
-    """How deep arrays and objects nest in `raw` (JSON text), brackets inside strings not counted.
-
-    Linear in the length of `raw` whatever it holds, and no regular expression: every step is one
-    pass of a C string method (`replace`, `split`, `translate`) and one pass over the brackets
-    left. (A backtracking pattern for JSON strings took quadratic time on an unterminated string
-    of escaped quotes: 100 kB held the bridge's thread, and the GIL, for over a minute.)
-    Inside strings, a run of backslashes escapes in pairs from its left, so deleting every `\\\\`
-    and then every `\\"` leaves exactly the quotes that open and close strings; every other piece
-    between two of them is a string. Outside strings a backslash is not JSON at all, and the
-    parser stops there, before any bracket this count might then misplace.
-    """
-    text = raw.replace("\\\\", "").replace('\\"', "")
-    outside = "".join(text.split('"')[::2])
-    brackets = outside.encode("utf-8", errors="surrogatepass").translate(None, _NOT_BRACKETS)
-    return max(accumulate(map(_STEP.__getitem__, brackets), initial=0))
+    """How deep arrays and objects nest in `raw` (JSON text), brackets inside strings not counted;
+    linear in its length whatever it holds, no regular expression (`userfile.json_nesting`)."""
+    return json_nesting(raw)
 
 
 def validate_worldstate(raw: str) -> WorldstateResult:

@@ -348,8 +348,9 @@ def test_replay_refuses_what_it_cannot_do(recorded, tmp_path):
         replay.replay(str(rt), "robot/a/1")
 
 
-def rewrite(src, dst, change) -> None:
-    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages."""
+def rewrite(src, dst, change, extra=()) -> None:
+    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages,
+    and `extra` (topic, data) messages added at the end."""
     from mcap.records import Metadata
     from mcap.stream_reader import StreamReader
 
@@ -367,6 +368,8 @@ def rewrite(src, dst, change) -> None:
                 sid = schemas.get(schema.id, 0) if schema is not None else 0
                 channels[channel.id] = w.register_channel(channel.topic, channel.message_encoding, sid)
             w.add_message(channels[channel.id], m.log_time, change(channel.topic, m.data), m.publish_time, m.sequence)
+        for i, (topic, data) in enumerate(extra):
+            w.add_message(w.register_channel(topic, "msgpack", 0), m.log_time, data, m.publish_time, i)
         for md in meta:
             w.add_metadata(md.name, md.metadata)
         w.finish()
@@ -426,3 +429,19 @@ def test_the_recorder_waits_for_a_gone_peer_from_when_its_token_vanished(tmp_pat
     node.gone.add(crashed)
     assert not node._finished()
     node.sink.finish()
+
+
+def test_a_worldstate_nested_100000_deep_is_a_one_line_error_in_every_review_mode(recorded, tmp_path, capsys):
+    """A worldstate whose JSON nests 100,000 deep made every review mode exit 1 (RecursionError in
+    score_team); the bridge records none deeper than 32, so the file was made: exit 2, one line."""
+    from arena.schemas.messages import Worldstate
+
+    path, _ = recorded
+    crafted = tmp_path / "deep.mcap"
+    deep = Worldstate(tick=30, team="a", json="[" * 100_000 + "]" * 100_000)
+    rewrite(path, crafted, lambda topic, data: data, [("refbox/a/worldstate", msgspec.msgpack.encode(deep))])
+    modes = [{}, {"as_json": True}, {"plots": str(tmp_path / "plots")}, {"html": str(tmp_path / "r.html")}]
+    for mode in modes:
+        assert review.main(str(crafted), **mode) == 2, mode
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "its JSON nests 100000 levels deep, more than 32" in err[0], (mode, err)
