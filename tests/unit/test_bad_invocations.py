@@ -76,6 +76,9 @@ BAD = [
     (["credentials", "show", "{tmp}"], "holds no credentials: arena credentials init"),
     (["credentials", "rotate", "{tmp}"], "holds no credentials"),
     (["credentials", "init", "{file}"], "is not a directory"),
+    # a folder with an unrelated .json5: init and rotate each advised running the other
+    (["credentials", "init", "{stranger}"], "holds settings.json5, which is not a credentials file"),
+    (["credentials", "rotate", "{stranger}"], "holds settings.json5, which is not a credentials file"),
     (["credentials", "show", "{tmp}", "robot/a/1"], "PRINCIPAL applies to rotate only"),
     (["credentials", "init", "{tmp}", "--robots", "9"], "--robots must be between 1 and 6"),
     (["credentials", "burn", "{tmp}"], "invalid choice: 'burn'"),
@@ -246,7 +249,9 @@ def hostile(tmp_path_factory) -> dict[str, str]:
     for name, data in HOSTILE.items():
         (d / f"{name}.toml").write_bytes(data)
     os.mkfifo(d / "fifo.toml")
-    return {name: str(d / f"{name}.toml") for name in (*HOSTILE, "fifo")}
+    (d / "stranger").mkdir()
+    (d / "stranger" / "settings.json5").write_text('{"theme": "dark"}\n')
+    return {name: str(d / f"{name}.toml") for name in (*HOSTILE, "fifo")} | {"stranger": str(d / "stranger")}
 
 
 def _cases() -> list[tuple[list[str], str, bool]]:

@@ -112,6 +112,24 @@ def test_a_spoilt_directory_is_one_line_naming_it(tmp_path, spoil, needle):
         provision(d, NAMES, 2)
 
 
+def test_a_lost_router_file_is_recovered_by_rotate_as_init_says(tmp_path):
+    """init said "run rotate" and rotate refused the same directory: now rotate makes the set anew,
+    for the principals its files name, and every file changes."""
+    d = tmp_path / "creds"
+    provision(d, NAMES, 2)
+    before = _files(d)
+    (d / ROUTER_FILE).unlink()
+    with pytest.raises(ConfigError, match="run arena credentials rotate"):
+        provision(d, NAMES, 2)
+    with pytest.raises(ConfigError, match="run arena credentials rotate"):
+        rotate(d, ["robot/a/1"])  # one principal cannot be rotated without the set's router file
+    made = rotate(d, [])
+    after = _files(d)
+    assert set(after) == set(before) == set(made)
+    assert all(after[name] != before[name] for name in before)
+    provision(d, NAMES, 2)  # whole again
+
+
 def test_files_of_another_set_are_not_mixed_in(tmp_path):
     provision(tmp_path / "one", NAMES, 2)
     provision(tmp_path / "two", NAMES, 2)
