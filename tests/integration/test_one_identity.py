@@ -102,6 +102,39 @@ def test_the_next_match_removes_what_a_killed_launcher_left(tmp_path, reap):
     assert list(tmp_path.glob("arena-*")) == [], "and the next match left nothing either"
 
 
+def test_a_second_referee_with_the_matchs_own_credentials_file_is_refused(tmp_path, reap):
+    """The file of a process arena match started (from its private temp dir) says `launched`, and a
+    second referee started with it played on and voided the match. Now it is refused, with and
+    without the match's own --config, and the match completes."""
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    match = spawn(*GAME, "--external", "a/1", "--match", "own", "--listen", sock)
+    reap.append(match)
+    command = _printed(match)  # the match waits for robot a/1 meanwhile
+    creds = Path(command[command.index("--credentials") + 1]).parent
+    second = [
+        *ARENA,
+        "run",
+        "referee",
+        "--match",
+        "own",
+        "--connect",
+        sock,
+        "--credentials",
+        str(creds / "referee.json5"),
+    ]
+    for extra in ([], ["--config", str(creds.parent / "config.json")]):
+        r = subprocess.run([*second, *extra], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2, r.stderr
+        assert "referee is already running in match 'own'" in r.stderr.strip().splitlines()[-1], r.stderr
+    robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
+    assert robot.returncode == 0, robot.stderr
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    result = json.loads(out)
+    assert result["outcome"] == "completed" and result["faults"] == [], result["outcome_reasons"]
+    assert [r["process"] for r in result["refused_starts"]] == ["referee", "referee"], result["refused_starts"]
+
+
 def _twins(kind: list[str], secure: bool, tmp_path, reap, run: int) -> dict:
     """A match with one external process, started twice at the same moment; the match's result."""
     listen = (

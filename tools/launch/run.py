@@ -472,7 +472,7 @@ def run(
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
             if policy:
                 cfg = with_policy(cfg, pid.team, policy)
-            held = hold_identity(session, keys, pid, keyring, net)  # noqa: F841 - kept while it runs
+            held = hold_identity(session, keys, pid, keyring)  # noqa: F841 - kept while it runs
             tell(
                 f"connected to {where} (zenoh {net.mode}); match {match!r}: {cfg.home} v {cfg.away}, "
                 f"{cfg.robots} robots per team, 2 x {cfg.half_time:g} s"
