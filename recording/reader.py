@@ -56,6 +56,18 @@ class Recording:
         return not self.truncated and self.meta.get("recording", {}).get("complete") == "true"
 
     @property
+    def interrupted(self) -> str:
+        """The signal that stopped the match before its end ("SIGINT", "SIGTERM"), or ""."""
+        return str(self.meta.get("recording", {}).get("interrupted", "") or "")
+
+    @property
+    def ends_early(self) -> str:
+        """Why the file holds less than the whole match ("" if it holds it all): cut short, or stopped."""
+        if self.truncated:
+            return f"recording truncated ({self.problem})"
+        return f"match stopped by {self.interrupted}" if self.interrupted else ""
+
+    @property
     def gaps(self) -> dict:
         """What the recorder found missing, per process (lost tap batches, keys short of their count)."""
         try:

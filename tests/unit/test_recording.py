@@ -252,6 +252,32 @@ def test_replay_of_a_truncated_file_compares_up_to_its_end(recorded, tmp_path, c
     assert not [r for r in caplog.records if r.levelno >= logging.ERROR], caplog.text
 
 
+def test_replay_of_a_match_stopped_by_ctrl_c_compares_up_to_where_it_stopped(recorded, caplog):
+    """A whole file of an interrupted match: every process stopped at its own tick, so robot b/1's
+    last `cmd` frames are missing while its inputs go on a little. It reported a divergence
+    ("recorded: None") and 14 "treating ... as dead" lines."""
+    import copy
+
+    path, _ = recorded
+    rec = load(str(path))
+    stopped = copy.copy(rec)
+    stopped.meta = {**rec.meta, "recording": {**rec.meta.get("recording", {}), "complete": "false"}}
+    stopped.meta["recording"]["interrupted"] = "SIGINT"
+    dt_ns = round(rec.cfg.timing.dt * 1e9)
+    cut = rec.cfg.total_ticks // 2
+
+    def upto(frames, tick):
+        return [f for f in frames if f[0] <= tick * dt_ns]
+
+    stopped.topics = {t: upto(frames, cut) for t, frames in rec.topics.items()}
+    stopped.topics["robot/b/1/cmd"] = upto(rec.topics["robot/b/1/cmd"], cut - 10)
+    assert not stopped.truncated and stopped.ends_early == "match stopped by SIGINT"
+    result = replay.replay(stopped, "robot/b/1")
+    assert result.match and result.frames > 0, result.first_difference
+    assert result.note == "match stopped by SIGINT: compared up to its end" and result.digest_match is None
+    assert not [r for r in caplog.records if r.levelno >= logging.ERROR], caplog.text
+
+
 @pytest.mark.parametrize(
     ("content", "needle"),
     [(b"", "is empty"), (b"hello, not mcap at all", "not an MCAP file"), (b"\x89MCAP0\r\n\x01", "cut short")],
