@@ -185,3 +185,25 @@ def test_arena_up_of_a_bad_compose_file_leaves_no_temp_dir(tmp_path):
     r = subprocess.run([*ARENA, "up", str(bad)], capture_output=True, text=True, env=env, timeout=60)
     assert r.returncode == 2, r.stderr
     assert list(tmp_path.glob("arena-*")) == [], "a temp dir for the credentials stayed behind"
+
+
+@pytest.mark.parametrize("case", ["half time", "match typo"])
+def test_arena_up_with_a_bad_half_time_or_a_match_typo_is_exit_2_and_leaves_nothing(case, tmp_path):
+    """Both were exit 1 and kept a log directory in the temp dir: the engine refused ARENA_HALF_TIME
+    after it had started, and a service with a typo in --match waited for a match that never came."""
+    compose = Path(__file__).resolve().parents[2] / "compose.yaml"
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    if case == "half time":
+        env["ARENA_HALF_TIME"] = "abc"
+        needle = "arena up: error: service engine refused to start: argument --half-time: 'abc' is not a number"
+    else:
+        text = compose.read_text().replace(
+            '"referee", "--match", "${ARENA_MATCH:-compose}"', '"referee", "--match", "compsoe"'
+        )
+        compose = tmp_path / "typo.yaml"
+        compose.write_text(text)
+        needle = "arena up: error: service 'referee': --match 'compsoe' is not the router's match"
+    r = subprocess.run([*ARENA, "up", str(compose)], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert r.stderr.startswith(needle), r.stderr
+    assert list(tmp_path.glob("arena-*")) == [], "a log directory stayed behind"

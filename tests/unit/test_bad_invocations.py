@@ -189,7 +189,10 @@ BAD = [
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
     (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),
     # arena operator
-    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_bal"}}'], "ACTION 1:"),
+    (  # the valid types were not listed
+        ["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_bal"}}'],
+        "ACTION 1: Invalid value 'teleport_bal' - at `$.type` (the types: teleport_ball, teleport_robot, referee)",
+    ),
     (["operator", "--match", "m", '{{"type": "teleport_ball"}}'], "required: --connect"),
     (
         [
@@ -343,6 +346,7 @@ def test_version():
     [
         ({"ZENOH_RUNTIME": "garbage"}, M, "ZENOH_RUNTIME='garbage' is not a zenoh runtime setting"),
         ({"ARENA_MATCH": "bad/id"}, ["up", "compose.yaml"], "ARENA_MATCH: bad match id 'bad/id'"),
+        ({"ARENA_HALF_TIME": "1e12"}, ["up", "compose.yaml"], "service engine refused to start: --half-time must be"),
     ],
 )
 def test_a_bad_environment_variable_is_one_line_and_exit_2(env, args, needle):
