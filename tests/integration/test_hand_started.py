@@ -110,6 +110,9 @@ def test_a_hand_started_robot_says_whom_it_waits_for_and_the_final_score(tmp_pat
     while "waiting for:" not in lines[-1]:
         lines.append(wait_for(lambda: first.stderr.readline(), 60, "whom robot a/1 waits for"))
     assert any("connected to " + sock in line for line in lines), lines
+    # The match was there, waiting for it: not "waiting for match 'two' to start" (a first query
+    # made before the connection knew the engine's queryable).
+    assert not any("to start" in line for line in lines), lines
     assert lines[-1].strip().startswith("arena run: robot/a/1: waiting for: robot/a/2"), lines
     second = subprocess.Popen([*ARENA, *commands[1][1:]], stderr=subprocess.PIPE, text=True)
     reap.append(second)
