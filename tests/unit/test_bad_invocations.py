@@ -322,6 +322,7 @@ def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, c
     [
         ("review", "arena review: interrupted"),
         ("match", "arena match: interrupted; every process of the match was stopped"),
+        ("facts", "arena facts: interrupted; every match still playing was stopped, its worker with it"),  # "the match"
     ],
 )
 def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
@@ -331,7 +332,7 @@ def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli.command(command), "run", interrupted)
-    argv = ["review", "m.mcap"] if command == "review" else M
+    argv = {"review": ["review", "m.mcap"], "facts": ["facts", "--seeds", "2"]}.get(command, M)
     assert cli.main(argv) == 130
     assert capsys.readouterr().err.strip() == said
 
