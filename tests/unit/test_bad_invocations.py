@@ -98,12 +98,17 @@ BAD = [
     ([*R, "--credentials", "/tmp/arena-gone/credentials/robot-a-1.json5"], "a match's temp dir is gone with its match"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/dev/zero"], "not a regular"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{fifo}"], "not a regular"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{deepjson}"], "nests arrays"),
     (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),
     (["run", "router", "--match", "m", "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use", PROCESS),
     (["run", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "the following arguments are required: kind"),
     # arena up
     (["up", "/nonexistent/compose.yaml"], "cannot read"),
     (["up", "{file}"], "not valid YAML"),
+    (["up", "/dev/zero"], "compose file /dev/zero is not a regular file"),  # was a read without end
+    (["up", "{bin}"], "is not a text file"),
     (["up", "compose.yaml", "--timeout", "-5"], "--timeout: '-5'"),
     # arena tournament
     ([*T, "--leg", "2"], "arena tournament: error: unrecognized arguments: --leg 2; did you mean --legs?"),
@@ -241,6 +246,7 @@ HOSTILE = {
     "bin": b"\x89MCAP0\r\n\xff\x00" * 64,  # a recording named by mistake
     "deep": b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n",
     "huge": b"[robot]\nmass = 1e308\n",
+    "deepjson": b"[" * 100_000,
 }
 
 

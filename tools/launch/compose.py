@@ -50,14 +50,18 @@ def expand(text: str, env: dict[str, str]) -> str:
 
 def load_services(path: str, env: dict[str, str]) -> dict[str, list[str]]:
     """service name -> argv, in start order (services others depend on first)."""
+    from arena.runtime import userfile
+
     try:
-        raw = Path(path).read_text()
-    except OSError as exc:
-        raise ComposeError(f"cannot read {path}: {exc.strerror}", bad_input=True) from None
+        raw = userfile.read_text(path, "compose file")  # regular, bounded, UTF-8
+    except ConfigError as exc:
+        raise ComposeError(str(exc), bad_input=True) from None
     try:
         doc = yaml.safe_load(expand(raw, env))
     except yaml.YAMLError as exc:
         raise ComposeError(f"{path} is not valid YAML: {str(exc).splitlines()[0]}", bad_input=True) from None
+    except RecursionError:  # the YAML composer recurses per level of nesting
+        raise ComposeError(f"{path} nests too deep to read", bad_input=True) from None
     services = (doc or {}).get("services") if isinstance(doc, dict) else None
     if not isinstance(services, dict) or not services:
         raise ComposeError(f"{path} has no services", bad_input=True)

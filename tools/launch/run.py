@@ -233,11 +233,10 @@ def configure_logging(level: str, by_hand: bool, stream=None) -> None:
 
 
 def load_config(path: str) -> MatchConfig:
-    try:
-        text = Path(path).read_text()
-    except OSError as exc:
-        raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
-    return MatchConfig.from_json(text)
+    """The match configuration JSON at `path` (regular, bounded, UTF-8: runtime/userfile.py)."""
+    from arena.runtime import userfile
+
+    return MatchConfig.from_json(userfile.read_text(path, "--config"))
 
 
 def record_path(text: str, fresh: bool = False) -> str:
