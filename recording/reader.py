@@ -72,7 +72,7 @@ class Recording:
         """What the recorder found missing, per process (lost tap batches, keys short of their count)."""
         try:
             gaps = msgspec.json.decode(self.meta.get("recording", {}).get("gaps", "{}"))
-        except msgspec.DecodeError:
+        except (msgspec.DecodeError, RecursionError):
             return {"?": {"error": "unreadable gaps metadata"}}
         return gaps if isinstance(gaps, dict) else {}
 
@@ -91,7 +91,7 @@ class Recording:
         for _, _, p in self.topics.get(topic, []):
             try:
                 msg = dec(p)
-            except (msgspec.DecodeError, msgspec.ValidationError):
+            except (msgspec.DecodeError, msgspec.ValidationError, RecursionError):  # nested past any message
                 self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
                 continue
             problem = nonfinite(p, msg) or first_problem(msg, _too_large) or _too_deep(msg)
@@ -189,7 +189,7 @@ def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:
         if name.startswith("summary/") and "json" in data:
             try:
                 s = dec(data["json"])
-            except (msgspec.DecodeError, msgspec.ValidationError):
+            except (msgspec.DecodeError, msgspec.ValidationError, RecursionError):
                 continue
             summaries[s.process] = s
     if keep is not None:

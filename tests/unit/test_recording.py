@@ -374,9 +374,9 @@ def test_replay_refuses_what_it_cannot_do(recorded, tmp_path):
         replay.replay(str(rt), "robot/a/1")
 
 
-def rewrite(src, dst, change, extra=()) -> None:
-    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages,
-    and `extra` (topic, data) messages added at the end."""
+def rewrite(src, dst, change, extra=(), meta_change=lambda name, data: data) -> None:
+    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages
+    and `meta_change(name, metadata)`'s metadata, and `extra` (topic, data) messages added at the end."""
     from mcap.records import Metadata
     from mcap.stream_reader import StreamReader
 
@@ -397,7 +397,7 @@ def rewrite(src, dst, change, extra=()) -> None:
         for i, (topic, data) in enumerate(extra):
             w.add_message(w.register_channel(topic, "msgpack", 0), m.log_time, data, m.publish_time, i)
         for md in meta:
-            w.add_metadata(md.name, md.metadata)
+            w.add_metadata(md.name, meta_change(md.name, md.metadata))
         w.finish()
 
 
@@ -471,3 +471,23 @@ def test_a_worldstate_nested_100000_deep_is_a_one_line_error_in_every_review_mod
         assert review.main(str(crafted), **mode) == 2, mode
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and "its JSON nests 100000 levels deep, more than 32" in err[0], (mode, err)
+
+
+def test_metadata_nested_100000_deep_is_skipped_not_a_crash(recorded, tmp_path, capsys):
+    """A summary or the gaps metadata nested 100,000 deep raised RecursionError in msgspec."""
+    path, _ = recorded
+    crafted = tmp_path / "deep-meta.mcap"
+    deep = "[" * 100_000 + "]" * 100_000
+
+    def poison(name: str, data: dict) -> dict:
+        if name == "summary/engine":
+            return {**data, "json": '{"process": "engine", "extra": ' + deep + "}"}
+        if name == "recording":
+            return {**data, "gaps": deep}
+        return data
+
+    rewrite(path, crafted, lambda topic, data: data, meta_change=poison)
+    rec = load(str(crafted))
+    assert "engine" not in rec.summaries and "referee" in rec.summaries
+    assert rec.gaps == {"?": {"error": "unreadable gaps metadata"}}
+    assert review.main(str(crafted), as_json=True) == 0, capsys.readouterr().err
