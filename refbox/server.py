@@ -41,10 +41,11 @@ from arena.runtime.config import RefboxParams
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
 MAX_ERRORS = 1000  # bad messages from one connection: then it is disconnected
 # [bytes/s] what one connection may send on average, and [bytes] in one burst: an MSL worldstate is
-# a few kB at 10 to 40 Hz; the burst holds two messages of the RefBox's largest size. A connection
-# that sends more is flooding and is disconnected.
-MAX_RATE = 256 * 1024
-MAX_BURST = 2 * rp.MAX_UNTERMINATED + 65536
+# a few kB at 10 to 40 Hz (well under 0.5 MB/s); a burst of 2 MB holds twenty messages of the
+# RefBox's largest size. A connection that sends more is flooding and is disconnected. Parsing
+# the costliest shape at this rate takes about a tenth of a core (`arena bench refbox`).
+MAX_RATE = 1 << 20
+MAX_BURST = 2 << 20
 READ_SLICE = 65536  # [bytes] read and parsed from one connection before the next one's turn
 DISCONNECTS = ("too-deep",)  # reasons no honest base station gives: disconnected at the first
 TEAMS = ("a", "b")
@@ -284,7 +285,7 @@ class BridgeServer:
             return
         if not client.spend(len(data), time.monotonic()):
             self.errors[client.side]["flooding"] += 1
-            self._drop(client, f"misbehaving (flooding: more than {MAX_RATE // 1024} kB/s)")
+            self._drop(client, f"misbehaving (flooding: more than {MAX_RATE >> 20} MB/s)")
             return
         self._take(client, data)
 

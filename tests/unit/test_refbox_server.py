@@ -254,8 +254,9 @@ def test_a_hostile_base_station_neither_stalls_the_other_nor_stays():
         good.sendall(GOOD)
         assert wait_for(lambda: server.counts["worldstates_a"] == 1 and server.counts["worldstates_b"] == 1)
         assert server.errors["a"] == {"malformed-json": 1} and server.sides() == 2
-        try:
-            hostile.sendall(b"x" * 4_000_000)
+        try:  # until it is cut off (a slow reader under load may take a while: up to 64 MB)
+            for _ in range(64):
+                hostile.sendall(b"x" * (1 << 20))
         except OSError:
             pass  # cut off while still sending
         assert recv_until_closed(hostile, timeout=10.0) == b"", "disconnected"
