@@ -90,7 +90,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"arena {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
-        stopped = "; every process of the match was stopped" if getattr(cmd, "STOPS_PROCESSES", False) else ""
+        stops = getattr(cmd, "STOPS_PROCESSES", False)  # True, or what the command stopped in its own words
+        stopped = (
+            f"; {stops}" if isinstance(stops, str) else "; every process of the match was stopped" if stops else ""
+        )
         said, code = ("terminated", 143) if isinstance(exc, Terminated) else ("interrupted", 130)
         print(f"arena {args.command}: {said}{stopped}", file=sys.stderr)
         return code

@@ -22,6 +22,7 @@ from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
 from arena.runtime.config import ConfigError, MatchConfig
+from arena.runtime.userfile import json_nesting
 from arena.schemas.messages import Summary
 from arena.schemas.validate import first_problem, nonfinite
 
@@ -55,11 +56,23 @@ class Recording:
         return not self.truncated and self.meta.get("recording", {}).get("complete") == "true"
 
     @property
+    def interrupted(self) -> str:
+        """The signal that stopped the match before its end ("SIGINT", "SIGTERM"), or ""."""
+        return str(self.meta.get("recording", {}).get("interrupted", "") or "")
+
+    @property
+    def ends_early(self) -> str:
+        """Why the file holds less than the whole match ("" if it holds it all): cut short, or stopped."""
+        if self.truncated:
+            return f"recording truncated ({self.problem})"
+        return f"match stopped by {self.interrupted}" if self.interrupted else ""
+
+    @property
     def gaps(self) -> dict:
         """What the recorder found missing, per process (lost tap batches, keys short of their count)."""
         try:
             gaps = msgspec.json.decode(self.meta.get("recording", {}).get("gaps", "{}"))
-        except msgspec.DecodeError:
+        except (msgspec.DecodeError, RecursionError):
             return {"?": {"error": "unreadable gaps metadata"}}
         return gaps if isinstance(gaps, dict) else {}
 
@@ -78,10 +91,10 @@ class Recording:
         for _, _, p in self.topics.get(topic, []):
             try:
                 msg = dec(p)
-            except (msgspec.DecodeError, msgspec.ValidationError):
+            except (msgspec.DecodeError, msgspec.ValidationError, RecursionError):  # nested past any message
                 self.undecodable[topic] = self.undecodable.get(topic, 0) + 1
                 continue
-            problem = nonfinite(p, msg) or first_problem(msg, _too_large)
+            problem = nonfinite(p, msg) or first_problem(msg, _too_large) or _too_deep(msg)
             if problem:
                 raise RecordingError(
                     f"{self.path}: a {topic} frame (tick {msg.tick}) is not what a match sends: {problem}"
@@ -93,6 +106,18 @@ class Recording:
 # [any unit] the largest number a review accepts in a decoded frame: positions are metres within a
 # field's fence, speeds m/s, times s, ticks a few 100,000; 1e308 m overflowed the plots' pixels.
 MAX_MAGNITUDE = 1e9
+
+
+# [levels] the deepest JSON a frame may carry (a worldstate's text): the bridge records none deeper
+# (rules/refbox_protocol.py MAX_DEPTH), and Python's JSON parser recurses once per level.
+MAX_JSON_DEPTH = 32
+
+
+def _too_deep(msg: object) -> str | None:
+    text = getattr(msg, "json", None)
+    if isinstance(text, str) and (depth := json_nesting(text)) > MAX_JSON_DEPTH:
+        return f"its JSON nests {depth} levels deep, more than {MAX_JSON_DEPTH}"
+    return None
 
 
 def _too_large(value: object, path: str) -> str | None:
@@ -164,7 +189,7 @@ def load(path: str, keep: frozenset[str] | set[str] | None = None) -> Recording:
         if name.startswith("summary/") and "json" in data:
             try:
                 s = dec(data["json"])
-            except (msgspec.DecodeError, msgspec.ValidationError):
+            except (msgspec.DecodeError, msgspec.ValidationError, RecursionError):
                 continue
             summaries[s.process] = s
     if keep is not None:

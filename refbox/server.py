@@ -14,11 +14,13 @@ caller (`drain`), the bad ones counted by team and reason.
 Nothing here ever blocks the caller: `broadcast` queues, the server thread
 writes. A base station that stops reading is cut off once 1 MiB is queued for it.
 
-No input ends the server: every message is bounded (`MAX_UNTERMINATED` characters,
-`MAX_DEPTH` levels of nesting) and every decode error is counted by reason. A base
-station that misbehaves is disconnected and the match goes on: one that nests too
-deep, sends `MAX_ERRORS` bad messages, or whose input raises anything unforeseen
-(counted as `unreadable`, with the exception's type in the log).
+No input ends or stalls the server: every message is bounded (`MAX_UNTERMINATED`
+characters, `MAX_DEPTH` levels of nesting), parsing is linear in its length, one
+connection is read `READ_SLICE` bytes at a time between the others' turns, and every
+decode error is counted by reason. A base station that misbehaves is disconnected
+and the match goes on: one that nests too deep, sends `MAX_ERRORS` bad messages,
+sends more than `MAX_RATE` bytes a second on average (`flooding`), or whose input
+raises anything unforeseen (counted as `unreadable`, with the exception's type in the log).
 """
 
 from __future__ import annotations
@@ -38,6 +40,13 @@ from arena.runtime.config import RefboxParams
 
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
 MAX_ERRORS = 1000  # bad messages from one connection: then it is disconnected
+# [bytes/s] what one connection may send on average, and [bytes] in one burst: an MSL worldstate is
+# a few kB at 10 to 40 Hz (well under 0.5 MB/s); a burst of 2 MB holds twenty messages of the
+# RefBox's largest size. A connection that sends more is flooding and is disconnected. Parsing
+# the costliest shape at this rate takes about a tenth of a core (`arena bench refbox`).
+MAX_RATE = 1 << 20
+MAX_BURST = 2 << 20
+READ_SLICE = 65536  # [bytes] read and parsed from one connection before the next one's turn
 DISCONNECTS = ("too-deep",)  # reasons no honest base station gives: disconnected at the first
 TEAMS = ("a", "b")
 
@@ -52,6 +61,14 @@ class Client:
     reader: rp.WorldstateReader = field(default_factory=rp.WorldstateReader)
     out: bytearray = field(default_factory=bytearray)
     errors: int = 0  # bad messages on this connection
+    budget: float = MAX_BURST  # [bytes] it may still send now (refilled at MAX_RATE)
+    since: float = field(default_factory=time.monotonic)  # when `budget` was last refilled
+
+    def spend(self, n: int, now: float) -> bool:
+        """Take `n` bytes off the budget; False when that overdraws it (the client floods)."""
+        self.budget = min(MAX_BURST, self.budget + (now - self.since) * MAX_RATE) - n
+        self.since = now
+        return self.budget >= 0
 
 
 def check_listen(endpoint: str) -> None:
@@ -257,7 +274,7 @@ class BridgeServer:
 
     def _read(self, client: Client) -> None:
         try:
-            data = client.sock.recv(65536)
+            data = client.sock.recv(READ_SLICE)
         except BlockingIOError:
             return
         except OSError as exc:
@@ -265,6 +282,10 @@ class BridgeServer:
             return
         if not data:
             self._drop(client, "closed the connection")
+            return
+        if not client.spend(len(data), time.monotonic()):
+            self.errors[client.side]["flooding"] += 1
+            self._drop(client, f"misbehaving (flooding: more than {MAX_RATE >> 20} MB/s)")
             return
         self._take(client, data)
 

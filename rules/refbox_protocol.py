@@ -33,12 +33,12 @@ from __future__ import annotations
 import ipaddress
 import json
 import math
-import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 from arena.runtime.config import ConfigError
 from arena.runtime.config import RefboxTeam as TeamEntry
+from arena.runtime.userfile import json_nesting
 
 PORT = 28097  # the RefBox's base-station port
 MAX_UNTERMINATED = 100_000  # [characters] the RefBox discards a message this long without its NUL
@@ -136,46 +136,74 @@ class CommandReader:
     """The base-station side: bytes in, `Command`s out, in either framing.
 
     A message that starts with `{` is JSON up to its NUL; any other byte is a
-    legacy character. Unknown or malformed ones are returned in `errors`.
+    legacy character. Unknown or malformed ones are returned in `errors`, the
+    first `LOG_FIRST_ERRORS` of a connection one by one and the rest only counted
+    in `dropped`. Linear in what arrives: every byte is looked at once, however
+    the stream is cut.
     """
 
     def __init__(self) -> None:
-        self._buf = b""
+        self._buf = bytearray()
+        self._scanned = 0  # bytes of an unterminated JSON command already searched for its NUL
+        self._skipping = False  # inside an overlong JSON command: drop up to its NUL
         self.errors: list[str] = []
+        self.dropped = 0  # errors beyond the first LOG_FIRST_ERRORS
+        self._logged = 0
+
+    def _error(self, why: str) -> None:
+        if self._logged < LOG_FIRST_ERRORS:
+            self._logged += 1
+            self.errors.append(why)
+        else:
+            self.dropped += 1
 
     def feed(self, data: bytes) -> list[Command]:
         self._buf += data
-        out: list[Command] = []
-        while self._buf:
-            if self._buf[:1] in (b"\0", b"\n", b"\r", b" "):
-                self._buf = self._buf[1:]
-            elif self._buf[:1] == b"{":
-                end = self._buf.find(b"\0")
+        buf, out, i = self._buf, [], 0
+        while i < len(buf):
+            if self._skipping or buf[i] == 0x7B:  # "{": a JSON command up to its NUL
+                end = buf.find(b"\0", max(i, self._scanned))
                 if end < 0:
-                    if len(self._buf) > MAX_UNTERMINATED:
-                        self.errors.append("command not terminated within 100000 bytes")
-                        self._buf = b""
+                    if len(buf) - i > MAX_UNTERMINATED and not self._skipping:
+                        self._error(f"command not terminated within {MAX_UNTERMINATED} bytes")
+                        self._skipping = True
+                    if self._skipping:
+                        i = len(buf)
+                    self._scanned = len(buf)
                     break
-                raw, self._buf = self._buf[:end], self._buf[end + 1 :]
-                cmd = _json_command(raw)
-                if isinstance(cmd, str):
-                    self.errors.append(cmd)
+                if self._skipping:
+                    self._skipping = False
+                elif end - i > MAX_UNTERMINATED:
+                    self._error(f"command not terminated within {MAX_UNTERMINATED} bytes")
                 else:
-                    out.append(cmd)
+                    cmd = _json_command(bytes(buf[i:end]))
+                    if isinstance(cmd, str):
+                        self._error(cmd)
+                    else:
+                        out.append(cmd)
+                i = end + 1
             else:
-                ch, self._buf = chr(self._buf[0]), self._buf[1:]
+                ch = chr(buf[i])
+                i += 1
+                if ch in "\0\n\r ":
+                    continue
                 if ch in LEGACY_DECODE:
                     name, colour = LEGACY_DECODE[ch]
                     out.append(Command(name, colour=colour))
                 else:
-                    self.errors.append(f"unknown legacy command {ch!r}")
+                    self._error(f"unknown legacy command {ch!r}")
+        del buf[:i]
+        self._scanned = max(0, self._scanned - i)
         return out
 
 
 def _json_command(raw: bytes) -> Command | str:
+    text = raw.decode("utf-8", errors="replace")
+    if nesting(text) > MAX_DEPTH:
+        return f"JSON command nested deeper than {MAX_DEPTH} levels"
     try:
-        obj = json.loads(raw)
-    except (ValueError, UnicodeDecodeError):
+        obj = json.loads(text)
+    except ValueError:
         return "malformed JSON command"
     if not isinstance(obj, dict) or not isinstance(obj.get("command"), str):
         return "JSON command without a command name"
@@ -201,20 +229,10 @@ class WorldstateResult:
     detail: str = ""
 
 
-_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
-_BRACKETS = str.maketrans("", "", "".join(chr(c) for c in range(128) if chr(c) not in "[]{}"))
-
-
 def nesting(raw: str) -> int:
-    """How deep arrays and objects nest in `raw` (JSON text), brackets inside strings not counted."""
-    depth = deepest = 0
-    for c in _STRING.sub("", raw).translate(_BRACKETS):
-        if c in "[{":
-            depth += 1
-            deepest = max(deepest, depth)
-        elif c in "]}":
-            depth -= 1
-    return deepest
+    """How deep arrays and objects nest in `raw` (JSON text), brackets inside strings not counted;
+    linear in its length whatever it holds, no regular expression (`userfile.json_nesting`)."""
+    return json_nesting(raw)
 
 
 def validate_worldstate(raw: str) -> WorldstateResult:

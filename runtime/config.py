@@ -326,6 +326,8 @@ class MatchConfig:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise ConfigError(f"match configuration is not JSON: {exc}") from None
+        except RecursionError:  # the parser recurses per level: 100,000 `[` is no configuration
+            raise ConfigError("match configuration nests arrays or objects too deep") from None
         if not isinstance(data, dict):
             raise ConfigError("match configuration must be a JSON object")
         return cls.from_dict(data)

@@ -129,7 +129,7 @@ class Secrets:
         `more`: zenoh settings added to some principals' fragments (top-level keys),
         e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`).
         `launched`: the principals `arena match` starts itself, whose identity it holds for them
-        (`metadata.arena.launched`: they claim none, tools/launch/claims.py)."""
+        (`metadata.arena.launched`; the match gives them their identity by OS pid, tools/launch/claims.py)."""
         private_directory(directory, create=True)
         out = {}
         for p in principals(self.processes):

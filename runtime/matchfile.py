@@ -17,9 +17,9 @@ import dataclasses
 import inspect
 import math
 import re
-import tomllib
 from typing import Any
 
+from arena.runtime import userfile
 from arena.runtime.config import ConfigError, MatchConfig
 
 TOP = ("seed", "home", "away", "robots", "half_time")
@@ -39,6 +39,30 @@ MAX_FIELD = 100.0  # [m] any length of [field]; an MSL field is 22 x 14 m
 # Numbers of those sections for which 0 means something (MatchConfig.validate checks their range).
 ZERO_ALLOWED = frozenset({"perception_latency", "batch", "kick_max_speed", "lob_angle", "dribble_max_omega"})
 MAX_ROBOT_SIZE = 2.0  # [m] an MSL robot is at most 0.52 m wide
+# Upper bounds of the numbers a file may set, far beyond anything playable but short of what
+# overflows the physics (1e308 kg, a 1e300 rad/s wheel): the unit's plausible limit, per key.
+# A number without its own row is at most MAX_NUMBER; [field] lengths at most MAX_FIELD.
+MAX_NUMBER = 1e6
+MAX_WALL_S = 86_400.0  # [s] a wall-clock wait of a day
+MAX_RULE_S = 3_600.0  # [s] a rule's time: one half at most
+UPPER = {
+    "robot": {"size": MAX_ROBOT_SIZE, "height": 5.0, "mass": 1000.0, "max_speed": 50.0, "max_accel": 100.0,
+              "max_omega": 100.0, "max_alpha": 1000.0, "wheel_radius": 1.0, "wheel_base": MAX_ROBOT_SIZE,
+              "max_wheel_speed": 10_000.0, "kick_max_speed": 50.0, "lob_angle": math.pi / 2,
+              "dribble_max_omega": 100.0, "cmd_timeout": 60.0},
+    "ball": {"radius": 1.0, "mass": 100.0, "rolling_decel": 100.0, "restitution": 1.0},
+    "sensor": {"pose_sigma": 10.0, "heading_sigma": math.pi, "ball_range": 2 * MAX_FIELD,
+               "robot_range": 2 * MAX_FIELD, "det_sigma": 10.0, "det_sigma_per_m": 1.0},
+    "rules": {"kickoff_time": MAX_RULE_S, "setpiece_time": MAX_RULE_S, "take_time": MAX_RULE_S,
+              "no_progress_s": MAX_RULE_S, "stuck_s": MAX_RULE_S, "setpiece_distance": MAX_FIELD,
+              "drop_ball_distance": MAX_FIELD, "progress_radius": MAX_FIELD, "push_speed": 100.0,
+              "dribble_limit": MAX_FIELD, "drop_ball_inset": MAX_FIELD, "spot_inset": MAX_FIELD,
+              "corner_inset": MAX_FIELD, "yellow_fouls": 1000, "red_fouls": 1000, "stuck_radius": MAX_FIELD},
+    "timing": {"substeps": 1000, "perception_latency": 1000, "batch": 1000, "startup_timeout": MAX_WALL_S,
+               "wait_timeout": MAX_WALL_S, "lease": MAX_WALL_S, "summary_grace": MAX_WALL_S,
+               "finish_grace": MAX_WALL_S},
+}  # fmt: skip
+MIN_DT = 1e-4  # [s] a 10 kHz control tick; finer would take days per simulated minute
 
 
 def _known(section: str) -> dict[str, Any]:
@@ -74,8 +98,13 @@ def _check_values(cfg: MatchConfig, where: str) -> None:
                 raise ConfigError(f"{where}: {section}.{f.name} must be > 0")
             if section == "field" and value > MAX_FIELD:  # every field entry is a length
                 raise ConfigError(f"{where}: field.{f.name} must be at most {MAX_FIELD:g} m, got {value}")
-    if cfg.robot.size > MAX_ROBOT_SIZE:
-        raise ConfigError(f"{where}: robot.size must be at most {MAX_ROBOT_SIZE:g} m, got {cfg.robot.size}")
+            upper = UPPER.get(section, {}).get(f.name, MAX_NUMBER)
+            if value > upper:
+                unit = re.match(r"\[([^\]-]+)\]", _comments(type(params)).get(f.name, ""))
+                unit_text = f" {unit.group(1)}" if unit else ""
+                raise ConfigError(f"{where}: {section}.{f.name} must be at most {upper:g}{unit_text}, got {value:g}")
+    if cfg.timing.dt < MIN_DT:
+        raise ConfigError(f"{where}: timing.dt must be at least {MIN_DT:g} s, got {cfg.timing.dt:g}")
     fp = cfg.field
     if fp.goal_width >= fp.width or fp.penalty_area_width >= fp.width or fp.penalty_area_depth * 2 >= fp.length:
         raise ConfigError(f"{where}: field: the goal and the penalty areas must fit inside the field")
@@ -104,13 +133,7 @@ def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
 
 def load(path: str) -> MatchConfig:
     """Read and validate FILE.toml; ConfigError naming the file and the bad key."""
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"--config {path} is not valid TOML: {exc}") from None
+    data = userfile.load_toml(path, "--config")  # regular, bounded, UTF-8, nesting bounded
     raw = to_dict(data, path)
     try:
         cfg = MatchConfig.from_dict(raw)

@@ -56,16 +56,36 @@ def _router_file(tls: tuple[bytes, bytes, bytes], viewer_zid: str, set_id: str) 
     return {"metadata": {"arena": arena | {"viewer_id": viewer_zid}}}
 
 
+def _is_credentials(path: Path) -> bool:
+    try:
+        _read(path)
+    except ConfigError:
+        return False
+    return True
+
+
+def _no_router(directory: Path, files: list[Path]) -> None:
+    """ConfigError saying what is wrong with a directory that has .json5 files but no router.json5."""
+    strangers = [p.name for p in files if not _is_credentials(p)]
+    if strangers:
+        raise ConfigError(
+            f"{directory} holds {', '.join(strangers)}, which {'is' if len(strangers) == 1 else 'are'} not "
+            f"a credentials file (no metadata.arena.process): move {'it' if len(strangers) == 1 else 'them'} "
+            "out, or give a directory of its own to the credentials"
+        )
+    raise ConfigError(
+        f"{directory} has credentials files but no {ROUTER_FILE} (the router's certificate): "
+        f"run arena credentials rotate {directory} and copy every file again"
+    )
+
+
 def load(directory: Path) -> Secrets | None:
     """The set in `directory` (None if it holds none); ConfigError naming the file that is wrong."""
     router = directory / ROUTER_FILE
     files = sorted(p for p in directory.glob("*.json5") if p.name != ROUTER_FILE) if directory.is_dir() else []
     if not router.exists():
         if files:
-            raise ConfigError(
-                f"{directory} has credentials files but no {ROUTER_FILE} (the router's certificate): "
-                f"run arena credentials rotate {directory} and copy every file again"
-            )
+            _no_router(directory, files)
         return None
     r = _read(router)["metadata"]["arena"]
     s = Secrets("", 0, [], secure=True, set_id=str(r.get("credentials", "")))
@@ -136,6 +156,15 @@ def set_robots(principals_of_set) -> int:
 def rotate(directory: Path, which: list[str]) -> list[str]:
     """New secrets for the principals `which` (all of them, the CA and the router's certificate too,
     if empty); returns the files written. Every rotated file must be copied again."""
+    files = sorted(directory.glob("*.json5")) if directory.is_dir() else []
+    if files and not (directory / ROUTER_FILE).exists() and not which:
+        # The router's file is gone: everything is made anew, for the principals the files name.
+        if not all(map(_is_credentials, files)):
+            _no_router(directory, files)
+        names = [_read(p)["metadata"]["arena"]["process"] for p in files]
+        for p in files:
+            p.unlink()
+        return provision(directory, names, 0)[1]
     s = load(directory)
     if s is None:
         raise ConfigError(f"{directory} holds no credentials: arena credentials init {directory}")

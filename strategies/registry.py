@@ -49,12 +49,13 @@ def all_strategies() -> dict[str, Strategy]:
     return found
 
 
-def describe(check: bool = True, only: set[str] | None = None) -> list[dict]:
+def describe(check: bool = True, only: set[str] | None = None, recheck: bool = False) -> list[dict]:
     """One row per strategy: name, aliases, where it comes from, conformance (`arena strategies`).
 
     `source` is the module of a built-in, or the plugin's distribution and
     entry point; `conformance` is "passes", "fails: <the first failed check>"
-    or "not checked".
+    or "not checked"; `cached` whether that verdict was kept from an earlier run of
+    the suite on the same source (strategies/checked.py; `recheck` runs it anyway).
     """
     from importlib.metadata import entry_points
 
@@ -70,16 +71,14 @@ def describe(check: bool = True, only: set[str] | None = None) -> list[dict]:
             source = f"built-in {s.make_team.__module__}"
         else:
             source = next((v for k, v in plugins.items() if k == name or k in s.aliases), "plugin")
-        status = "not checked"
+        status, cached = "not checked", False
         if check:
-            from arena.strategies import conformance
+            from arena.strategies import checked
 
-            try:
-                conformance.check_all(s)
-                status = "passes"
-            except AssertionError as exc:
-                status = f"fails: {(str(exc).splitlines() or ['?'])[0]}"
-        rows.append({"name": name, "aliases": list(s.aliases), "source": source, "conformance": status})
+            status, cached = checked.verdict(s, recheck)
+        rows.append(
+            {"name": name, "aliases": list(s.aliases), "source": source, "conformance": status, "cached": cached}
+        )
     return rows
 
 

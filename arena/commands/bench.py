@@ -19,6 +19,7 @@ EXAMPLES = """examples:
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
   arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
+  arena bench refbox               # RefBox bridge parsing of hostile messages: us per kB at 100 kB and 1 MB
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
@@ -32,6 +33,7 @@ USES = {
     "robot": {"strategy"},
     "learn": {"runs", "half_time", "strategy"},
     "scenario": {"runs"},
+    "refbox": {"runs"},
     "nav": {"trials", "seed", "scenarios", "only", "plots"},
 }
 DEFAULTS = {
@@ -52,12 +54,13 @@ def add_parser(sub) -> None:
     b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario"],
+        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario", "refbox"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
         "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
         "on 2 workers vs. 1 (needs the learn extra); scenario: 10-s scenario runs per minute in process, "
-        "and the ratio to a plain match of the same length",
+        "and the ratio to a plain match of the same length; refbox: the bridge's parsing of hostile messages "
+        "(us per kB at 100 kB and 1 MB)",
     )
     b.add_argument(
         "--strategy",
@@ -117,6 +120,10 @@ def run(args: argparse.Namespace) -> int:
         from arena.scenarios.bench import bench_scenario
 
         return bench_scenario(args.runs, args.json)
+    if args.what == "refbox":
+        from arena.refbox.bench import bench_refbox
+
+        return bench_refbox(args.runs, args.json)
     if args.what == "throughput":
         from arena.tools.experiments import throughput
 

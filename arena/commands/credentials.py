@@ -13,7 +13,7 @@ EXAMPLES = """examples:
   scp creds/robot-a-1.json5 robot-a-1:          # once: it works in every match that uses creds/
   arena match --home BS --away BS --listen tcp/0.0.0.0:7447 --external a/1 --credentials creds/
   arena credentials show creds/                  # the set, the certificate's expiry, each file's owner
-  arena credentials rotate creds/ robot/a/1      # a robot's computer was lost: copy its new file
+  arena credentials rotate creds/ a/1            # robot a/1's computer was lost: copy its new file
   arena credentials rotate creds/                # everything new, CA included: copy every file again"""
 
 
@@ -29,7 +29,11 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     p.add_argument("directory", metavar="DIR", help="the credentials directory (made mode 0700)")
     p.add_argument(  # a default, or argparse lists it among the required arguments
-        "principals", nargs="*", default=[], metavar="PRINCIPAL", help="rotate: e.g. robot/a/1 (default: all)"
+        "principals",
+        nargs="*",
+        default=[],
+        metavar="PRINCIPAL",
+        help="rotate: e.g. a/1 or robot/a/1, basestation/b, operator (default: all)",
     )
     p.add_argument("--robots", type=int, default=6, metavar="N", help="init: robots per team to provision (6)")
     return p
@@ -49,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
         _, made = provision(directory, [*process_names(args.robots), "refbox", COLLECTOR_PRINCIPAL], args.robots)
         print(f"{directory}: {'made ' + ', '.join(made) if made else 'complete already, nothing changed'}")
     elif args.action == "rotate":
-        made = rotate(directory, args.principals)
+        made = rotate(directory, [_principal(p) for p in args.principals])
         away = [m for m in made if m.startswith(("robot-", "basestation-"))]  # what may run on another computer
         print(
             f"{directory}: new {', '.join(made)}; copy {', '.join(away) or 'none of them'} again to the computer each is on"
@@ -57,3 +61,14 @@ def run(args: argparse.Namespace) -> int:
     if args.action in ("init", "show"):
         print("\n".join(show(directory)))
     return 0
+
+
+def _principal(name: str) -> str:
+    """`a/1` as `robot/a/1`, the short form `--external` takes; a principal that is no process
+    (`operator`, `collector`) as given."""
+    from arena.runtime.config import ProcessId
+
+    try:
+        return str(ProcessId.parse(name))
+    except ConfigError:
+        return name

@@ -9,7 +9,7 @@ from arena.commands._match_flags import every_match_latency, match_config
 from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
-STOPS_PROCESSES = True
+STOPS_PROCESSES = "every match still playing was stopped, its worker with it"  # several matches, not one
 
 EXAMPLES = """examples:
   arena facts --seeds 20                             # 20 chase-and-shoot matches, 2 x 60 s, in process

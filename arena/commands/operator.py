@@ -43,18 +43,38 @@ def parse_actions(texts: list[str]) -> list:
 
     from arena.schemas.messages import RefereeOverride, TeleportBall, TeleportRobot
 
+    kinds = (TeleportBall, TeleportRobot, RefereeOverride)
+    types = ", ".join(k.__struct_config__.tag for k in kinds)
     out = []
     for i, text in enumerate(texts, 1):
         try:
             out.append(msgspec.json.decode(text, type=TeleportBall | TeleportRobot | RefereeOverride))
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-            raise ValueError(f"ACTION {i}: {exc}") from None
+            why = str(exc)
+            if why.endswith("- at `$.type`") or why == "Object missing required field `type`":
+                why += f" (the types: {types})"
+            raise ValueError(f"ACTION {i}: {why}") from None
     return out
+
+
+def _open(net, credentials: str | None):
+    """The session; a router that listens but refuses it is ConfigError with the cause, as `arena run` says it."""
+    from arena.runtime.session import EndpointError, open_session
+    from arena.schemas.keys import OPERATOR_PRINCIPAL
+    from arena.tools.launch.run import refusal, refused_by
+
+    try:
+        return open_session(net)
+    except EndpointError:
+        ep = refused_by(net.connect)
+        if ep is None:
+            raise
+        raise refusal(ep, net, credentials, OPERATOR_PRINCIPAL) from None
 
 
 def run(args: argparse.Namespace) -> int:
     from arena.runtime.config import ConfigError
-    from arena.runtime.session import NetConfig, open_session
+    from arena.runtime.session import NetConfig
     from arena.schemas.keys import OPERATOR_PRINCIPAL, Keys
     from arena.schemas.messages import Operator, encode
 
@@ -71,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"arena operator: error: {exc}", file=sys.stderr)
         return 2
     key = Keys(args.match).operator()
-    with open_session(net) as session:
+    with _open(net, args.credentials) as session:
         pub = session.declare_publisher(key)
         deadline = time.monotonic() + args.wait
         while not pub.matching_status.matching and time.monotonic() < deadline:

@@ -10,7 +10,12 @@ from arena.commands._common import add_command
 EXAMPLES = """examples:
   arena strategies                 # every strategy, built-in or plugin, and whether it passes the conformance suite
   arena strategies AD chase        # only these (a plugin by its name too)
-  arena strategies --no-check --json"""
+  arena strategies --recheck       # run the suite even where the source has not changed since the last run
+  arena strategies --no-check --json
+
+A verdict is kept per strategy with the SHA-256 of its package's source and of the arena code the
+suite runs, in $XDG_CACHE_HOME/soccer-arena (else ~/.cache/soccer-arena): the suite runs again only
+for what changed, and the table marks a kept verdict "(kept)"."""
 
 
 def add_parser(sub) -> None:
@@ -21,7 +26,11 @@ def add_parser(sub) -> None:
         EXAMPLES,
     )
     st.add_argument("names", nargs="*", metavar="NAME", help="only these strategies (names or aliases)")
-    st.add_argument("--no-check", action="store_true", help="skip the conformance suite (~1.5 s per strategy)")
+    check = st.add_mutually_exclusive_group()
+    check.add_argument("--no-check", action="store_true", help="skip the conformance suite (~1.5 s per strategy)")
+    check.add_argument(
+        "--recheck", action="store_true", help="run the suite even for a strategy whose verdict is kept (unchanged)"
+    )
     st.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -29,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     from arena.strategies import registry
 
     wanted = {registry.resolve_name(n) for n in args.names}
-    rows = [r for r in registry.describe(check=not args.no_check, only=wanted or None)]
+    rows = registry.describe(check=not args.no_check, only=wanted or None, recheck=args.recheck)
     if args.json:
         print(json.dumps({"strategies": rows}, indent=2))
         return 0
@@ -42,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
     for col in ("name", "alias", "from", "conformance"):
         t.add_column(col)
     for r in rows:
-        t.add_row(r["name"], "/".join(r["aliases"]) or "-", escape(r["source"]), escape(r["conformance"]))
+        verdict = r["conformance"] + (" (kept)" if r["cached"] else "")
+        t.add_row(r["name"], "/".join(r["aliases"]) or "-", escape(r["source"]), escape(verdict))
     make_console().print(t)
     return 0 if not any(r["conformance"].startswith("fails") for r in rows) else 1

@@ -80,6 +80,18 @@ def test_a_secure_match_refuses_a_wrong_or_missing_credential(tmp_path, reap):
         assert robot.returncode == 2, (extra, err)
         assert err.strip().splitlines()[-1].startswith(f"arena run: error: {cause}"), (extra, err)
         assert "no router" not in err, err
+    # arena operator without its file said only "Unable to connect to any of [...]"; now the cause.
+    action = '{"type": "referee", "command": "STOP"}'
+    for ep, cause in (
+        (endpoint, f"the router at {endpoint} is a secure match's: it needs this process's own --credentials file "
+         "(operator.json5"),
+        (f"tcp/127.0.0.1:{port}", f"the router at tcp/127.0.0.1:{port} speaks TLS (a secure match): connect to "
+         f"{endpoint} with this process's own --credentials file (operator.json5"),
+    ):  # fmt: skip
+        r = subprocess.run([*ARENA, "operator", "--match", "hand", "--connect", ep, action], capture_output=True,
+                           text=True, timeout=60)  # fmt: skip
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+        assert r.stderr.startswith(f"arena operator: error: {cause}"), r.stderr
 
 
 def test_a_hand_started_robot_says_whom_it_waits_for_and_the_final_score(tmp_path, reap):
@@ -98,6 +110,9 @@ def test_a_hand_started_robot_says_whom_it_waits_for_and_the_final_score(tmp_pat
     while "waiting for:" not in lines[-1]:
         lines.append(wait_for(lambda: first.stderr.readline(), 60, "whom robot a/1 waits for"))
     assert any("connected to " + sock in line for line in lines), lines
+    # The match was there, waiting for it: not "waiting for match 'two' to start" (a first query
+    # made before the connection knew the engine's queryable).
+    assert not any("to start" in line for line in lines), lines
     assert lines[-1].strip().startswith("arena run: robot/a/1: waiting for: robot/a/2"), lines
     second = subprocess.Popen([*ARENA, *commands[1][1:]], stderr=subprocess.PIPE, text=True)
     reap.append(second)

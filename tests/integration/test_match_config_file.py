@@ -54,6 +54,10 @@ BAD_KEYS = [
     ("[field]\nwidth = 1e308\n", "field.width must be at most 100 m"),
     ("[robot]\nwheel_radius = 0\n", "robot.wheel_radius must be > 0"),  # was the engine's LinAlgError
     ("[robot]\nsize = 50\n", "robot.size must be at most 2 m"),
+    ("[robot]\nmass = 1e308\n", "robot.mass must be at most 1000 kg, got 1e+308"),  # was played
+    ("[rules]\nno_progress_s = inf\n", "rules.no_progress_s must be a finite number"),
+    ("[timing]\ndt = 1e-300\n", "timing.dt must be at least 0.0001 s"),  # was astronomically many ticks
+    ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nests arrays or tables too deep"),  # was RecursionError
     ("[field\n", "not valid TOML"),
 ]
 

@@ -102,6 +102,39 @@ def test_the_next_match_removes_what_a_killed_launcher_left(tmp_path, reap):
     assert list(tmp_path.glob("arena-*")) == [], "and the next match left nothing either"
 
 
+def test_a_second_referee_with_the_matchs_own_credentials_file_is_refused(tmp_path, reap):
+    """The file of a process arena match started (from its private temp dir) says `launched`, and a
+    second referee started with it played on and voided the match. Now it is refused, with and
+    without the match's own --config, and the match completes."""
+    sock = f"unixsock-stream/{tmp_path}/r.sock"
+    match = spawn(*GAME, "--external", "a/1", "--match", "own", "--listen", sock)
+    reap.append(match)
+    command = _printed(match)  # the match waits for robot a/1 meanwhile
+    creds = Path(command[command.index("--credentials") + 1]).parent
+    second = [
+        *ARENA,
+        "run",
+        "referee",
+        "--match",
+        "own",
+        "--connect",
+        sock,
+        "--credentials",
+        str(creds / "referee.json5"),
+    ]
+    for extra in ([], ["--config", str(creds.parent / "config.json")]):
+        r = subprocess.run([*second, *extra], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2, r.stderr
+        assert "referee is already running in match 'own'" in r.stderr.strip().splitlines()[-1], r.stderr
+    robot = subprocess.run([*ARENA, *command[1:]], capture_output=True, text=True, timeout=120)
+    assert robot.returncode == 0, robot.stderr
+    out, err = match.communicate(timeout=120)
+    assert match.returncode == 0, err
+    result = json.loads(out)
+    assert result["outcome"] == "completed" and result["faults"] == [], result["outcome_reasons"]
+    assert [r["process"] for r in result["refused_starts"]] == ["referee", "referee"], result["refused_starts"]
+
+
 def _twins(kind: list[str], secure: bool, tmp_path, reap, run: int) -> dict:
     """A match with one external process, started twice at the same moment; the match's result."""
     listen = (
@@ -152,3 +185,25 @@ def test_arena_up_of_a_bad_compose_file_leaves_no_temp_dir(tmp_path):
     r = subprocess.run([*ARENA, "up", str(bad)], capture_output=True, text=True, env=env, timeout=60)
     assert r.returncode == 2, r.stderr
     assert list(tmp_path.glob("arena-*")) == [], "a temp dir for the credentials stayed behind"
+
+
+@pytest.mark.parametrize("case", ["half time", "match typo"])
+def test_arena_up_with_a_bad_half_time_or_a_match_typo_is_exit_2_and_leaves_nothing(case, tmp_path):
+    """Both were exit 1 and kept a log directory in the temp dir: the engine refused ARENA_HALF_TIME
+    after it had started, and a service with a typo in --match waited for a match that never came."""
+    compose = Path(__file__).resolve().parents[2] / "compose.yaml"
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    if case == "half time":
+        env["ARENA_HALF_TIME"] = "abc"
+        needle = "arena up: error: service engine refused to start: argument --half-time: 'abc' is not a number"
+    else:
+        text = compose.read_text().replace(
+            '"referee", "--match", "${ARENA_MATCH:-compose}"', '"referee", "--match", "compsoe"'
+        )
+        compose = tmp_path / "typo.yaml"
+        compose.write_text(text)
+        needle = "arena up: error: service 'referee': --match 'compsoe' is not the router's match"
+    r = subprocess.run([*ARENA, "up", str(compose)], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert r.stderr.startswith(needle), r.stderr
+    assert list(tmp_path.glob("arena-*")) == [], "a log directory stayed behind"

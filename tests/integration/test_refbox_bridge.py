@@ -236,3 +236,56 @@ def test_via_refbox_is_refused_in_lockstep():
         timeout=60,
     )
     assert r.returncode == 2 and "--via-refbox needs --realtime" in r.stderr and "Traceback" not in r.stderr
+
+
+class CommandCollector(threading.Thread):
+    """A good base station: reads NUL-terminated JSON commands until the bridge closes."""
+
+    def __init__(self, sock: socket.socket):
+        super().__init__(daemon=True)
+        self.sock = sock
+        self.commands: list[tuple[str, str]] = []
+
+    def run(self) -> None:
+        self.sock.settimeout(120)
+        buf = b""
+        while data := self.sock.recv(4096):
+            buf += data
+            *messages, buf = buf.split(b"\0")
+            self.commands += [(m["command"], m["targetTeam"]) for m in map(json.loads, messages)]
+        self.sock.close()
+
+
+def test_a_100_kB_message_at_the_start_changes_nothing():
+    """`"` and 49,990 escaped quotes, sent by the first base station as soon as it is welcomed, in
+    a real-time match: the match starts and ends on time, the other base station gets every
+    command, and the message is counted as one malformed worldstate."""
+    port = free_port()
+    args = ["match", "--home", "AD", "--away", "BS", "--realtime", "--half-time", "2", "--seed", "9"]
+    match = subprocess.Popen(
+        [*ARENA, *args, "--refbox", f"tcp/127.0.0.1:{port}", "--refbox-wait", "2", "--json"],
+        stdout=PIPE,
+        stderr=PIPE,
+        text=True,
+    )
+    try:
+        hostile = connect(port)
+        hostile.recv(4096)  # WELCOME
+        hostile.sendall(b'"' + b'\\"' * 49_990 + b"\0")
+        good = CommandCollector(connect(port))
+        good.start()
+        out, err = match.communicate(timeout=180)
+    finally:
+        if match.poll() is None:
+            match.kill()
+            match.communicate()
+    assert match.returncode == 0, err[-3000:]
+    good.join(10)
+    hostile.close()
+    result = json.loads(out)
+    assert result["ticks"] == 200 and "void" not in json.dumps(result.get("status", ""))
+    assert result["refbox"]["worldstate_errors"] == {"a": {"malformed-json": 1}, "b": {}}
+    # WELCOME, then every command of the match, the last tick's GAMEOVER included.
+    counts = result["refbox"]["counts"]
+    assert len(good.commands) == result["refbox"]["commands_forwarded"] + 1 == counts["commands_to_b"]
+    assert good.commands[0][0] == "WELCOME" and good.commands[-1][0] == "GAMEOVER"

@@ -128,5 +128,8 @@ def test_sigterm_stops_arena_facts_and_its_workers_now(reap):
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143, err
-    assert err.strip().splitlines()[-1] == "arena facts: terminated; every process of the match was stopped"
+    assert (
+        err.strip().splitlines()[-1]
+        == "arena facts: terminated; every match still playing was stopped, its worker with it"
+    )
     wait_for(lambda: not [p for p in workers if alive(p)], 10, "the workers to be gone")

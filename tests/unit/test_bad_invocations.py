@@ -3,7 +3,8 @@
 A table of bad invocations across every subcommand. Each must print exactly
 one line on stderr, never a traceback, and exit with the documented code
 (arena/cli.py: 2 for a user error). `{tmp}` is an empty directory, `{file}` a
-file with garbage in it, `{busy}` a TCP port that something already listens on.
+file with garbage in it, `{busy}` a TCP port that something already listens on;
+`{bin}`, `{fifo}`, `{deep}` and `{huge}` are the hostile files of `HOSTILE`.
 
 The first case of every sub-command, and every case marked PROCESS (it opens a
 zenoh session, listens, or starts a match's processes), runs as a real
@@ -75,6 +76,9 @@ BAD = [
     (["credentials", "show", "{tmp}"], "holds no credentials: arena credentials init"),
     (["credentials", "rotate", "{tmp}"], "holds no credentials"),
     (["credentials", "init", "{file}"], "is not a directory"),
+    # a folder with an unrelated .json5: init and rotate each advised running the other
+    (["credentials", "init", "{stranger}"], "holds settings.json5, which is not a credentials file"),
+    (["credentials", "rotate", "{stranger}"], "holds settings.json5, which is not a credentials file"),
     (["credentials", "show", "{tmp}", "robot/a/1"], "PRINCIPAL applies to rotate only"),
     (["credentials", "init", "{tmp}", "--robots", "9"], "--robots must be between 1 and 6"),
     (["credentials", "burn", "{tmp}"], "invalid choice: 'burn'"),
@@ -94,12 +98,17 @@ BAD = [
     ([*R, "--credentials", "/tmp/arena-gone/credentials/robot-a-1.json5"], "a match's temp dir is gone with its match"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/nonexistent.json"], "cannot read"),
     (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{file}"], "not JSON"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "/dev/zero"], "not a regular"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{fifo}"], "not a regular"),
+    (["run", "engine", "--match", "m", "--connect", "tcp/127.0.0.1:1", "--config", "{deepjson}"], "nests arrays"),
     (["run", "engine", "--match", "m", "--listen", "tcp/127.0.0.1:0", "--half-time", "inf"], "finite number"),
     (["run", "router", "--match", "m", "--listen", "tcp/127.0.0.1:{busy}"], "Address already in use", PROCESS),
     (["run", "--match", "m", "--connect", "tcp/127.0.0.1:1"], "the following arguments are required: kind"),
     # arena up
     (["up", "/nonexistent/compose.yaml"], "cannot read"),
     (["up", "{file}"], "not valid YAML"),
+    (["up", "/dev/zero"], "compose file /dev/zero is not a regular file"),  # was a read without end
+    (["up", "{bin}"], "is not a text file"),
     (["up", "compose.yaml", "--timeout", "-5"], "--timeout: '-5'"),
     # arena tournament
     ([*T, "--leg", "2"], "arena tournament: error: unrecognized arguments: --leg 2; did you mean --legs?"),
@@ -174,12 +183,21 @@ BAD = [
     (["config", "--check", "/nonexistent.toml"], "cannot read"),
     (["config", "--check", "{file}"], "not valid TOML"),
     (["match", "--config", "{file}"], "not valid TOML"),
+    (["match", "--config", "{bin}"], "is not a text file (byte 0 is not UTF-8"),  # was internal error, exit 1
+    (["match", "--config", "{fifo}"], "is not a regular file"),  # was a hang
+    (["match", "--config", "/dev/zero"], "is not a regular file"),  # was a read without end
+    (["match", "--config", "{tmp}"], "is a directory: give a file"),
+    (["match", "--config", "{deep}"], "nests arrays or tables too deep"),  # was RecursionError
+    (["config", "--check", "{huge}"], "robot.mass must be at most 1000 kg, got 1e+308"),  # was accepted
     (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
     (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),
     # arena operator
-    (["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_bal"}}'], "ACTION 1:"),
+    (  # the valid types were not listed
+        ["operator", "--match", "m", "--connect", "tcp/127.0.0.1:1", '{{"type": "teleport_bal"}}'],
+        "ACTION 1: Invalid value 'teleport_bal' - at `$.type` (the types: teleport_ball, teleport_robot, referee)",
+    ),
     (["operator", "--match", "m", '{{"type": "teleport_ball"}}'], "required: --connect"),
     (
         [
@@ -224,6 +242,27 @@ def garbage(tmp_path_factory):
     return path
 
 
+HOSTILE = {
+    "bin": b"\x89MCAP0\r\n\xff\x00" * 64,  # a recording named by mistake
+    "deep": b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "huge": b"[robot]\nmass = 1e308\n",
+    "deepjson": b"[" * 100_000,
+}
+
+
+@pytest.fixture(scope="module")
+def hostile(tmp_path_factory) -> dict[str, str]:
+    import os
+
+    d = tmp_path_factory.mktemp("hostile")
+    for name, data in HOSTILE.items():
+        (d / f"{name}.toml").write_bytes(data)
+    os.mkfifo(d / "fifo.toml")
+    (d / "stranger").mkdir()
+    (d / "stranger" / "settings.json5").write_text('{"theme": "dark"}\n')
+    return {name: str(d / f"{name}.toml") for name in (*HOSTILE, "fifo")} | {"stranger": str(d / "stranger")}
+
+
 def _cases() -> list[tuple[list[str], str, bool]]:
     """BAD as (args, needle, in a process): the first case of each sub-command, and the PROCESS ones."""
     seen: set[str] = set()
@@ -243,10 +282,10 @@ CASES = _cases()
     CASES,
     ids=[("process: " if process else "") + " ".join(a)[:60] for a, _, process in CASES],
 )
-def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_port, garbage, tmp_path, capfd):
+def test_a_bad_invocation_is_one_line_and_exit_2(args, needle, process, busy_port, garbage, hostile, tmp_path, capfd):
     from arena.scenarios.library import LIBRARY
 
-    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY) for a in args]
+    argv = [a.format(busy=busy_port, file=garbage, tmp=tmp_path, lib=LIBRARY, **hostile) for a in args]
     if process:
         r = subprocess.run([sys.executable, "-m", "arena", *argv], capture_output=True, text=True, timeout=60)
     else:
@@ -289,6 +328,7 @@ def test_an_internal_failure_is_one_line_naming_the_log(tmp_path, monkeypatch, c
     [
         ("review", "arena review: interrupted"),
         ("match", "arena match: interrupted; every process of the match was stopped"),
+        ("facts", "arena facts: interrupted; every match still playing was stopped, its worker with it"),  # "the match"
     ],
 )
 def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
@@ -298,7 +338,7 @@ def test_ctrl_c_is_one_line_and_exit_130(monkeypatch, capsys, command, said):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli.command(command), "run", interrupted)
-    argv = ["review", "m.mcap"] if command == "review" else M
+    argv = {"review": ["review", "m.mcap"], "facts": ["facts", "--seeds", "2"]}.get(command, M)
     assert cli.main(argv) == 130
     assert capsys.readouterr().err.strip() == said
 
@@ -313,6 +353,7 @@ def test_version():
     [
         ({"ZENOH_RUNTIME": "garbage"}, M, "ZENOH_RUNTIME='garbage' is not a zenoh runtime setting"),
         ({"ARENA_MATCH": "bad/id"}, ["up", "compose.yaml"], "ARENA_MATCH: bad match id 'bad/id'"),
+        ({"ARENA_HALF_TIME": "1e12"}, ["up", "compose.yaml"], "service engine refused to start: --half-time must be"),
     ],
 )
 def test_a_bad_environment_variable_is_one_line_and_exit_2(env, args, needle):

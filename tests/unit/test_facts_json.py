@@ -67,3 +67,19 @@ def test_the_printed_lines_say_what_their_two_numbers_are():
     assert "x/y = team a (home) / team b (away)" in explained
     for word in ("outside", "stall", "stuck", "by-fence stuck", "corner", "pushing", "contact", "overlap", "saves"):
         assert word in lines[first] + lines[first + 1] and word in explained, word
+
+
+def test_the_summary_header_has_a_legend_for_its_terse_columns():
+    """`conceded-stuck` and `robot1/robot2` were printed without saying what they count."""
+    run = subprocess.run(
+        [sys.executable, "-m", "arena", "facts", "--seeds", "1", "--home", "AD", "--away", "BS", "--half-time", "2"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("strategy  sides"))
+    legend = lines[header + 1]
+    assert "conceded-stuck: goals it conceded while one of them was stuck" in legend, legend
+    assert "robot1/robot2: metres run by outfield robot 1 over robot 2" in legend, legend

@@ -186,3 +186,15 @@ def test_a_failed_engine_or_referee_voids_the_match_even_with_its_summary():
     assert [f["process"] for f in o["faults"]] == ["engine"]
     o = outcome(cfg, full, {}, {"referee": why}, {})
     assert o["outcome"] == "void" and o["outcome_reasons"] == [f"referee: {why}"]
+
+
+def test_forged_counts_are_said_to_be_messages():
+    """Forged ones are counted per zenoh message (one may batch several frames), conflicting ones
+    per frame; the line said "frames" for both."""
+    from arena.tools.launch.faults import warnings
+
+    lines = warnings({"forged": {"arena/m/cmd/a/1": 3, "arena/m/referee": 1}, "conflicts": {"arena/m/referee": 2}})
+    assert lines == [
+        "possible spoofing on arena/m/cmd/a/1 (3 forged messages)",
+        "possible spoofing on arena/m/referee (1 forged message, 2 conflicting frames)",
+    ]

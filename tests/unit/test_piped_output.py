@@ -43,5 +43,9 @@ def test_the_console_is_wide_when_piped_and_the_terminals_width_on_a_terminal(mo
     monkeypatch.delenv("COLUMNS", raising=False)
     monkeypatch.setattr(sys.stdout, "isatty", lambda: False, raising=False)
     assert console.console().width == console.PIPED_WIDTH
+    monkeypatch.setenv("COLUMNS", "")
+    assert console.console().width == console.PIPED_WIDTH, "set but empty: rich wrapped at 80 again"
+    monkeypatch.setenv("COLUMNS", "wide")
+    assert console.console().width == console.PIPED_WIDTH
     monkeypatch.setenv("COLUMNS", "100")
     assert console.console().width == 100, "a COLUMNS the user set wins"

@@ -112,6 +112,24 @@ def test_a_spoilt_directory_is_one_line_naming_it(tmp_path, spoil, needle):
         provision(d, NAMES, 2)
 
 
+def test_a_lost_router_file_is_recovered_by_rotate_as_init_says(tmp_path):
+    """init said "run rotate" and rotate refused the same directory: now rotate makes the set anew,
+    for the principals its files name, and every file changes."""
+    d = tmp_path / "creds"
+    provision(d, NAMES, 2)
+    before = _files(d)
+    (d / ROUTER_FILE).unlink()
+    with pytest.raises(ConfigError, match="run arena credentials rotate"):
+        provision(d, NAMES, 2)
+    with pytest.raises(ConfigError, match="run arena credentials rotate"):
+        rotate(d, ["robot/a/1"])  # one principal cannot be rotated without the set's router file
+    made = rotate(d, [])
+    after = _files(d)
+    assert set(after) == set(before) == set(made)
+    assert all(after[name] != before[name] for name in before)
+    provision(d, NAMES, 2)  # whole again
+
+
 def test_files_of_another_set_are_not_mixed_in(tmp_path):
     provision(tmp_path / "one", NAMES, 2)
     provision(tmp_path / "two", NAMES, 2)
@@ -151,3 +169,16 @@ def test_the_next_start_removes_what_a_killed_maker_left(tmp_path, monkeypatch):
     assert sweep("arena-t-") == [tmp_path / left.rsplit("/", 1)[-1]]
     assert mine.exists() and (mine / OWNER).exists(), "a live owner's directory stays"
     assert foreign.exists(), "a directory without an owner mark is not ours to remove"
+
+
+def test_rotate_takes_the_short_form_external_takes(tmp_path, capfd):
+    """`arena credentials rotate creds/ a/1` said "no credentials for a/1"; --external takes a/1."""
+    from tests.integration.helpers import arena_in_process
+
+    d = tmp_path / "creds"
+    provision(d, NAMES, 2)
+    a0, a1 = (d / "robot-a-0.json5").read_bytes(), (d / "robot-a-1.json5").read_bytes()
+    r = arena_in_process(["credentials", "rotate", str(d), "a/1"], capfd)
+    assert r.returncode == 0, r.stderr
+    assert (d / "robot-a-1.json5").read_bytes() != a1 and (d / "robot-a-0.json5").read_bytes() == a0
+    assert "copy basestation-a.json5, robot-a-1.json5 again" in r.stdout, r.stdout

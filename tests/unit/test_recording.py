@@ -252,6 +252,32 @@ def test_replay_of_a_truncated_file_compares_up_to_its_end(recorded, tmp_path, c
     assert not [r for r in caplog.records if r.levelno >= logging.ERROR], caplog.text
 
 
+def test_replay_of_a_match_stopped_by_ctrl_c_compares_up_to_where_it_stopped(recorded, caplog):
+    """A whole file of an interrupted match: every process stopped at its own tick, so robot b/1's
+    last `cmd` frames are missing while its inputs go on a little. It reported a divergence
+    ("recorded: None") and 14 "treating ... as dead" lines."""
+    import copy
+
+    path, _ = recorded
+    rec = load(str(path))
+    stopped = copy.copy(rec)
+    stopped.meta = {**rec.meta, "recording": {**rec.meta.get("recording", {}), "complete": "false"}}
+    stopped.meta["recording"]["interrupted"] = "SIGINT"
+    dt_ns = round(rec.cfg.timing.dt * 1e9)
+    cut = rec.cfg.total_ticks // 2
+
+    def upto(frames, tick):
+        return [f for f in frames if f[0] <= tick * dt_ns]
+
+    stopped.topics = {t: upto(frames, cut) for t, frames in rec.topics.items()}
+    stopped.topics["robot/b/1/cmd"] = upto(rec.topics["robot/b/1/cmd"], cut - 10)
+    assert not stopped.truncated and stopped.ends_early == "match stopped by SIGINT"
+    result = replay.replay(stopped, "robot/b/1")
+    assert result.match and result.frames > 0, result.first_difference
+    assert result.note == "match stopped by SIGINT: compared up to its end" and result.digest_match is None
+    assert not [r for r in caplog.records if r.levelno >= logging.ERROR], caplog.text
+
+
 @pytest.mark.parametrize(
     ("content", "needle"),
     [(b"", "is empty"), (b"hello, not mcap at all", "not an MCAP file"), (b"\x89MCAP0\r\n\x01", "cut short")],
@@ -348,8 +374,9 @@ def test_replay_refuses_what_it_cannot_do(recorded, tmp_path):
         replay.replay(str(rt), "robot/a/1")
 
 
-def rewrite(src, dst, change) -> None:
-    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages."""
+def rewrite(src, dst, change, extra=(), meta_change=lambda name, data: data) -> None:
+    """Copy the recording `src` to `dst`, every record as it was but `change(topic, data)`'s messages
+    and `meta_change(name, metadata)`'s metadata, and `extra` (topic, data) messages added at the end."""
     from mcap.records import Metadata
     from mcap.stream_reader import StreamReader
 
@@ -367,8 +394,10 @@ def rewrite(src, dst, change) -> None:
                 sid = schemas.get(schema.id, 0) if schema is not None else 0
                 channels[channel.id] = w.register_channel(channel.topic, channel.message_encoding, sid)
             w.add_message(channels[channel.id], m.log_time, change(channel.topic, m.data), m.publish_time, m.sequence)
+        for i, (topic, data) in enumerate(extra):
+            w.add_message(w.register_channel(topic, "msgpack", 0), m.log_time, data, m.publish_time, i)
         for md in meta:
-            w.add_metadata(md.name, md.metadata)
+            w.add_metadata(md.name, meta_change(md.name, md.metadata))
         w.finish()
 
 
@@ -426,3 +455,39 @@ def test_the_recorder_waits_for_a_gone_peer_from_when_its_token_vanished(tmp_pat
     node.gone.add(crashed)
     assert not node._finished()
     node.sink.finish()
+
+
+def test_a_worldstate_nested_100000_deep_is_a_one_line_error_in_every_review_mode(recorded, tmp_path, capsys):
+    """A worldstate whose JSON nests 100,000 deep made every review mode exit 1 (RecursionError in
+    score_team); the bridge records none deeper than 32, so the file was made: exit 2, one line."""
+    from arena.schemas.messages import Worldstate
+
+    path, _ = recorded
+    crafted = tmp_path / "deep.mcap"
+    deep = Worldstate(tick=30, team="a", json="[" * 100_000 + "]" * 100_000)
+    rewrite(path, crafted, lambda topic, data: data, [("refbox/a/worldstate", msgspec.msgpack.encode(deep))])
+    modes = [{}, {"as_json": True}, {"plots": str(tmp_path / "plots")}, {"html": str(tmp_path / "r.html")}]
+    for mode in modes:
+        assert review.main(str(crafted), **mode) == 2, mode
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "its JSON nests 100000 levels deep, more than 32" in err[0], (mode, err)
+
+
+def test_metadata_nested_100000_deep_is_skipped_not_a_crash(recorded, tmp_path, capsys):
+    """A summary or the gaps metadata nested 100,000 deep raised RecursionError in msgspec."""
+    path, _ = recorded
+    crafted = tmp_path / "deep-meta.mcap"
+    deep = "[" * 100_000 + "]" * 100_000
+
+    def poison(name: str, data: dict) -> dict:
+        if name == "summary/engine":
+            return {**data, "json": '{"process": "engine", "extra": ' + deep + "}"}
+        if name == "recording":
+            return {**data, "gaps": deep}
+        return data
+
+    rewrite(path, crafted, lambda topic, data: data, meta_change=poison)
+    rec = load(str(crafted))
+    assert "engine" not in rec.summaries and "referee" in rec.summaries
+    assert rec.gaps == {"?": {"error": "unreadable gaps metadata"}}
+    assert review.main(str(crafted), as_json=True) == 0, capsys.readouterr().err

@@ -76,6 +76,95 @@ def test_command_reader_reports_garbage():
     assert len(reader.errors) == 3
 
 
+def test_command_reader_bounds_its_errors_and_survives_deep_json():
+    """A RefBox (or anything on its port) is input too: 1 MB of unknown characters is one pass and
+    20 logged errors, the rest counted; a command nested 90,000 deep is an error, not a
+    RecursionError that ends the reading thread; an overlong command is dropped up to its NUL."""
+    reader = rp.CommandReader()
+    assert reader.feed(b"?" * 1_000_000) == []
+    assert len(reader.errors) == rp.LOG_FIRST_ERRORS and reader.dropped == 1_000_000 - rp.LOG_FIRST_ERRORS
+    reader = rp.CommandReader()
+    assert reader.feed(b'{"command":' + b"[" * 90_000 + b"\0" + rp.encode_json("STOP")) == [rp.Command("STOP")]
+    assert reader.errors == [f"JSON command nested deeper than {rp.MAX_DEPTH} levels"]
+    reader, got = rp.CommandReader(), []
+    for i in range(0, 300_000, 1000):  # 300 kB of one command without its NUL, then the NUL and a good one
+        got += reader.feed(b"{" + b" " * 999 if i == 0 else b" " * 1000)
+    got += reader.feed(b"\0s")
+    assert [c.name for c in got] == ["START"]
+    assert reader.errors == [f"command not terminated within {rp.MAX_UNTERMINATED} bytes"]
+
+
+def reference_nesting(raw: str) -> int:
+    """A character-by-character JSON string scanner: the oracle for `rp.nesting`."""
+    depth = deepest = 0
+    in_string = escaped = False
+    for c in raw:
+        if in_string:
+            if escaped:
+                escaped = False
+            elif c == "\\":
+                escaped = True
+            elif c == '"':
+                in_string = False
+        elif c == '"':
+            in_string = True
+        elif c in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif c in "]}":
+            depth -= 1
+    return deepest
+
+
+# Inputs that made a backtracking pattern for JSON strings quadratic, and other hostile shapes,
+# at the RefBox's size limit and at ten times it. Each is parsed in a few ms (`arena bench refbox`
+# prints the cost per kB at both sizes); before, the first took over a minute with the GIL held.
+PATHOLOGICAL = [
+    ('"' + '\\"' * 49_990, 0),  # the issue's message: an unterminated string of escaped quotes
+    ('"' + '\\"' * 499_990, 0),
+    ('"[' * 50_000, 25_000),  # every other bracket is outside a string
+    ("\\" * 1_000_000, 0),
+    ("[" * 1_000_000, 1_000_000),
+    ('["' + "\\\\" * 100_000 + '", [[1]]]', 3),  # escaped backslashes end before the closing quote
+    ('{"a": "' + "\u00e9[" * 100_000 + '"}', 1),
+]
+
+
+@pytest.mark.parametrize(("raw", "depth"), PATHOLOGICAL, ids=lambda x: f"{len(x)}" if isinstance(x, str) else None)
+def test_nesting_of_pathological_messages(raw, depth):
+    assert rp.nesting(raw) == depth
+    r = rp.validate_worldstate(raw)
+    assert r.doc is None and (r.reason == "too-deep") == (depth > rp.MAX_DEPTH)
+
+
+def test_the_100_kB_message_through_the_reader():
+    message = b'"' + b'\\"' * 49_990 + b"\0"
+    (r,) = rp.WorldstateReader().feed(message)
+    assert r.reason == "malformed-json" and len(message) > 100_000 - 30
+
+
+def test_nesting_agrees_with_a_character_scanner():
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    # JSON's tokens, strings with escapes among them and perhaps unterminated at the end; outside
+    # strings a backslash is no JSON, the parser stops there, and the counts may differ after it.
+    string = st.lists(st.sampled_from(["a", "[", "{", "]", "\\\\", '\\"', "\u00e9", "\\n"]), max_size=8).map(
+        lambda parts: '"' + "".join(parts) + '"'
+    )
+    token = st.one_of(st.sampled_from(["[", "]", "{", "}", ",", ":", "1", " "]), string)
+    text = st.tuples(st.lists(token, max_size=30), st.booleans()).map(
+        lambda t: "".join(t[0])[: -1 if t[1] and t[0] and t[0][-1].endswith('"') else None]
+    )
+
+    @settings(max_examples=400, deadline=None, database=None)
+    @given(text)
+    def agree(raw: str) -> None:
+        assert rp.nesting(raw) == max(0, reference_nesting(raw))
+
+    agree()
+
+
 def enc(doc) -> bytes:
     return json.dumps(doc).encode() + b"\0"
 

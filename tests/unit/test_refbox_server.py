@@ -221,7 +221,51 @@ def test_the_bridge_survives_any_input_on_its_socket():
     try:
         feed()
         assert sum(server.errors["a"].values()) > 0
-        assert set(server.errors["a"]) <= {"malformed-json", "missing-key", "wrong-type", "not-terminated", "too-deep"}
+        assert set(server.errors["a"]) <= {
+            "malformed-json",
+            "missing-key",
+            "wrong-type",
+            "not-terminated",
+            "too-deep",
+            "flooding",
+        }
         still_serves(server)
+    finally:
+        server.close(linger=0)
+
+
+def wait_for(cond, timeout: float = 10.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while not cond() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return cond()
+
+
+def test_a_hostile_base_station_neither_stalls_the_other_nor_stays():
+    """Team a sends the 100 kB message of escaped quotes (a bad message, counted; its connection
+    stays, as an honest station's typo would) and then floods; team b is served throughout, and the
+    flooding connection is cut off."""
+    server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x"), LOG)
+    try:
+        hostile = connect_as_a(server)
+        good = socket.create_connection(("127.0.0.1", server.port))
+        assert b"WELCOME" in read_through(good, b"\0")
+        hostile.sendall(b'"' + b'\\"' * 49_990 + b"\0" + GOOD)
+        good.sendall(GOOD)
+        assert wait_for(lambda: server.counts["worldstates_a"] == 1 and server.counts["worldstates_b"] == 1)
+        assert server.errors["a"] == {"malformed-json": 1} and server.sides() == 2
+        try:  # until it is cut off (a slow reader under load may take a while: up to 64 MB)
+            for _ in range(64):
+                hostile.sendall(b"x" * (1 << 20))
+        except OSError:
+            pass  # cut off while still sending
+        assert recv_until_closed(hostile, timeout=10.0) == b"", "disconnected"
+        assert server.errors["a"]["flooding"] == 1 and server.sides() == 1
+        server.broadcast("STOP")
+        good.sendall(GOOD)
+        assert read_through(good, STOP) == STOP
+        assert wait_for(lambda: server.counts["worldstates_b"] == 2)
+        good.close()
+        hostile.close()
     finally:
         server.close(linger=0)

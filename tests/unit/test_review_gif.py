@@ -101,3 +101,14 @@ def test_timeline_marks_and_score():
     assert last_mark(tl, 35, within=50)["kind"] == "GOAL"
     assert last_mark(tl, 10, within=50)["kind"] == "KICKOFF"
     assert last_mark(tl, 200, within=50) is None
+
+
+def test_the_half_time_frame_shows_the_kickoff_positions_under_its_banner():
+    """The world of the half-time tick still has the first half's positions, and the referee's
+    KICKOFF b of that tick made the GIF say "KICKOFF b" over them; the placement is one tick later."""
+    cfg = MatchConfig(half_time=2.0)
+    worlds, _ = _match(cfg, ticks=cfg.total_ticks + 1)
+    frames = animation.frames_of(worlds, cfg.timing.dt, cfg.half_ticks)
+    ticks = [w.tick for w in frames]
+    assert cfg.half_ticks not in ticks and cfg.half_ticks + 1 in ticks, ticks
+    assert ticks == sorted(ticks) and len(ticks) == 9

@@ -386,3 +386,37 @@ def _example_plugin() -> Strategy:
 
 def test_the_example_plugin_package_passes_the_conformance_suite():
     conformance.check_all(_example_plugin())
+
+
+def test_arena_strategies_runs_the_suite_again_only_for_changed_source(tmp_path, monkeypatch):
+    """`arena strategies` ran the conformance suite for every strategy on every call (42 s on a
+    loaded host): a verdict is now kept by source hash in the user's cache dir."""
+    import sys
+
+    from arena.strategies import checked, registry
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    runs = []
+    monkeypatch.setattr(conformance, "check_all", lambda s: runs.append(s.name))
+    rows = registry.describe(only={"chase"})
+    assert (runs, rows[0]["conformance"], rows[0]["cached"]) == (["chase"], "passes", False)
+    rows = registry.describe(only={"chase"})
+    assert (runs, rows[0]["conformance"], rows[0]["cached"]) == (["chase"], "passes", True)
+    registry.describe(only={"chase"}, recheck=True)
+    assert runs == ["chase", "chase"]
+    assert (tmp_path / "cache" / "soccer-arena" / checked.CACHE_FILE).exists()
+
+    # A plugin's own source is part of the key: an edit to its package runs the suite again.
+    pkg = tmp_path / "src" / "edited_plugin"
+    pkg.mkdir(parents=True)
+    (pkg / "__init__.py").write_text("from arena.strategies.simple import *  # noqa\n")
+    monkeypatch.syspath_prepend(str(tmp_path / "src"))
+    import edited_plugin
+
+    s = Strategy(
+        name="edited", make_team=type("T", (_StandTeam,), {"__module__": "edited_plugin"}), make_robot=_CreepRobot
+    )
+    assert checked.verdict(s) == ("passes", False) and checked.verdict(s) == ("passes", True)
+    (pkg / "__init__.py").write_text("# edited\n")
+    assert checked.verdict(s) == ("passes", False)
+    del sys.modules[edited_plugin.__name__]

@@ -67,7 +67,8 @@ def test_version_matches_the_package():
     assert r.returncode == 0 and r.stdout.strip() == f"arena {version('soccer-arena')}"
 
 
-def test_strategies_lists_name_alias_source_and_conformance(capfd):
+def test_strategies_lists_name_alias_source_and_conformance(capfd, tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))  # the suite's verdicts are kept there
     r = arena_in_process(["strategies", "chase", "BS", "--json"], capfd)
     assert r.returncode == 0, r.stderr
     rows = {row["name"]: row for row in json.loads(r.stdout)["strategies"]}

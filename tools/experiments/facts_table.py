@@ -83,6 +83,15 @@ TOTALS = (
 ).split()
 
 
+# Under the summary's header: what its less obvious columns count.
+SUMMARY_LEGEND = (
+    "  (per side: per match the strategy played; stuck-s and corner-s: robot-seconds its outfield robots stood "
+    "stuck by the fence or in a corner; conceded-stuck: goals it conceded while one of them was stuck; "
+    "pushing: fouls given against it; robot1/robot2: metres run by outfield robot 1 over robot 2, "
+    "the paper's Fig. 9 ratio)"
+)
+
+
 def summary(facts: list[MatchFacts]) -> list[str]:
     """Totals over matches, per strategy (a strategy met on both sides counts both)."""
     goals = [sum(m.score) for m in facts]
@@ -98,6 +107,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         "strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
         "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2"
     )
+    out.append(SUMMARY_LEGEND)
     from arena.tools.experiments.fixtures import short
 
     for s, r in sorted(per.items()):

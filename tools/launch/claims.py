@@ -7,7 +7,8 @@ The router's host (`arena match`, `arena run router`) answers one claim at a tim
 once the claimant's token has reached it, so of two processes started at the same moment
 exactly one gets the identity, in either mode; the other is refused with the reason. The identity is free again when the
 holder's token vanishes (it exited or its session was lost). `arena match` holds its own
-processes' identities from the start: they never ask.
+processes' identities from the start and gives each only to the process it started (by OS
+pid): a second process with one of their credentials files is refused like any other.
 
 The same answer refuses a process whose credentials cannot be this match's: no key where
 the match has one for that process (it left out `--credentials`), or a key that does not
@@ -28,7 +29,6 @@ import zenoh
 
 from arena.runtime.config import ConfigError, ProcessId
 from arena.runtime.mac import Keyring
-from arena.runtime.session import NetConfig
 from arena.schemas.keys import Keys
 
 TOKEN_WAIT = 2.0  # [s] a claim whose token has not reached the router by then is refused
@@ -45,8 +45,14 @@ def _text(payload: bytes) -> dict:
 class Claims:
     """The router side: who holds which identity of match `keys.match`."""
 
-    def __init__(self, session, keys: Keys, keyring: Keyring | None, reserved: dict[str, str], announce=None):
+    def __init__(
+        self, session, keys: Keys, keyring: Keyring | None, reserved: dict[str, str], announce=None, pid_of=None
+    ):
+        """`reserved`: identities held from the start (process -> by whom); `pid_of(process)`: the
+        OS pid of the process `arena match` started for a reserved identity, which alone may claim it
+        (this host's pid of a running child: no second process has it)."""
         self.keys = keys
+        self.pid_of = pid_of or (lambda process: None)
         self.keyring = keyring
         self.announce = announce or (lambda text: None)
         self.refused: list[dict] = []  # every refusal, for the match's JSON
@@ -89,6 +95,9 @@ class Claims:
             while f"{process}/{nonce}" not in self._tokens and time.monotonic() < deadline:
                 self._lock.wait(0.05)
             held = self._held.get(process)
+            if held is not None and held["nonce"] is None and self._own_child(process, claim):
+                held = None  # arena match's own process for this identity, claiming what it was kept for
+                who = f"started by arena match, pid {claim.get('pid')}"
             if held is not None and held["nonce"] != nonce:
                 reason: str | None = (
                     f"{process} is already running in match {self.keys.match!r} ({held['who']}): "
@@ -104,6 +113,10 @@ class Claims:
             self.refused.append({"process": process, "from": who.removeprefix("from "), "reason": reason})
             self.announce(f"refused {process} {who}: {reason}")
         return reason
+
+    def _own_child(self, process: str, claim: dict) -> bool:
+        pid = self.pid_of(process)
+        return pid is not None and claim.get("pid") == pid and claim.get("host") == socket.gethostname()
 
     def _check_key(self, process: str, nonce: str, mac) -> str | None:
         verify = self.keyring.verifier(process, self.keys.claim(process)) if self.keyring is not None else None
@@ -158,21 +171,19 @@ def claim(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, timeout:
     return None
 
 
-def hold_identity(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, net: NetConfig):
+def hold_identity(session, keys: Keys, pid: ProcessId, keyring: Keyring | None):
     """This process's identity in the match, or ConfigError with the reason it is someone else's.
     `arena match` holds its own processes' for them; a router that gives out none leaves the
-    liveliness check. Returns what holds it (None: nothing to keep)."""
-    if launched(net):
-        return None
+    liveliness check. Returns what holds it (None: nothing to keep).
+
+    A credentials file that says `launched` (one of `arena match`'s own, from its private temp
+    dir) proves nothing about who holds it: its holder claims the identity as any other process,
+    and the match gives it only to the process it started (by OS pid, `Claims.pid_of`). A second
+    process started with that file, by hand or with the match's own `--config`, is refused."""
     held = claim(session, keys, pid, keyring)
     if held is None:
         refuse_duplicate(session, keys, pid)
     return held
-
-
-def launched(net: NetConfig) -> bool:
-    """Started by `arena match`, which holds this process's identity for it (its credentials say so)."""
-    return bool(net.base and json.loads(net.base).get("metadata", {}).get("arena", {}).get("launched"))
 
 
 def refuse_duplicate(session, keys: Keys, pid: ProcessId) -> None:

@@ -50,14 +50,18 @@ def expand(text: str, env: dict[str, str]) -> str:
 
 def load_services(path: str, env: dict[str, str]) -> dict[str, list[str]]:
     """service name -> argv, in start order (services others depend on first)."""
+    from arena.runtime import userfile
+
     try:
-        raw = Path(path).read_text()
-    except OSError as exc:
-        raise ComposeError(f"cannot read {path}: {exc.strerror}", bad_input=True) from None
+        raw = userfile.read_text(path, "compose file")  # regular, bounded, UTF-8
+    except ConfigError as exc:
+        raise ComposeError(str(exc), bad_input=True) from None
     try:
         doc = yaml.safe_load(expand(raw, env))
     except yaml.YAMLError as exc:
         raise ComposeError(f"{path} is not valid YAML: {str(exc).splitlines()[0]}", bad_input=True) from None
+    except RecursionError:  # the YAML composer recurses per level of nesting
+        raise ComposeError(f"{path} nests too deep to read", bad_input=True) from None
     services = (doc or {}).get("services") if isinstance(doc, dict) else None
     if not isinstance(services, dict) or not services:
         raise ComposeError(f"{path} has no services", bad_input=True)
@@ -128,6 +132,7 @@ def up(path: str, timeout: float = 600.0) -> MatchResult:
         if len(routers) != 1:
             raise ComposeError(f"{path} must have exactly one router service ('arena run router ...')", bad_input=True)
         router = routers[0]
+        _same_match(services, router)
         children.append(spawn(router, ProcessId("router"), _argv(services[router]), tmp, env=env))
         _wait_for_socket(sock, children[0])
         net, keyring = _collector_net(env, router_argv=services[router], match=match)
@@ -204,6 +209,31 @@ def _collector_net(env: dict[str, str], router_argv: list[str], match: str):
     return dataclasses.replace(net, base=base), keyring
 
 
+def _same_match(services: dict[str, list[str]], router: str) -> None:
+    """ComposeError (bad input) when a service names another match than the router's: it would wait
+    for a match that never starts, and the match for it."""
+
+    def match_of(argv: list[str]) -> str | None:
+        return argv[argv.index("--match") + 1] if "--match" in argv[:-1] else None
+
+    want = match_of(services[router])
+    for name, argv in services.items():
+        got = match_of(argv)
+        if got is not None and want is not None and got != want:
+            raise ComposeError(
+                f"service {name!r}: --match {got!r} is not the router's match {want!r} (a typo?)", bad_input=True
+            )
+
+
+def _exited(c: Child) -> ComposeError:
+    """A service that ended before the match started: its exit code 2 means it refused its command
+    line or environment (one line: the last of its log), which is bad input, as for arena run."""
+    if c.popen.returncode == 2:
+        last = (c.tail(1).strip() or "no output").removeprefix("arena run: error: ")
+        return ComposeError(f"service {c.name} refused to start: {last}", bad_input=True)
+    return ComposeError(f"service {c.name} exited with code {c.popen.returncode}:\n{c.tail()}")
+
+
 def _argv(argv: list[str]) -> list[str]:
     """`arena ...` from the compose file, run with this very Python."""
     return [sys.executable, "-m", "arena", *argv[1:]]
@@ -213,7 +243,7 @@ def _wait_for_socket(sock: Path, router: Child, limit: float = 30.0) -> None:
     deadline = time.monotonic() + limit
     while not sock.exists():
         if router.popen.poll() is not None:
-            raise ComposeError(f"the router service exited with code {router.popen.returncode}:\n{router.tail()}")
+            raise _exited(router)
         if time.monotonic() > deadline:
             raise ComposeError("the router service did not start listening")
         time.sleep(0.05)
@@ -224,7 +254,7 @@ def _fetch(transport: ZenohTransport, keys: Keys, children: list[Child]) -> Matc
     while time.monotonic() < deadline:
         for c in children:
             if c.popen.poll() not in (None, 0):
-                raise ComposeError(f"service {c.name} exited with code {c.popen.returncode}:\n{c.tail()}")
+                raise _exited(c)
         payload = transport.query(keys.config(), timeout=1.0)
         if payload is not None:
             try:

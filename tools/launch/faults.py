@@ -179,8 +179,11 @@ def warnings(result: dict) -> list[str]:
     lines = []
     conflicts, forged = result.get("conflicts", {}), result.get("forged", {})
     for key in sorted({*conflicts, *forged}):
-        counts = [f"{n} {what}" for n, what in ((forged.get(key, 0), "forged"), (conflicts.get(key, 0), "conflicting"))]
-        lines.append(f"possible spoofing on {key} ({', '.join(c for c in counts if not c.startswith('0 '))} frames)")
+        # Forged ones are counted per message as it arrives (one message may batch several ticks'
+        # frames), conflicting ones per frame the lockstep compared.
+        counts = ((forged.get(key, 0), "forged message"), (conflicts.get(key, 0), "conflicting frame"))
+        said = ", ".join(f"{n} {what}{'s' if n != 1 else ''}" for n, what in counts if n)
+        lines.append(f"possible spoofing on {key} ({said})")
     for f in result.get("faults", []):
         at = f" at tick {f['tick']}" if f.get("tick") is not None else ""
         lines.append(f"fault: {f['process']}{at}: {f['reason']}")

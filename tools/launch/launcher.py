@@ -228,6 +228,10 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
             watch_spoofing(transport, keys, announce)
             # An external's digest is recomputed from the frames it puts (tools/launch/witness.py).
             witness = Witness(transport, keys, cfg.robots, {str(p) for p in external}, cfg.timing.periods())
+            # One identity, one process: arena match's own claim theirs by OS pid (tools/launch/claims.py).
+            mine = f"started by arena match, pid {os.getpid()}"
+            pid_of = lambda process: next((c.popen.pid for c in children if c.name == process), None)
+            claims = Claims(session, keys, secrets.keyring("launcher"), {str(p): mine for p in local}, announce, pid_of)
             if starter is not None:
                 starter.release()
             for p in cfg.processes() if starter is None else ():
@@ -239,8 +243,6 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
             joins = Joins(session, keys, external, announce)
-            mine = f"started by arena match, pid {os.getpid()}"
-            claims = Claims(session, keys, secrets.keyring("launcher"), {str(p): mine for p in local}, announce)
             if external and announce is not None:
                 announce(instructions(sorted(external), match, endpoint, record, cred_paths, secure))
             try:

@@ -233,11 +233,10 @@ def configure_logging(level: str, by_hand: bool, stream=None) -> None:
 
 
 def load_config(path: str) -> MatchConfig:
-    try:
-        text = Path(path).read_text()
-    except OSError as exc:
-        raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
-    return MatchConfig.from_json(text)
+    """The match configuration JSON at `path` (regular, bounded, UTF-8: runtime/userfile.py)."""
+    from arena.runtime import userfile
+
+    return MatchConfig.from_json(userfile.read_text(path, "--config"))
 
 
 def record_path(text: str, fresh: bool = False) -> str:
@@ -269,6 +268,7 @@ def record_path(text: str, fresh: bool = False) -> str:
 REFUSED_AFTER = 6.0  # [s] listening but not connected this long is a refusal: zenoh retries a connect every <= 4 s
 ROUTER_RETRY_S = 0.25  # [s] wall: pause between attempts to reach a router that is not there yet
 REFUSED_TWICE_S = 1.0  # [s] wall: a router refusing us this long after its first refusal is not one still starting
+CONFIG_GRACE_S = 1.0  # [s] wall: connected this long without the match's configuration, the match is not there yet
 
 
 def refused_by(connect: tuple[str, ...]) -> str | None:
@@ -305,10 +305,11 @@ def fetch_config(
 ) -> MatchConfig:
     """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
     deadline = time.monotonic() + timeout
-    state = ""
+    state = said = ""  # what we wait for now, and what we last told
     ep = None
     elsewhere = ""  # the other matches the router we reached hosts
     refused_since: float | None = None  # a router listens, and we are still not connected to it
+    connected_since: float | None = None  # a fresh connection learns the engine's queryable a moment later
     while time.monotonic() < deadline:
         payload = transport.query(keys.config(), timeout=1.0)
         if payload is not None:
@@ -318,6 +319,7 @@ def fetch_config(
             probe = None if connected else refused_by(connect)
             if connected:
                 refused_since = None
+                connected_since = connected_since or time.monotonic()
             elif probe is not None:  # (a probe that fails on a loaded host proves nothing)
                 ep = probe
                 refused_since = refused_since or time.monotonic()
@@ -328,8 +330,11 @@ def fetch_config(
             if connected:  # a typo in --match is said with the match that is there
                 elsewhere = elsewhere or hosted_elsewhere(session, keys)
                 now += elsewhere
-            if now != state and tell is not None and (connected or refused_since is None):
+            # Connected, a match that is there answers within CONFIG_GRACE_S: only then is it "waiting".
+            settled = not connected or time.monotonic() - (connected_since or 0.0) >= CONFIG_GRACE_S
+            if now != said and tell is not None and settled and (connected or refused_since is None):
                 tell(f"{now if connected else 'waiting: ' + now} (up to {timeout:g} s)")
+                said = now
             state = now
         time.sleep(0.2)
     if refused_since is not None and refused is not None and ep is not None:
@@ -472,7 +477,7 @@ def run(
                 raise ConfigError(f"{pid} is not part of this match ({cfg.robots} robots per team)")
             if policy:
                 cfg = with_policy(cfg, pid.team, policy)
-            held = hold_identity(session, keys, pid, keyring, net)  # noqa: F841 - kept while it runs
+            held = hold_identity(session, keys, pid, keyring)  # noqa: F841 - kept while it runs
             tell(
                 f"connected to {where} (zenoh {net.mode}); match {match!r}: {cfg.home} v {cfg.away}, "
                 f"{cfg.robots} robots per team, 2 x {cfg.half_time:g} s"

@@ -32,19 +32,25 @@ GOAL, RESTART, HALF, NOW = "#ff1744", "#eeeeee", "#ffeb3b", "#00e5ff"  # the tim
 SIDES = {"s": (4, 0), "^": (3, 0), "D": (4, 45), "v": (3, 180), "8": (8, 22.5)}  # marker: (sides, rotation [deg])
 
 
-def frames_of(worlds: list[World], dt: float) -> list[World]:
-    """One world every FRAME_PERIOD seconds of play (or every world, if they are further apart)."""
+def frames_of(worlds: list[World], dt: float, half_tick: int | None = None) -> list[World]:
+    """One world every FRAME_PERIOD seconds of play (or every world, if they are further apart).
+
+    The world of `half_tick` still shows the first half's last positions, while the referee's
+    frame of that tick already starts the second half (KICKOFF); the engine places everybody for
+    it one tick later. That frame shows the next world instead, so the banner names what is seen."""
     if len(worlds) < 2:
         return list(worlds)
     per_world = (worlds[1].tick - worlds[0].tick) * dt  # [s]
-    return worlds[:: max(1, round(FRAME_PERIOD / per_world))]
+    step = max(1, round(FRAME_PERIOD / per_world))
+    picked = list(range(0, len(worlds), step))
+    return [worlds[i + 1] if worlds[i].tick == half_tick and i + 1 < len(worlds) else worlds[i] for i in picked]
 
 
 def animate(worlds: list[World], cfg, path: Path, refs: list[Referee], draw_field) -> str:
     """Write the GIF to `path`; `draw_field(ax, cfg, grass=False)` draws the lines and goals."""
     from PIL import Image, ImageDraw
 
-    frames = frames_of(worlds, cfg.timing.dt)
+    frames = frames_of(worlds, cfg.timing.dt, cfg.half_ticks)
     tl = timeline([], refs, cfg.timing.dt)  # marks and scores only
     background, to_px, strip = _background(cfg, tl, draw_field)
     fonts = _fonts()

@@ -129,7 +129,8 @@ def heatmap(worlds: list[World], cfg, path: Path, draw_field, goalkeepers: bool 
 
     f = cfg.field
     extent = [[-f.length / 2 - f.runoff, f.length / 2 + f.runoff], [-f.width / 2 - f.runoff, f.width / 2 + f.runoff]]
-    cell = 0.5  # [m]
+    area = (extent[0][1] - extent[0][0]) * (extent[1][1] - extent[1][0])
+    cell = cell_size(*mirrored_points(worlds, cfg, "", goalkeepers), area)  # [m]
     bins = [max(1, round((hi - lo) / cell)) for lo, hi in extent]
     period = cfg.timing.dt * _frame_ticks(worlds)  # [s] per frame
     who = "field players" if not goalkeepers else "all robots"
@@ -148,12 +149,31 @@ def heatmap(worlds: list[World], cfg, path: Path, draw_field, goalkeepers: bool 
         ax.set_xlabel("x [m], attacking \u2192")
     fig.tight_layout(rect=(0, 0, 0.95, 1))
     bar = fig.colorbar(im, ax=list(axes), fraction=0.015, pad=0.01)
-    bar.set_label(f"time in a {cell:g} m cell [s] (summed over robots)")
+    bar.set_label(f"time in a {cell:g} m cell [s] (summed over robots; the cell grows for a short match)")
     fig.suptitle(
         f"where the play was: {cfg.home} (a) vs {cfg.away} (b), both halves, each team attacking to the right"
         + ("" if goalkeepers else "; goalkeepers left out (arena review --plots DIR --goalkeepers)")
     )
     return _save(fig, path)
+
+
+# [m] the heatmap's cell: at least MIN_CELL, at most MAX_CELL, in steps of CELL_STEP.
+MIN_CELL, MAX_CELL, CELL_STEP = 0.5, 2.0, 0.25
+
+
+def cell_size(xs: np.ndarray, ys: np.ndarray, area: float) -> float:
+    """The cell [m] for this much play: the ball's path, swept one cell wide, covers the area once.
+
+    A ball path of L metres visits about L / cell cells, so cells much smaller than area / L leave
+    most of a short match's field empty in a patchwork of single strokes (2 x 60 s: about 120 m of
+    path on 140 m^2, 27 % of 0.5 m cells visited); a long match keeps the fine 0.5 m grid."""
+    ok = ~(np.isnan(xs) | np.isnan(ys))
+    steps = np.hypot(np.diff(xs[ok]), np.diff(ys[ok]))
+    path = float(steps[steps < JUMP].sum())
+    if path <= 0:
+        return MAX_CELL
+    cell = math.ceil(area / path / CELL_STEP) * CELL_STEP
+    return min(MAX_CELL, max(MIN_CELL, cell))
 
 
 def cell_seconds(worlds, cfg, team: str, goalkeepers: bool, bins, extent, period: float):

@@ -10,7 +10,8 @@ engine's cooperative driver (runtime/coop.py):
    order its sender sent them. The node's own link emulators, seeded from the
    configuration, drop and delay exactly the frames they did in the match;
 2. the node's lockstep generator is driven to its end. It uses every recorded
-   frame; where the recording ends (a truncated file) nobody else can send,
+   frame; where the recording ends (a truncated file, or a match stopped by
+   Ctrl-C or SIGTERM, whose processes each stopped at their own tick) nobody else can send,
    and the driver gives those waits up at once, as a match gives up on a
    process that has gone;
 3. what the node publishes on its output keys is compared, frame by frame,
@@ -120,7 +121,8 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
     for ib in node.inbound:
         for payload in rec.payloads(keys.rel(ib.key)):
             bus.deliver(ib.key, payload)
-    if rec.truncated:  # its inputs stop where the file does; giving up on every sender there is expected
+    early = rec.ends_early
+    if early:  # its inputs stop where the file does; giving up on every sender there is expected
         node.log.addFilter(lambda r: r.msg != "treating %s as dead: %s")
     try:
         drive(bus, [task])
@@ -135,8 +137,8 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
         while (raw := channel.try_recv()) is not None:  # a batch (`Outbound.batch`) is its frames, as tapped
             got.extend(decode_batch(raw) if raw[:1] and raw[0] in BATCH_HEADS else (raw,))
         want = rec.payloads(rel)
-        if rec.truncated:
-            got = got[: len(want)]  # the recording ends early; compare what it has
+        if early:  # compare what both have: each process (and its recorded outputs) stopped at its own tick
+            got, want = got[: len(want)], want[: len(got)]
         counts[rel] = min(len(got), len(want))
         for i in range(max(len(got), len(want))):
             a = want[i] if i < len(want) else None
@@ -148,9 +150,9 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
                 break
     recorded_summary = rec.summaries.get(name)
     digest_match = None
-    if recorded_summary is not None and summary and not rec.truncated:
+    if recorded_summary is not None and summary and not early:
         digest_match = recorded_summary.digest == summary[0].digest
-    note = f"recording truncated ({rec.problem}): compared up to its end" if rec.truncated else ""
+    note = f"{early}: compared up to its end" if early else ""
     return ReplayResult(
         process=name,
         match=first is None,
