@@ -196,6 +196,11 @@ class Peer:
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )
                 clock.wait_on(self._alive_cond, min(left, 0.5))
+                self._alive_cond.release()  # a session call, and not under the lock its callbacks take
+                try:
+                    self.announce_spoofing()  # forged frames come in at the barrier too: said as they do
+                finally:
+                    self._alive_cond.acquire()
         if self.tap is not None:
             # Through a router (client mode), a peer's liveliness token can arrive
             # before its subscriber declaration: the first tap batch would be
@@ -372,7 +377,7 @@ class Node(Peer):
         if name in SERVED:
             latest = Latest()
             ob.put_through(latest.wrap)
-            self.transport.serve(key, latest.get)
+            self.transport.serve(key, latest.get, sign=self.keyring.signer(key))
         self.outbound.append(ob)
         return ob
 

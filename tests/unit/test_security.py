@@ -84,11 +84,16 @@ def test_fragments_hold_user_password_tls_root_and_keys(tmp_path):
     # Its own key, and the keys of the senders of what it receives (sense, field; its orders): every
     # frame it takes is authenticated, in every mode. No other robot's, no other team's.
     assert set(keys) == {"robot/b/1", "engine", "basestation/b"}
-    assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine"}
+    # the referee takes a live session's operator frames, the engine those and the viewer's control frames
+    assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine", "operator"}
     bs = set(load_fragment(str(paths["basestation/a"]))["metadata"]["arena"]["keys"])
     assert bs == {"basestation/a", "engine", "referee", "robot/a/0", "robot/a/1", "robot/a/2"}  # field: engine
     engine = set(load_fragment(str(paths["engine"]))["metadata"]["arena"]["keys"])
-    assert engine == {"engine", "referee", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
+    assert engine == {"engine", "referee", "viewer", "operator", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
+    viewer = set(load_fragment(str(paths["viewer"]))["metadata"]["arena"]["keys"])
+    assert "operator" not in viewer, "the operator's key is lent to a local viewer only (tools/launch/launcher.py)"
+    lent = s.keyring("viewer", ("operator",))
+    assert lent.signer("arena/m1/operator", sender="operator") is not None and lent.own == s.mac_keys["viewer"]
     insecure = Secrets.new("m1", 3, NAMES, secure=False).fragment("robot/b/1")
     assert set(insecure) == {"metadata"}, "without --secure: the MAC key only, the zenoh settings untouched"
     json.dumps(frag)  # plain JSON, so valid JSON5
