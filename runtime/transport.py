@@ -299,7 +299,8 @@ class ZenohTransport:
         found = None
         # Every answer is looked at, not only up to the first good one: each forged one is counted,
         # whichever came first. The query ends when every queryable has answered (or at `timeout`).
-        for reply in self.session.get(key, timeout=timeout):
+        # No consolidation: zenoh's default keeps one answer per key, and a stranger's could be it.
+        for reply in self.session.get(key, timeout=timeout, consolidation=_every_answer(verify)):
             if reply.ok is None:
                 continue
             payload = reply.ok.payload.to_bytes()
@@ -330,7 +331,7 @@ class ZenohTransport:
             elif on_forged is not None:
                 on_forged()
 
-        self.session.get(key, cb, timeout=timeout)
+        self.session.get(key, cb, timeout=timeout, consolidation=_every_answer(verify))
 
     def close(self) -> None:
         with self._wake_lock:
@@ -341,6 +342,11 @@ class ZenohTransport:
             _undeclare(entity)
         self._keep.clear()
         self._pubs.clear()
+
+
+def _every_answer(verify: Verify | None) -> zenoh.ConsolidationMode | None:
+    """A verified query takes every answer (`query`); an unverified one, zenoh's default."""
+    return None if verify is None else zenoh.ConsolidationMode.NONE
 
 
 def _undeclare(entity: object) -> None:
