@@ -5,6 +5,8 @@ from __future__ import annotations
 import hashlib
 import json
 
+import pytest
+
 from arena.runtime.acl import access_control, permissions, principals
 from arena.runtime.credentials import Secrets, load_fragment
 from arena.runtime.mac import Keyring, tag
@@ -134,3 +136,31 @@ def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_
     assert puts == {"operator"} and reads == {"engine", "referee"}
     op = permissions("operator", P, 3)
     assert op["put/ingress"] == [key] and not any("/alive/" in k for k in op.get("liveliness_token/ingress", []))
+
+
+@pytest.mark.parametrize("lent", [False, True])
+def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_key(lent):
+    """A Foxglove client published `/operator` and the viewer put it as is: a stranger's goal counted.
+    Only a viewer started for a local operator holds the operator's key (tools/launch/launcher.py
+    `local_operator`) and signs with it; any other refuses the message, counted."""
+    from arena.processes.viewer import ViewerNode
+    from arena.runtime.config import MatchConfig, ProcessId
+    from arena.runtime.mac import Keyring, new_key
+    from arena.runtime.transport import MemoryBus, MemoryTransport
+    from arena.schemas.keys import Keys
+
+    bus = MemoryBus()
+    tr = MemoryTransport(bus)
+    tr.keyring = Keyring("viewer", {"viewer": new_key(), **({"operator": new_key()} if lent else {})})
+    engine_side = MemoryTransport(bus).subscribe("arena/m/operator")
+    viewer = ViewerNode(ProcessId("viewer"), MatchConfig(live=0, pace=1.0), tr, Keys("m"))
+    try:
+        viewer.on_client_message("/operator", b'{"actions": [{"type": "referee", "command": "GOAL", "team": "b"}]}')
+    finally:
+        viewer.server.stop()
+    got = engine_side.try_recv()
+    if lent:
+        assert got is not None and viewer.rejections.total == 0
+        assert viewer.operator_sign is not None
+    else:
+        assert got is None and viewer.rejections.by_reason == {"refused": 1}
