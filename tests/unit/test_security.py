@@ -164,3 +164,16 @@ def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_
         assert viewer.operator_sign is not None
     else:
         assert got is None and viewer.rejections.by_reason == {"refused": 1}
+
+
+def test_only_a_viewer_started_here_on_loopback_without_secure_is_lent_the_operators_key():
+    from arena.runtime.config import MatchConfig, ProcessId
+    from arena.tools.launch.launcher import local_operator
+
+    live = MatchConfig(live=8765)
+    assert local_operator(live, False, "127.0.0.1", set())
+    assert local_operator(live, False, "::1", set())
+    assert not local_operator(live, True, "127.0.0.1", set()), "secure: only the operator principal may put"
+    assert not local_operator(live, False, "0.0.0.0", set()), "anybody on the network could publish"
+    assert not local_operator(live, False, "127.0.0.1", {ProcessId("viewer")}), "a viewer started elsewhere"
+    assert not local_operator(MatchConfig(), False, "127.0.0.1", set()), "no viewer"
