@@ -22,7 +22,7 @@ def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, 
     port, live, mcap = free_port(), free_port(), tmp_path / "op.mcap"
     endpoint = f"tcp/127.0.0.1:{port}"
     match = Launcher(
-        reap, tmp_path / "logs", "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "1.5",
+        reap, tmp_path / "logs", "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "8",
         "--listen", endpoint, "--match", "op", "--live", str(live), "--record", str(mcap), "--json",
     )  # fmt: skip
     # The operator's credentials file (its MAC key), as arena match says where it is.
