@@ -24,7 +24,6 @@ reason, counted, and the match goes on.
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 
@@ -208,8 +207,7 @@ class OperatorInbox:
         self.key = key = node.keys.operator()
         self.cfg = node.cfg
         self.rejections = node.rejections
-        verify = node.keyring.verifier(OPERATOR_PRINCIPAL, key)
-        on_forged = functools.partial(node.rejections.forged, key, OPERATOR_PRINCIPAL)
+        verify, on_forged = node.mac_check(key, OPERATOR_PRINCIPAL)
         self.channel = node.transport.subscribe(key, verify=verify, on_forged=on_forged)
         self.kinds = kinds
         self.seq = -1  # the last frame's

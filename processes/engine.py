@@ -35,7 +35,6 @@ logged, and the match goes on.
 
 from __future__ import annotations
 
-import functools
 import logging
 import math
 import time
@@ -143,10 +142,7 @@ class EngineNode(Node):
                 self.rejections.reject(key, *problem)
 
         # Only the viewer's frames, by their MAC (runtime/mac.py); the others are counted as forged.
-        verify, on_forged = (
-            self.keyring.verifier("viewer", key),
-            functools.partial(self.rejections.forged, key, "viewer"),
-        )
+        verify, on_forged = self.mac_check(key, "viewer")
         if isinstance(self.driver, Reactor):
             self.transport.subscribe_callback(key, on_control, verify, on_forged)
             pacer.start(self.driver.poke)
@@ -238,8 +234,7 @@ class EngineNode(Node):
         if self.pacer is not None:
             # A live match: the viewer's state now (a pause set before the start holds tick 0).
             key = self.keys.control()
-            verify = self.keyring.verifier("viewer", key)
-            on_forged = functools.partial(self.rejections.forged, key, "viewer")
+            verify, on_forged = self.mac_check(key, "viewer")
             raw = self.transport.query(key, timeout=2.0, verify=verify, on_forged=on_forged)
             if raw is not None and (problem := self.pacer.control_raw(raw)):
                 self.rejections.reject(key, problem[0], f"the viewer's control state: {problem[1]}")

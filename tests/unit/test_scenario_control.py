@@ -218,9 +218,10 @@ def _inbox(kinds):
     from arena.schemas.keys import Keys
 
     bus = MemoryBus()
+    rejections = Rejections(logging.getLogger("t"))
     node = types.SimpleNamespace(
-        keys=Keys("m"), cfg=MatchConfig(), rejections=Rejections(logging.getLogger("t")),
-        keyring=Keyring("engine"), transport=MemoryTransport(bus),
+        keys=Keys("m"), cfg=MatchConfig(), rejections=rejections, transport=MemoryTransport(bus),
+        mac_check=lambda key, sender: (Keyring("engine").verifier(sender, key), lambda: rejections.forged(key, sender)),
     )  # fmt: skip
     return OperatorInbox(node, kinds), MemoryTransport(bus).publisher("arena/m/operator"), node.rejections
 
