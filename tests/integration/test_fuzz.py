@@ -306,7 +306,7 @@ def waiting_receivers(rel: str) -> list[str]:
     return [p for p in receivers if p.startswith(("engine", "referee", "basestation/", "robot/")) and p != "robot/a/0"]
 
 
-def arrived(session, match_id: str, pubs: dict, timeout: float = 120.0) -> list[tuple[str, str]]:
+def arrived(session, match_id: str, pubs: dict, timeout: float = 300.0) -> list[tuple[str, str]]:
     """Wait until every payload put through `pubs` has been taken in by every waiting receiver.
 
     The signal: after its payloads, each key gets one frame without a MAC, on the same publisher, so
