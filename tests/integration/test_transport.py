@@ -141,3 +141,30 @@ def test_a_query_takes_only_the_answer_with_the_servers_mac_and_counts_every_oth
         assert rx.query(key, 2.0) in (b"genuine", b"forged"), "without a key: the first answer, whoever's"
         for t in (tx, liar, rx):
             t.close()
+
+
+def test_a_process_with_the_engines_key_never_takes_a_strangers_configuration(tmp_path):
+    """Only strangers answer: the process gives up, and says how many answers it ignored and why."""
+    import pytest
+
+    from arena.runtime.config import MatchConfig
+    from arena.runtime.mac import Keyring, new_key
+    from arena.runtime.node import StartupError
+    from arena.schemas.keys import Keys
+    from arena.tools.launch.run import fetch_config
+
+    keys = Keys("t")
+    endpoint = f"unixsock-stream/{tmp_path}/c.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as stranger,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as robot,
+    ):
+        liar = ZenohTransport(stranger)
+        liar.serve(keys.config(), MatchConfig(home="policy:/some/file.pkl").to_json().encode())
+        rx = ZenohTransport(robot, Keyring("robot/a/0", {"robot/a/0": new_key(), "engine": new_key()}))
+        forged = [0]
+        with pytest.raises(StartupError, match=r"ignored \d+ answer\(s\) without the engine's MAC"):
+            fetch_config(rx, keys, 2.5, forged=forged)
+        assert forged[0] >= 1
+        for t in (liar, rx):
+            t.close()

@@ -351,11 +351,20 @@ def fetch_config(
         time.sleep(0.2)
     if refused_since is not None and refused is not None and ep is not None:
         raise refused(ep)  # a router listens there and never took us: say why, not "no router"
+    ignored = (
+        f"; ignored {forged[0]} answer(s) without the engine's MAC (possible spoofing, or an engine "
+        "started without its --credentials)"
+        if forged[0]
+        else ""
+    )
     raise StartupError(
-        f"gave up after {timeout:g} s{' ' if state.startswith('waiting') else ': '}{state}"
-        if state
-        else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
-        f"{keys.match!r} running and reachable on the given endpoint?"
+        (
+            f"gave up after {timeout:g} s{' ' if state.startswith('waiting') else ': '}{state}"
+            if state
+            else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
+            f"{keys.match!r} running and reachable on the given endpoint?"
+        )
+        + ignored
     )
 
 
