@@ -33,6 +33,8 @@ from arena.runtime.config import MatchConfig
 from arena.schemas.keys import MAX_FRAME_BYTES, OPERATOR_PRINCIPAL
 from arena.schemas.messages import Condition, Operator, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot
 from arena.sim.physics import Physics
+from arena.sim.physics.bodies import FENCE_RADIUS
+from arena.sim.physics.placement import PARK_GAP
 
 _OPERATOR = msgspec.msgpack.Decoder(Operator)
 GRAVITY = 9.81  # [m/s^2] the highest a ball can be teleported to is where the fastest kick could lift it
@@ -60,11 +62,13 @@ def _speed(name: str, parts: tuple[float | None, ...], limit: float) -> str | No
 def check_action(cfg: MatchConfig, a: object) -> str | None:
     """Why a teleport or an override cannot be applied in this match (None: it can).
 
-    Every number finite; a position inside the fence (the field's lines plus `runoff`); a robot's
-    speeds within its model's `max_speed` and `max_omega`; a ball no faster than the model's
-    kick plus its top speed, and no higher than such a kick could lift it; a robot that plays."""
+    Every number finite; a position inside the fence (the field's lines plus `runoff`; a robot also
+    where a parked one stands, beyond it: a replay with substitution teleports to recorded poses);
+    a robot's speeds within its model's `max_speed` and `max_omega`; a ball no faster than the
+    model's kick plus its top speed, and no higher than such a kick could lift it; a robot that plays."""
     f, rp = cfg.field, cfg.robot
     fx, fy = f.length / 2 + f.runoff, f.width / 2 + f.runoff
+    parked_x = fx + FENCE_RADIUS + PARK_GAP
     ball = rp.kick_max_speed + rp.max_speed
     match a:
         case TeleportBall():
@@ -77,7 +81,7 @@ def check_action(cfg: MatchConfig, a: object) -> str | None:
         case TeleportRobot():
             checks = (
                 None if a.robot < cfg.robots else f"robot {a.robot}: the match has {cfg.robots} per team",
-                _out_of("x", a.x, fx),
+                _out_of("x", a.x, parked_x),
                 _out_of("y", a.y, fy),
                 _out_of("orientation", a.orientation, 1e3),
                 _speed("speed", (a.vx, a.vy), rp.max_speed),
