@@ -14,15 +14,23 @@ the digest; a plain match has no steps and plays exactly as before.
 The same messages drive a live session (`--realtime` or `--live`): `arena
 operator` puts `Operator` frames, and the engine and the referee take them at
 their next tick (`OperatorInbox`) and log what they applied, with the tick.
+A frame counts only with the operator's MAC (runtime/mac.py; the others are
+counted per key as forged) and a `seq` above the last one's (a replayed frame
+is refused). Wherever an action comes from (an operator frame, a scenario
+step), it is range-checked first (`check_action`: finite, inside the fence,
+speeds within the robot model's limits); one that is not is refused with its
+reason, counted, and the match goes on.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import msgspec
 
 from arena.runtime.config import MatchConfig
+from arena.schemas.keys import MAX_FRAME_BYTES, OPERATOR_PRINCIPAL
 from arena.schemas.messages import (
     Cmd,
     Condition,
@@ -35,8 +43,69 @@ from arena.schemas.messages import (
     TeleportRobot,
 )
 from arena.sim.physics import Physics
+from arena.sim.physics.bodies import FENCE_RADIUS
+from arena.sim.physics.placement import PARK_GAP
 
 _OPERATOR = msgspec.msgpack.Decoder(Operator)
+GRAVITY = 9.81  # [m/s^2] the highest a ball can be teleported to is where the fastest kick could lift it
+
+
+def _out_of(name: str, value: float | None, bound: float) -> str | None:
+    """Why `value` is not a finite number within +-`bound` (None: it is, or it is not given)."""
+    if value is None:
+        return None
+    if not math.isfinite(value):
+        return f"{name} is not finite"
+    if abs(value) > bound:
+        return f"{name} = {value:g} is beyond +-{bound:g}"
+    return None
+
+
+def _speed(name: str, parts: tuple[float | None, ...], limit: float) -> str | None:
+    given = [v for v in parts if v is not None]
+    if not all(math.isfinite(v) for v in given):
+        return f"{name} is not finite"
+    speed = math.hypot(*given) if given else 0.0
+    return f"{name} {speed:g} is above the model's {limit:g}" if speed > limit else None
+
+
+def check_action(cfg: MatchConfig, a: object) -> str | None:
+    """Why a teleport or an override cannot be applied in this match (None: it can).
+
+    Every number finite; a position inside the fence (the field's lines plus `runoff`; a robot also
+    where a parked one stands, beyond it: a replay with substitution teleports to recorded poses);
+    a robot's speeds within its model's `max_speed` and `max_omega`; a ball no faster than the
+    model's kick plus its top speed, and no higher than such a kick could lift it; a robot that plays."""
+    f, rp = cfg.field, cfg.robot
+    fx, fy = f.length / 2 + f.runoff, f.width / 2 + f.runoff
+    parked_x = fx + FENCE_RADIUS + PARK_GAP
+    ball = rp.kick_max_speed + rp.max_speed
+    match a:
+        case TeleportBall():
+            checks = (
+                _out_of("x", a.x, fx),
+                _out_of("y", a.y, fy),
+                _out_of("z", a.z, ball * ball / (2 * GRAVITY)),
+                _speed("ball speed", (a.vx, a.vy, a.vz), ball),
+            )
+        case TeleportRobot():
+            checks = (
+                None if a.robot < cfg.robots else f"robot {a.robot}: the match has {cfg.robots} per team",
+                _out_of("x", a.x, parked_x),
+                _out_of("y", a.y, fy),
+                _out_of("orientation", a.orientation, 1e3),
+                _speed("speed", (a.vx, a.vy), rp.max_speed),
+                _out_of("omega", a.omega, rp.max_omega),
+            )
+        case RefereeOverride():
+            checks = (
+                _out_of("x", a.x, fx),
+                _out_of("y", a.y, fy),
+                None if -1 <= a.robot < cfg.robots else f"robot {a.robot}: the match has {cfg.robots} per team",
+            )
+        case _:
+            return None
+    return next((c for c in checks if c), None)
 
 
 def referee_steps(steps: tuple[Step, ...]) -> list[tuple[int, RefereeOverride]]:
@@ -45,11 +114,14 @@ def referee_steps(steps: tuple[Step, ...]) -> list[tuple[int, RefereeOverride]]:
 
 
 class Director:
-    """Fires the engine's share of the steps: `observe` every referee frame, `act(k)` every tick."""
+    """Fires the engine's share of the steps: `observe` every referee frame, `act(k)` every tick.
 
-    def __init__(self, cfg: MatchConfig, physics: Physics):
+    `refuse(why)`: called for a step's action that fails `check_action` (it is not applied)."""
+
+    def __init__(self, cfg: MatchConfig, physics: Physics, refuse: Callable[[str], None] | None = None):
         self.cfg = cfg
         self.physics = physics
+        self.refuse = refuse
         mine = [s for s in cfg.scenario.steps if any(not isinstance(a, RefereeOverride) for a in s.actions)]
         self.at: dict[int, list[Step]] = {}  # by tick: a replay with substitution has a step every tick
         for s in mine:
@@ -77,6 +149,11 @@ class Director:
             self.fired += 1
             placed: list[tuple[str, int]] = []  # robots this step put down, in order
             for action in step.actions:
+                why = check_action(self.cfg, action)
+                if why is not None:
+                    if self.refuse is not None:
+                        self.refuse(f"step at tick {step.at}: {why}")
+                    continue
                 self.apply(action)
                 if isinstance(action, TeleportRobot) and action.present and not action.by_force:
                     self.unstack((action.team, action.robot), placed)
@@ -244,28 +321,52 @@ OVERLAP = 0.9  # two robots whose centres are closer than this many sizes were p
 
 
 class OperatorInbox:
-    """A live session's `operator` frames: taken at each tick, the wanted kinds kept and logged."""
+    """A live session's `operator` frames: taken at each tick, the wanted kinds checked, kept and logged.
+
+    Only frames with the operator's MAC get here (the others are counted as forged on the key), and
+    only one whose `seq` is above the last one's counts (a genuine frame put again is refused)."""
 
     def __init__(self, node, kinds: tuple[type, ...]):
-        self.key = node.keys.operator()
-        self.channel = node.transport.subscribe(self.key)
+        self.key = key = node.keys.operator()
+        self.cfg = node.cfg
         self.rejections = node.rejections
+        verify, on_forged = node.mac_check(key, OPERATOR_PRINCIPAL)
+        self.channel = node.transport.subscribe(key, verify=verify, on_forged=on_forged)
         self.kinds = kinds
+        self.seq = -1  # the last frame's
         self.log: list[dict[str, object]] = []  # {tick, seq, action}: what was applied, for the summary
+        self.refused: list[dict[str, object]] = []  # {tick, seq, action, why}: what was not
 
     def take(self, k: int) -> list:
         out = []
         while (raw := self.channel.try_recv()) is not None:
+            if len(raw) > MAX_FRAME_BYTES:
+                self.rejections.reject(self.key, "too-large", f"{len(raw)} bytes, at most {MAX_FRAME_BYTES}")
+                continue
             try:
                 msg = _OPERATOR.decode(raw)
             except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-                self.rejections.reject(self.key, "malformed", str(exc))
+                self.rejections.reject(self.key, "malformed", str(exc)[:120])
                 continue
+            if msg.seq <= self.seq:
+                self.rejections.reject(self.key, "out-of-sequence", f"seq {msg.seq} after {self.seq}")
+                continue
+            self.seq = msg.seq
             for a in msg.actions:
-                if isinstance(a, self.kinds):
-                    out.append(a)
-                    self.log.append({"tick": k, "seq": msg.seq, "action": msgspec.to_builtins(a)})
+                if not isinstance(a, self.kinds):
+                    continue
+                why = check_action(self.cfg, a)
+                if why is not None:  # (not the action itself: it may hold a NaN, which JSON has not)
+                    self.rejections.reject(self.key, "invalid", why)
+                    self.refused.append({"tick": k, "seq": msg.seq, "type": type(a).__name__, "why": why})
+                    continue
+                out.append(a)
+                self.log.append({"tick": k, "seq": msg.seq, "action": msgspec.to_builtins(a)})
         return out
+
+    def summary(self) -> dict[str, object]:
+        """The summary's share: `operator` (what was applied) and, if any, `operator_refused`."""
+        return {"operator": self.log} | ({"operator_refused": self.refused} if self.refused else {})
 
 
 def operator_inbox(node, kinds: tuple[type, ...]) -> OperatorInbox | None:

@@ -89,7 +89,7 @@ class EngineNode(Node):
         self.physics.stop_play()
         self.restarts = Restarts(cfg, self.physics)
         # A scenario's steps (processes/director.py); its teleports at tick 0 are its start.
-        self.director = Director(cfg, self.physics) if cfg.scenario.active else None
+        self.director = Director(cfg, self.physics, self.refuse_step) if cfg.scenario.active else None
         self.operator = operator_inbox(self, (TeleportBall, TeleportRobot))  # live sessions: `arena operator`
         if any(t == 0 and o.command == "START" for t, o in referee_steps(cfg.scenario.steps)):
             self.physics.start_play()  # the ball is in play from tick 0, before the referee's frame arrives
@@ -115,15 +115,18 @@ class EngineNode(Node):
         self.parked: dict[tuple[str, int], dict[str, float]] = {}  # dead robots taken off the field
         self.world_gate: WireGate | None = None
         self.pacer = self._live_pacer()
-        self.transport.serve(self.keys.config(), cfg.to_json().encode())
+        # Both answers carry the engine's MAC (runtime/mac.py): a process started by hand takes its
+        # configuration from the reply that checks out (tools/launch/run.py `fetch_config`).
+        config, field = self.keys.config(), self.keys.key("field")
+        self.transport.serve(config, cfg.to_json().encode(), sign=self.keyring.signer(config))
         # `field` is put once, at tick 0; a late joiner (a viewer, a spectator) gets it with a `get`.
-        self.transport.serve(self.keys.key("field"), encode(self.field_spec()))
+        self.transport.serve(field, encode(self.field_spec()), sign=self.keyring.signer(field))
 
     def _live_pacer(self) -> Pacer | None:
         """A live lockstep match (`--live`): the viewer's pace, pause and steps (runtime/pace.py)."""
         if self.cfg.live < 0 or self.cfg.realtime:
             return None
-        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log)
+        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log, self.cfg.timing.wait_timeout)
         key = self.keys.control()
         # Unpaced, the viewer draws at most 30 frames a second of wall time: only every
         # Nth world frame goes on the wire, and the held one whenever the pacer holds
@@ -136,15 +139,21 @@ class EngineNode(Node):
         def on_control(raw: bytes) -> None:
             problem = pacer.control_raw(raw)
             if problem:
-                self.rejections.reject(key, "malformed", problem)
+                self.rejections.reject(key, *problem)
 
+        # Only the viewer's frames, by their MAC (runtime/mac.py); the others are counted as forged.
+        verify, on_forged = self.mac_check(key, "viewer")
         if isinstance(self.driver, Reactor):
-            self.transport.subscribe_callback(key, on_control)
+            self.transport.subscribe_callback(key, on_control, verify, on_forged)
             pacer.start(self.driver.poke)
         else:
-            channel = self.transport.subscribe(key)
-            pacer.pull_from(channel.try_recv)
+            channel = self.transport.subscribe(key, verify=verify, on_forged=on_forged)
+            pacer.pull_from(channel.try_recv, on_control)
         return pacer
+
+    def refuse_step(self, why: str) -> None:
+        """A scenario step's teleport out of range (processes/director.py `check_action`): not applied, counted."""
+        self.rejections.reject("scenario", "invalid", why)
 
     def check_cmd(self, cmd: Cmd) -> str | None:
         return check_cmd(cmd, self.wheels)
@@ -186,7 +195,7 @@ class EngineNode(Node):
         if self.operator is not None:
             for action in self.operator.take(k):
                 if self.director is None:
-                    self.director = Director(self.cfg, self.physics)
+                    self.director = Director(self.cfg, self.physics, self.refuse_step)
                 self.director.apply(action)
 
     def publish(self, k: int) -> None:
@@ -224,9 +233,11 @@ class EngineNode(Node):
     def loop(self) -> Waits:
         if self.pacer is not None:
             # A live match: the viewer's state now (a pause set before the start holds tick 0).
-            raw = self.transport.query(self.keys.control(), timeout=2.0)
-            if raw is not None and self.pacer.control_raw(raw):
-                self.rejections.reject(self.keys.control(), "malformed", "the viewer's control state")
+            key = self.keys.control()
+            verify, on_forged = self.mac_check(key, "viewer")
+            raw = self.transport.query(key, timeout=2.0, verify=verify, on_forged=on_forged)
+            if raw is not None and (problem := self.pacer.control_raw(raw)):
+                self.rejections.reject(key, problem[0], f"the viewer's control state: {problem[1]}")
         yield from super().loop()
 
     def lockstep(self) -> Waits:
@@ -296,6 +307,7 @@ class EngineNode(Node):
                 self.director.drive(k)
             self.pending_events.extend(ph.step())
             self.timed(t0)
+            self.announce_spoofing()  # (no Reactor in real time to say it ten times a second)
             delay = start + (k + 1) * dt - time.monotonic()
             if delay > 0:
                 time.sleep(delay)
@@ -314,7 +326,7 @@ class EngineNode(Node):
                 "parked": {f"{t}/{n}": p for (t, n), p in sorted(self.parked.items())},
                 "sent_off": [{"tick": k, "robot": f"{t}/{n}", "command": c} for k, t, n, c in self.restarts.sent_off],
             }
-            | ({"operator": self.operator.log} if self.operator is not None else {})
+            | (self.operator.summary() if self.operator is not None else {})
             | self.director_extra()
         )
 

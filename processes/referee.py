@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 
-from arena.processes.director import operator_inbox, referee_steps
+from arena.processes.director import check_action, operator_inbox, referee_steps
 from arena.refbox.follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
@@ -30,7 +30,13 @@ class RefereeNode(Node):
         self.follower = Follower(self.box, self.log) if self.cfg.refbox.follow else None
         self.decide = self.follower.step if self.follower else self.box.step
         # A scenario's referee overrides (processes/director.py), each forced at the first referee tick >= its own.
-        self.forced = referee_steps(self.cfg.scenario.steps)
+        self.forced = []
+        for at, o in referee_steps(self.cfg.scenario.steps):
+            why = check_action(self.cfg, o)
+            if why is None:
+                self.forced.append((at, o))
+            else:  # not forced, counted: the match goes on
+                self.rejections.reject("scenario", "invalid", f"step at tick {at}: {why}")
         self.operator = operator_inbox(self, (RefereeOverride,))  # live sessions: `arena operator`
 
     def act(self, k: int) -> None:
@@ -62,13 +68,14 @@ class RefereeNode(Node):
                 return
             k = self.ref_schedule.first_after(e)
             self.act(min(k, last))
+            self.announce_spoofing()  # (no Reactor in real time to say it ten times a second)
             if k >= last:
                 return
 
     def summary_extra(self) -> dict[str, object]:
         out = self.box.summary()
         if self.operator is not None:
-            out["operator"] = self.operator.log
+            out.update(self.operator.summary())
         if self.follower is not None:
             out["refbox_follow"] = self.follower.summary()
         return out

@@ -21,8 +21,14 @@ server, which runs on the SDK's own threads) with:
   (runtime/pace.py, through `Control` frames on `arena/<m>/control`);
 * client messages on `/operator` (Foxglove's Publish panel, JSON
   `{"actions": [...]}`), put as `Operator` frames on `arena/<m>/operator` for
-  the engine and the referee of a live session (docs/scenarios.md; in a secure
-  match the router drops them: only the `operator` principal may put there).
+  the engine and the referee of a live session (docs/scenarios.md), signed
+  with the operator's MAC. Only a viewer `arena match` starts for a local
+  operator holds that key (no `--secure`, Foxglove served on a loopback
+  address: whoever reaches the port is on the operator's own computer);
+  any other viewer refuses these messages, counted, and says to use
+  `arena operator` with the operator's credentials (in a secure match the
+  router drops a viewer's puts there anyway: only the `operator` principal
+  may put there).
 
 It is in nobody's lockstep and has none of its own: it subscribes with rings
 that keep the newest frames (a viewer that falls behind drops, never blocks),
@@ -50,6 +56,7 @@ from foxglove.websocket import Capability, Parameter, ServerListener
 from arena.recording import scene
 from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Observer
+from arena.schemas.keys import OPERATOR_PRINCIPAL
 from arena.schemas.messages import (
     Control,
     EngineEvents,
@@ -170,23 +177,37 @@ class ViewerNode(Observer):
         super().__init__(*args, **kwargs)
         cfg, keys, tr = self.cfg, self.keys, self.transport
         self.world_in = tr.subscribe(keys.key("world"), latest=1, **self._owned("world", "engine"))
-        self.field_in = tr.subscribe(keys.key("field"), latest=1)  # drawn from the configuration; checked against it
+        # drawn from the configuration; checked against it
+        self.field_in = tr.subscribe(keys.key("field"), latest=1, **self._owned("field", "engine"))
         self.referee_in = tr.subscribe(keys.key("referee"), latest=RING, **self._owned("referee", "referee"))
         self.events_in = tr.subscribe(keys.key("events"), latest=RING, **self._owned("events", "engine"))
         # What the teams believe is asked for (their senders serve the last frame, runtime/node.py),
         # one key at a time: the access control of a secure match allows no wildcard.
         self.report_keys = {keys.key("report", t, n): t for t in TEAMS for n in range(cfg.robots)}
         self.order_keys = {keys.key("order", t, 0): t for t in TEAMS}
+        senders = {keys.key("report", t, n): f"robot/{t}/{n}" for t in TEAMS for n in range(cfg.robots)}
+        senders |= {key: f"basestation/{t}" for key, t in self.order_keys.items()}
+        self._ask_owned = {  # only their senders' answers (their MAC)
+            key: {
+                "verify": self.keyring.verifier(sender, key),
+                "on_forged": functools.partial(self.rejections.reject, key, "forged", sender),
+            }
+            for key, sender in senders.items()
+        }
         self._answers: collections.deque[tuple[str, bytes]] = collections.deque(maxlen=RING)  # transport threads
-        self.control_put = tr.publisher(keys.control())
-        # A live session's operator frames from the Foxglove Publish panel (docs/scenarios.md). In a
-        # secure match the router drops them: only the `operator` principal may put them.
-        self.operator_put = tr.publisher(keys.operator())
+        self.control_put = tr.publisher(keys.control(), sign=self.keyring.signer(keys.control()))
+        # A live session's operator frames from the Foxglove Publish panel (docs/scenarios.md), signed
+        # as the operator: only a viewer started for a local operator holds its key (module doc).
+        self.operator_sign = self.keyring.signer(keys.operator(), sender=OPERATOR_PRINCIPAL)
+        keyless = self.keyring.own is None  # started by hand without credentials: nobody verifies anything
+        self.operator_put = (
+            tr.publisher(keys.operator(), sign=self.operator_sign) if self.operator_sign or keyless else None
+        )
         self.client_topics: dict[tuple[int, int], str] = {}
         self.operator_seq = 0
         # The engine asks for the viewer's state once before tick 0 (a pause set before
         # the start holds tick 0); every change after that is put on the same key.
-        tr.serve(keys.control(), self._control_state)
+        tr.serve(keys.control(), self._control_state, sign=self.keyring.signer(keys.control()))
         self._dec_world = msgspec.msgpack.Decoder(World).decode
         self._dec_field = msgspec.msgpack.Decoder(FieldSpec).decode
         self._dec_ref = msgspec.msgpack.Decoder(Referee).decode
@@ -274,7 +295,16 @@ class ViewerNode(Observer):
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
             self.rejections.reject(self.keys.operator(), "malformed", f"from Foxglove: {exc}")
             return
-        self.operator_seq += 1
+        if self.operator_put is None:
+            self.rejections.reject(
+                self.keys.operator(),
+                "refused",
+                "from Foxglove: this viewer holds no operator key (started by arena match for a local "
+                "operator only); use arena operator --credentials operator.json5",
+            )
+            return
+        # As `arena operator` counts: microseconds, so either's next frame comes after the other's last.
+        self.operator_seq = max(self.operator_seq + 1, time.time_ns() // 1000)
         self.operator_put(msgspec.msgpack.encode(Operator(seq=self.operator_seq, actions=req.actions)))
 
     def _control_state(self) -> bytes:
@@ -325,7 +355,7 @@ class ViewerNode(Observer):
     def ask_beliefs(self) -> None:
         """Ask every robot for its last report and every base station for its order to robot 0."""
         for key in (*self.report_keys, *self.order_keys):
-            self.transport.ask(key, functools.partial(self._answer, key), ASK_S)
+            self.transport.ask(key, functools.partial(self._answer, key), ASK_S, **self._ask_owned[key])
 
     def _answer(self, key: str, raw: bytes) -> None:
         """On the transport's thread: a deque's append is thread-safe, the loop takes them in turn."""

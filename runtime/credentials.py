@@ -57,9 +57,16 @@ __all__ = [
 ]
 from arena.runtime.mac import Keyring, new_key
 
-# Besides the senders of every key it receives (the key table, `routes`): the viewer asks the teams
-# for their last reports and orders, which it does not subscribe to.
-ALSO_VERIFIES = {"viewer": ["engine", "referee"]}
+# Besides the senders of every key it receives (the key table, `routes`): the keys outside the table.
+# The engine takes a live session's `control` from the viewer and `operator` frames from the
+# operator, the referee the `operator` frames; a process started by hand asks the engine for the
+# `config` (every principal already verifies the engine: its `field` goes to all).
+ALSO_VERIFIES = {
+    "viewer": ["engine", "referee"],
+    "engine": ["viewer", "operator"],
+    "referee": ["operator"],
+    "refbox": ["engine"],
+}
 
 
 def new_zid() -> str:
@@ -99,16 +106,17 @@ class Secrets:
             s.viewer_zid = new_zid()
         return s
 
-    def keyring(self, principal: str) -> Keyring:
+    def keyring(self, principal: str, lent: tuple[str, ...] = ()) -> Keyring:
+        """The keys `principal` holds: its own, its senders'; `lent`: other principals' it may sign as."""
         if principal in ("recorder", "launcher", COLLECTOR_PRINCIPAL):
             verifies = list(self.mac_keys)
         else:  # every frame it receives carries its sender's MAC (runtime/mac.py)
             senders = [s for _, s, receivers in routes(self.robots) if principal in receivers]
-            verifies = [principal, *senders, *ALSO_VERIFIES.get(principal, [])]
+            verifies = [principal, *senders, *ALSO_VERIFIES.get(principal, []), *lent]
         return Keyring(principal, {p: self.mac_keys[p] for p in verifies if p in self.mac_keys})
 
-    def fragment(self, principal: str) -> dict:
-        ring = self.keyring(principal)
+    def fragment(self, principal: str, lent: tuple[str, ...] = ()) -> dict:
+        ring = self.keyring(principal, lent)
         frag: dict = {}
         if self.secure:
             frag["mode"] = "client"
@@ -123,18 +131,26 @@ class Secrets:
         frag["metadata"] = {"arena": {"credentials": self.set_id, "process": principal, "keys": keys}}
         return frag
 
-    def write(self, directory: Path, more: dict[str, dict] | None = None, launched=()) -> dict[str, Path]:
+    def write(
+        self,
+        directory: Path,
+        more: dict[str, dict] | None = None,
+        launched=(),
+        lend: dict[str, tuple[str, ...]] | None = None,
+    ) -> dict[str, Path]:
         """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
 
         `more`: zenoh settings added to some principals' fragments (top-level keys),
         e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`).
         `launched`: the principals `arena match` starts itself, whose identity it holds for them
-        (`metadata.arena.launched`; the match gives them their identity by OS pid, tools/launch/claims.py)."""
+        (`metadata.arena.launched`; the match gives them their identity by OS pid, tools/launch/claims.py).
+        `lend`: principal -> the other principals whose keys its fragment holds too (the live viewer
+        of a local operator gets the operator's, tools/launch/launcher.py)."""
         private_directory(directory, create=True)
         out = {}
         for p in principals(self.processes):
             path = directory / f"{user_of(p)}.json5"
-            frag = self.fragment(p) | (more or {}).get(p, {})
+            frag = self.fragment(p, (lend or {}).get(p, ())) | (more or {}).get(p, {})
             if p in launched:
                 frag["metadata"]["arena"]["launched"] = True
             write_private(path, json.dumps(frag, indent=2) + "\n")

@@ -14,7 +14,12 @@ from the launcher (in its credentials fragment, schemas/README.md "Security"),
 and the keys of the senders of every key it receives (the key table's
 `routes`): every data key (`sense`, `cmd`, `report`, `order`, `referee`,
 `engine/events`, `world`, `field`, `worldstate`), every `tap/<p>` and
-`summary/<p>`. The collector (`arena match`) and the recorder hold every key.
+`summary/<p>`, and the keys outside the table: a live session's `operator`
+(the operator's, which the engine and the referee verify) and `control` (the
+viewer's, which the engine verifies), and the answers to queries (`config` and
+`field` from the engine, the served `report`s and `order`s, the viewer's
+`control` state), whose MAC rides in the reply's attachment. The collector
+(`arena match`) and the recorder hold every key.
 
 A receiver checks the MAC before the frame reaches its lockstep: one with a
 missing or wrong MAC is dropped and counted, per key, as `forged`, so it can
@@ -97,9 +102,12 @@ class Keyring:
     def own(self) -> bytes | None:
         return self.keys.get(self.process)
 
-    def signer(self, key_expr: str) -> Callable[[bytes], bytes] | None:
-        """attachment(payload) for a key this process sends, or None without a key."""
-        k = self.own
+    def signer(self, key_expr: str, sender: str | None = None) -> Callable[[bytes], bytes] | None:
+        """attachment(payload) for a key this process sends, or None without a key.
+
+        `sender`: sign as that principal, whose key this keyring holds (the live viewer forwards
+        a local operator's Foxglove messages with the operator's key, processes/viewer.py)."""
+        k = self.keys.get(self.process if sender is None else sender)
         if k is None:
             return None
         return _tagger(k, key_expr)

@@ -40,7 +40,7 @@ from arena.runtime.lockstep import Inbound, Latest, Outbound, Rejections, Schedu
 from arena.runtime.mac import Keyring
 from arena.runtime.stats import percentile
 from arena.runtime.tap import Handoff, Tap, TappedOutbound
-from arena.runtime.transport import Transport
+from arena.runtime.transport import Transport, Verify
 from arena.schemas import messages as msgs
 from arena.schemas.keys import KEY_BY_NAME, SERVED, Keys
 
@@ -132,6 +132,12 @@ class Peer:
             if declare is not None:
                 self._spoofing_tokens.append(declare(self.keys.spoofing(self.name, self.keys.rel(key))))
 
+    def mac_check(self, key: str, sender: str) -> tuple[Verify | None, Callable[[], None]]:
+        """(verify, on_forged) for what `sender` puts on `key` (or answers there): only its frames,
+        by their MAC (runtime/mac.py; None: no key for it, accept all); each other one counted per key
+        as forged and, the first, announced (`Rejections.forged`)."""
+        return self.keyring.verifier(sender, key), functools.partial(self.rejections.forged, key, sender)
+
     def rng(self, *path: object):
         """This process's own RNG for `path` (one per component)."""
         return seeds.rng(self.cfg.seed, self.name, *path)
@@ -196,6 +202,11 @@ class Peer:
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )
                 clock.wait_on(self._alive_cond, min(left, 0.5))
+                self._alive_cond.release()  # a session call, and not under the lock its callbacks take
+                try:
+                    self.announce_spoofing()  # forged frames come in at the barrier too: said as they do
+                finally:
+                    self._alive_cond.acquire()
         if self.tap is not None:
             # Through a router (client mode), a peer's liveliness token can arrive
             # before its subscriber declaration: the first tap batch would be
@@ -372,7 +383,7 @@ class Node(Peer):
         if name in SERVED:
             latest = Latest()
             ob.put_through(latest.wrap)
-            self.transport.serve(key, latest.get)
+            self.transport.serve(key, latest.get, sign=self.keyring.signer(key))
         self.outbound.append(ob)
         return ob
 
@@ -400,8 +411,7 @@ class Node(Peer):
         model = IDEAL if ideal else self.links.get(spec.link_class, IDEAL)
         changes = () if ideal or not self.cfg.scenario.steps else scheduled(self.cfg, spec.link_class)
         emulator = LinkEmulator(model, seeds.rng(self.cfg.seed, "link", self.keys.rel(key), self.name), changes)
-        verify = self.keyring.verifier(sender, key)
-        on_forged = functools.partial(self.rejections.forged, key, sender)
+        verify, on_forged = self.mac_check(key, sender)
         ib: Inbound[Any] = Inbound(
             key=key,
             msg_type=spec.message,

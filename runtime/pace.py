@@ -11,8 +11,13 @@ The pacer only ever delays a tick; what the engine computes and sends at tick
 k is the same whenever it runs, so pacing and pausing never change a digest.
 The wall clock is read for waiting only, never for behaviour.
 
-The viewer sends `Control` frames on `arena/<m>/control`; the engine hands
-them to `control`. In reactive lockstep (runtime/drivers.py, `Reactor`) the
+The viewer sends `Control` frames on `arena/<m>/control`, with its MAC: the
+engine takes only the viewer's (processes/engine.py), and hands them to
+`control`. A frame's `seq` must be above the last one's and at most
+`SEQ_WINDOW` past it (the viewer counts up by one per change), so not even a
+frame that got through could hold the sequence out of the viewer's reach; and
+no pause outlasts `wait_timeout`: the pacer then gives up and plays on
+(`give_up`), so a paused match still ends within its wall-clock bounds. In reactive lockstep (runtime/drivers.py, `Reactor`) the
 loop runs in zenoh's callbacks, so nothing may sleep there: a small thread of
 the pacer calls `poke` (the Reactor's) when a tick's time has come, and a
 control frame pokes it too. In pull mode `sync` blocks on the main thread.
@@ -27,15 +32,18 @@ the tick the engine holds. Every frame is still encoded and digested
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections.abc import Callable
 
+from arena.runtime.lockstep import EVERY_TICK
 from arena.schemas.messages import Control
 
 BEHIND_S = 0.25  # [s] wall: further behind its schedule than this, the pacer restarts it from now (no sprint)
 POLL_S = 0.05  # [s] wall: pull mode, how often a paused engine looks for control frames
 LIVE_WORLD_HZ = 10.0  # [Hz] match time: world frames an unpaced live match puts on the wire
+SEQ_WINDOW = 1000  # [-] a control frame's seq may be at most this far past the last one's
 
 
 def _nowhere(payload: bytes) -> None:
@@ -85,10 +93,12 @@ class Pacer:
     sender = "viewer"
     key = "control"
     paired = False  # a held tick is a wait like any other: the engine puts its held `sense` batches first
+    schedule = EVERY_TICK  # the Reactor's bound on a wait names the tick waited for (runtime/drivers.py `_look`)
 
-    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None):
+    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None, timeout: float = math.inf):
         self.dt = dt
         self.pace = pace
+        self.timeout = timeout  # [s] wall: the longest pause in pull mode (`sync`); the Reactor bounds its own waits
         self.log = log or logging.getLogger("arena.pace")
         self.paused = False
         self.until = -1  # paused: ticks up to this one may still play (steps)
@@ -103,6 +113,7 @@ class Pacer:
         self._stop = False
         self._thread: threading.Thread | None = None
         self._pending: Callable[[], bytes | None] | None = None
+        self._take: Callable[[bytes], None] | None = None
         self.controls = 0  # control frames applied
         self.on_hold: Callable[[], None] | None = None  # called (on the loop's thread) whenever a tick is held
 
@@ -135,14 +146,22 @@ class Pacer:
             self.played = k
             return True
 
+    @property
+    def last_seen(self) -> int:
+        return self.played
+
     def sync(self, k: int) -> None:
-        """Pull mode: block until tick k may play."""
+        """Pull mode: block until tick k may play, at most `timeout` seconds (then `give_up`)."""
+        since = time.monotonic()
         while True:
             if self._pending is not None:
                 while (raw := self._pending()) is not None:
-                    self.control_raw(raw)
+                    (self._take or self.control_raw)(raw)
             if self.ready(k):
                 return
+            if time.monotonic() - since >= self.timeout:
+                self.give_up(f"held for {self.timeout:g} s before tick {k}")
+                continue
             with self._cond:
                 left = POLL_S if self._due is None else min(POLL_S, self._due - time.monotonic())
                 if left > 0:
@@ -162,10 +181,13 @@ class Pacer:
             self._anchor = None
 
     # --------------------------------------------------------------- control
-    def control(self, c: Control) -> None:
+    def control(self, c: Control) -> tuple[str, str] | None:
+        """Apply one frame; returns (reason, detail) if it is refused (a repeat or an old one is ignored)."""
         with self._cond:
             if c.seq <= self._seq:
-                return  # a repeat or an old frame
+                return None  # a repeat (the state the engine asked for, then put) or an old frame
+            if c.seq > max(self._seq, 0) + SEQ_WINDOW:
+                return "out-of-sequence", f"seq {c.seq} jumps more than {SEQ_WINDOW} past {self._seq}"
             self._seq = c.seq
             if c.pace >= 0.0:
                 self.pace = c.pace
@@ -179,22 +201,24 @@ class Pacer:
             self._cond.notify_all()
         if self._poke is not None:
             self._poke()
+        return None
 
-    def control_raw(self, raw: bytes, decode=None) -> str | None:
-        """Apply one wire frame; returns why it was rejected, or None."""
+    def control_raw(self, raw: bytes, decode=None) -> tuple[str, str] | None:
+        """Apply one wire frame; returns (reason, detail) if it was rejected, or None."""
         import msgspec
 
         try:
             c = (decode or msgspec.msgpack.Decoder(Control).decode)(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-            return str(exc)[:120]
-        self.control(c)
-        return None
+            return "malformed", str(exc)[:120]
+        return self.control(c)
 
     # ---------------------------------------------------------------- modes
-    def pull_from(self, recv: Callable[[], bytes | None]) -> None:
-        """Pull mode: `sync` drains `recv` (a channel's try_recv) for control frames."""
+    def pull_from(self, recv: Callable[[], bytes | None], take: Callable[[bytes], None] | None = None) -> None:
+        """Pull mode: `sync` drains `recv` (a channel's try_recv) for control frames, each to `take`
+        (which applies it and counts a rejection; default: `control_raw`)."""
         self._pending = recv
+        self._take = take
 
     def start(self, poke: Callable[[], None]) -> None:
         """Reactive mode: a thread pokes the loop when a paced tick is due."""

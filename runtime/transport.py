@@ -87,12 +87,26 @@ class Transport(Protocol):
 
     def declare_alive(self, key: str) -> None: ...
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None: ...
-    def serve(self, key: str, payload: bytes | Callable[[], bytes | None]) -> None:
-        """Answer queries on `key` with `payload`, or with what `payload()` returns at the time (None: no answer)."""
+    def serve(self, key: str, payload: bytes | Callable[[], bytes | None], sign: Sign | None = None) -> None:
+        """Answer queries on `key` with `payload`, or with what `payload()` returns at the time (None: no answer).
+        With `sign`, every answer carries `sign(answer)` as its attachment (a MAC)."""
 
-    def query(self, key: str, timeout: float) -> bytes | None: ...
-    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
-        """Query `key` without waiting: `on_reply(payload)` runs on the transport's thread for each answer."""
+    def query(
+        self, key: str, timeout: float, verify: Verify | None = None, on_forged: Callable[[], None] | None = None
+    ) -> bytes | None:
+        """The first answer to a query on `key` (None: none within `timeout`). With `verify`, every
+        answer is looked at and the ones that fail it are dropped, `on_forged()` called for each."""
+
+    def ask(
+        self,
+        key: str,
+        on_reply: Callable[[bytes], None],
+        timeout: float,
+        verify: Verify | None = None,
+        on_forged: Callable[[], None] | None = None,
+    ) -> None:
+        """Query `key` without waiting: `on_reply(payload)` runs on the transport's thread for each answer
+        (with `verify`, each that passes it)."""
 
     def close(self) -> None: ...
 
@@ -270,28 +284,54 @@ class ZenohTransport:
 
         self._keep.append(self.session.liveliness().declare_subscriber(key_expr, cb, history=True))
 
-    def serve(self, key: str, payload: bytes | Callable[[], bytes | None]) -> None:
+    def serve(self, key: str, payload: bytes | Callable[[], bytes | None], sign: Sign | None = None) -> None:
         def cb(query: zenoh.Query) -> None:
             keep_thread_state()
             answer = payload if isinstance(payload, bytes) else payload()
             if answer is not None:
-                query.reply(key, answer)
+                query.reply(key, answer, attachment=None if sign is None else sign(answer))
 
         self._keep.append(self.session.declare_queryable(key, cb))
 
-    def query(self, key: str, timeout: float) -> bytes | None:
-        for reply in self.session.get(key, timeout=timeout):
-            if reply.ok is not None:
-                return reply.ok.payload.to_bytes()
-        return None
+    def query(
+        self, key: str, timeout: float, verify: Verify | None = None, on_forged: Callable[[], None] | None = None
+    ) -> bytes | None:
+        found = None
+        # Every answer is looked at, not only up to the first good one: each forged one is counted,
+        # whichever came first. The query ends when every queryable has answered (or at `timeout`).
+        # No consolidation: zenoh's default keeps one answer per key, and a stranger's could be it.
+        for reply in self.session.get(key, timeout=timeout, consolidation=_every_answer(verify)):
+            if reply.ok is None:
+                continue
+            payload = reply.ok.payload.to_bytes()
+            if verify is None:
+                return payload
+            if not verify(payload, _attachment(reply.ok)):
+                if on_forged is not None:
+                    on_forged()
+            elif found is None:
+                found = payload
+        return found
 
-    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
+    def ask(
+        self,
+        key: str,
+        on_reply: Callable[[bytes], None],
+        timeout: float,
+        verify: Verify | None = None,
+        on_forged: Callable[[], None] | None = None,
+    ) -> None:
         def cb(reply: zenoh.Reply) -> None:
             keep_thread_state()
-            if reply.ok is not None:
-                on_reply(reply.ok.payload.to_bytes())
+            if reply.ok is None:
+                return
+            payload = reply.ok.payload.to_bytes()
+            if verify is None or verify(payload, _attachment(reply.ok)):
+                on_reply(payload)
+            elif on_forged is not None:
+                on_forged()
 
-        self.session.get(key, cb, timeout=timeout)
+        self.session.get(key, cb, timeout=timeout, consolidation=_every_answer(verify))
 
     def close(self) -> None:
         with self._wake_lock:
@@ -302,6 +342,11 @@ class ZenohTransport:
             _undeclare(entity)
         self._keep.clear()
         self._pubs.clear()
+
+
+def _every_answer(verify: Verify | None) -> zenoh.ConsolidationMode | None:
+    """A verified query takes every answer (`query`); an unverified one, zenoh's default."""
+    return None if verify is None else zenoh.ConsolidationMode.NONE
 
 
 def _undeclare(entity: object) -> None:
@@ -423,14 +468,14 @@ class MemoryTransport:
     def watch_alive(self, key_expr: str, on_change: Callable[[str, bool], None]) -> None:
         self.bus.watch(key_expr, on_change)
 
-    def serve(self, key: str, payload: bytes | Callable[[], bytes]) -> None:
-        self.bus._served[key] = payload
+    def serve(self, key: str, payload: bytes | Callable[[], bytes], sign: Sign | None = None) -> None:
+        self.bus._served[key] = payload  # no attachments on the memory bus (see `publisher`)
 
-    def query(self, key: str, timeout: float) -> bytes | None:
+    def query(self, key: str, timeout: float, verify=None, on_forged=None) -> bytes | None:
         payload = self.bus._served.get(key)
         return payload if payload is None or isinstance(payload, bytes) else payload()
 
-    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float) -> None:
+    def ask(self, key: str, on_reply: Callable[[bytes], None], timeout: float, verify=None, on_forged=None) -> None:
         payload = self.query(key, timeout)
         if payload is not None:
             on_reply(payload)

@@ -89,14 +89,14 @@ Infrastructure keys (not data pairs):
 |---|---|
 | `arena/<match>/{ALIVE}/<process>` | zenoh liveliness token of each process (`engine`, `referee`, `basestation/a`, `robot/a/1`, `recorder`, `viewer`); the match starts when all are present |
 | `arena/<match>/{WAITING}/<process>/<tick>` | liveliness token of a process blocked for over a second (or a quarter of `timing.wait_timeout`) before acting at `<tick>`; taken back when the wait ends. A receiver whose sender announces a wait at a tick not past the frame it misses keeps waiting, so only the receiver of the missing frame gives up (optional for a client of your own: without it, you are only ever blamed for a frame you really owe) |
-| `arena/<match>/{CONFIG}` | queryable served by the engine: the match configuration as JSON (UTF-8) |
+| `arena/<match>/{CONFIG}` | queryable served by the engine: the match configuration as JSON (UTF-8), the answer with the engine's MAC (see "Security") |
 | `arena/<match>/{SUMMARY}/<process>` | `Summary`, once per process at the end of the match |
 | `arena/<match>/{COLLECTOR}` | liveliness token of a summary collector (`arena match`, `arena up`); while present, a process repeats its summary until acknowledged |
 | `arena/<match>/{ACK}/<process>` | the collector's acknowledgement of a summary (payload `ack`) |
 | `arena/<match>/{TAP}/<process>` | `TapBatch`, only in a recorded match: every frame the process sent, batched every {TAP_PERIOD} ticks, for the recorder (docs/recording.md) |
 | `arena/<match>/{SPOOFING}/<user>/<key>` | liveliness token (`<user>`: the process with `/` as `-`, `robot-a-1`) a process declares the first time it drops a frame on `<key>` whose MAC does not check out, or counts one that conflicts with the frame it took for that tick; `arena match` prints `possible spoofing on <key>` once (see "Security") |
-| `arena/<match>/{CONTROL}` | `Control`, only in a live lockstep match (`arena match --live`): the viewer pauses, steps and paces the engine; waits only, never a different digest (docs/recording.md) |
-| `arena/<match>/{OPERATOR}` | `Operator`, only in a live session (`--realtime` or `--live`): teleports and referee overrides from `arena operator`, applied at the engine's and the referee's next tick; in a secure match only the `operator` principal may put it (docs/scenarios.md) |
+| `arena/<match>/{CONTROL}` | `Control`, only in a live lockstep match (`arena match --live`): the viewer pauses, steps and paces the engine; waits only, never a different digest (docs/recording.md). With the viewer's MAC; the engine takes a `seq` above the last one's and at most 1,000 past it, and plays on after a pause of `wait_timeout` |
+| `arena/<match>/{OPERATOR}` | `Operator`, only in a live session (`--realtime` or `--live`): teleports and referee overrides from `arena operator`, applied at the engine's and the referee's next tick; with the operator's MAC (`operator.json5`) and a `seq` above the last one's; each action finite, inside the fence and within the robot model's speeds, else refused and counted; in a secure match only the `operator` principal may put it (docs/scenarios.md) |
 
 """
 
@@ -224,7 +224,8 @@ gets it with a `get` on `arena/<match>/field`), watch liveliness on
 liveliness token `arena/<match>/{ALIVE}/<process>` (e.g. `alive/robot/a/1`).
 The engine starts tick 0 once every process's token is present. The match
 configuration is the JSON answer of a `get` on `arena/<match>/{CONFIG}` (see
-"Configuration" below).
+"Configuration" below) that carries the engine's MAC: look at every answer
+(consolidation off), and drop one without it.
 
 **Claiming the identity** (one process per identity). Declare a liveliness
 token `arena/<match>/{CLAIM}/<process>/<nonce>` (a nonce of your choice, e.g. 16
@@ -445,8 +446,11 @@ router. `viewer` is read-only: it may put nothing but the live `control`.
 liveliness token.
 
 **Message authentication** (every match, with or without `--secure`). Every
-frame on every data key of the table above, and every `{SUMMARY}/<process>` and
-`{TAP}/<process>`, carries as the sample's zenoh **attachment** a {MAC_BYTES}-byte MAC
+frame on every data key of the table above, every `{SUMMARY}/<process>` and
+`{TAP}/<process>`, every `{OPERATOR}` frame (the operator's key) and `{CONTROL}` frame
+(the viewer's), and every answer to a query (`{CONFIG}` and `field` from the engine,
+a served `report` or `order`, the viewer's `{CONTROL}` state: in the reply's
+attachment) carries as the sample's zenoh **attachment** a {MAC_BYTES}-byte MAC
 made with its sender's own key:
 
     BLAKE2b(key = own key from metadata.arena.keys, digest_size = {MAC_BYTES},
@@ -480,8 +484,9 @@ key as `forged` (the match JSON's `forged`), and declares the liveliness token
 prints once as "possible spoofing on KEY". A frame with a valid MAC that
 differs from the one already taken for its tick, whatever the tick, is a
 `conflict` (per key, `conflicts`) and is reported the same way. A process
-started without `--credentials` sends no MAC and checks none; the processes
-of a match that wrote it a credentials file drop what it sends as forged.
+started without `--credentials` sends no MAC and checks none (it takes the
+first `{CONFIG}` answer, whoever's); the processes of a match that wrote it a
+credentials file drop what it sends as forged.
 
 The collector also accepts one Summary per process,
 only on that process's own key, and only if it is plausible (tick within the

@@ -8,8 +8,8 @@ came after a forged one was counted as `out-of-sequence`, so hardly anything was
 
 Here the stranger puts a whole match's worth of well-formed `referee`, `cmd`, `order` and
 `report` frames, every one for a tick its receiver will expect, while every process but robot
-a/0 waits at the start barrier (so the forged frames are there first); then a/0 starts and the
-match plays. It must play exactly as the unforged one (the golden digests, so the same score),
+a/0 waits at the start barrier; then, once every forged frame has arrived (`SENTINELS`), a/0
+starts and the match plays. It must play exactly as the unforged one (the golden digests, so the same score),
 and every forged frame is counted by every process subscribed to its key, per key, with one
 "possible spoofing on KEY" line per key during the match.
 """
@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import time
 
 import zenoh
 
@@ -34,8 +33,34 @@ ROBOTS = range(CFG["robots"])
 POSE = m.Pose(x=0.5, y=-0.5, theta=0.1)
 
 
+# The signal that every forged frame is in (no fixed wait): the last frames put are one on a key of
+# each receiver that nothing forged reached before. Zenoh keeps one session's puts in order per link,
+# so when a receiver counts that one as forged, and says so with its spoofing token (`spoofing/<process>
+# /<key>`, at the start barrier too), every frame put before it has reached that receiver.
+SENTINELS = {
+    "robot/b/1/cmd": "engine",
+    "team/a/report/1": "basestation/a",
+    "team/b/report/1": "basestation/b",
+    **{f"robot/{t}/{n}/sense": f"robot/{t}/{n}" for t in TEAMS for n in ROBOTS if (t, n) != ("a", 0)},
+}
+
+
+def sentinel_frames() -> dict[str, tuple[int, list[bytes]]]:
+    """key -> (1 receiver, one forged frame for its first tick)."""
+    out: dict[str, tuple[int, list[bytes]]] = {}
+    for key in SENTINELS:
+        if key.endswith("/cmd"):
+            out[key] = (1, [m.encode(m.Cmd(tick=0, vx=-5.0))])
+        elif "/report/" in key:
+            out[key] = (1, [m.encode(m.Report(tick=0, robot=int(key[-1]), pose=POSE))])
+        else:
+            out[key] = (1, [m.encode(m.Sense(tick=0, pose=POSE))])
+    return out
+
+
 def forged_frames() -> dict[str, tuple[int, list[bytes]]]:
-    """key -> (how many waiting processes receive it, the forged frames, every tick of its schedule)."""
+    """key -> (how many waiting processes receive it, the forged frames, every tick of its schedule);
+    the keys of `SENTINELS` come last, with one frame each."""
     penalty = [m.RefCommand(name="PENALTY", team="b")]
     out: dict[str, tuple[int, list[bytes]]] = {
         "referee": (
@@ -62,7 +87,7 @@ def forged_frames() -> dict[str, tuple[int, list[bytes]]]:
                     1,
                     [m.encode(m.Order(tick=k, robot=n, command="STOP")) for k in range(1, TOTAL + 1, 5)],
                 )
-    return out
+    return {k: v for k, v in out.items() if k not in SENTINELS} | sentinel_frames()
 
 
 def test_a_stranger_forging_frames_ahead_changes_nothing_and_every_frame_is_counted(tmp_path, reap):
@@ -83,7 +108,11 @@ def test_a_stranger_forging_frames_ahead_changes_nothing_and_every_frame_is_coun
         wait_for(lambda: len(alive) >= others, 120, "every other process at its start barrier")
         sub.undeclare()
         wait_for(lambda: len(list(session.info.peers_zid())) >= others, 30, "a direct link to every other process")
-        for key, (_, payloads) in frames.items():
+        tokens: set[str] = set()
+        spoofing = session.liveliness().declare_subscriber(
+            f"arena/{match_id}/spoofing/**", lambda s: tokens.add(str(s.key_expr).split("/spoofing/")[1]), history=True
+        )
+        for key, (_, payloads) in frames.items():  # the sentinels last
             pub = session.declare_publisher(
                 f"arena/{match_id}/{key}",
                 congestion_control=zenoh.CongestionControl.BLOCK,
@@ -92,7 +121,10 @@ def test_a_stranger_forging_frames_ahead_changes_nothing_and_every_frame_is_coun
             for payload in payloads:
                 pub.put(payload)  # no attachment: the stranger has no key
             pub.undeclare()
-        time.sleep(2.0)  # every forged frame is in its receivers' queues before the genuine ones come
+        # Every forged frame is in its receivers' queues before the genuine ones come.
+        want_tokens = {f"{p.replace('/', '-')}/{key}" for key, p in SENTINELS.items()}
+        wait_for(lambda: want_tokens <= tokens, 120, "every receiver's spoofing token for its sentinel")
+        spoofing.undeclare()
         with open(launcher.logs / "external_robot_a_0.log", "wb") as log:
             reap.append(subprocess.Popen([*ARENA, *command[1:]], stdout=log, stderr=subprocess.STDOUT))
         out = launcher.finish(120)

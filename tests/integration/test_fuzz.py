@@ -33,6 +33,7 @@ import signal
 import subprocess
 import threading
 import time
+from collections import Counter
 from pathlib import Path
 
 import msgspec
@@ -274,11 +275,10 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
                 if len(payload) > MAX_FRAME_BYTES:
                     sent["too-large"] += receivers
         # Counted whenever they arrive, even after the start: no payload is at a tick anybody expects.
-        # But a process counts only what it reads before it ends, and a put returns once queued: up
-        # to thousands of small payloads can still sit in the links' buffers, more than a receiver
-        # reads in a 2 x 4 s match at rtf 30 (0.3 s; with the 60 ms perception latency 10 of the
-        # 10,055 went uncounted in one run of 2, 2 of 1,048 in one of 9). Let them drain first.
-        time.sleep(3.0)
+        # But a process counts only what it reads before it ends, and a put returns once queued:
+        # payloads can still sit in the links' buffers (a fixed 3 s drain counted 1,010 of 1,011 at
+        # a load of 10). So the start waits for a signal that every one has arrived (`sentinels`).
+        sentinels = arrived(session, match_id, pubs)
         # Its stderr into a file: a pipe nobody reads would stall a robot that says what it waits for.
         with open(launcher.logs / "external_robot_a_0.log", "wb") as log:
             reap.append(subprocess.Popen([*ARENA, *command[1:]], stdout=log, stderr=subprocess.STDOUT))
@@ -291,10 +291,47 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
     assert result["outcome"] == "completed", (result["faults"], result["outcome_reasons"])
     assert result["dead"] == [] and result["ticks"] == TOTAL
     # Every payload is counted by every process subscribed to its key: none lost, none twice.
-    assert result["rejected"] == sent["count"], (result["rejected_reasons"], sent)
+    assert result["rejected"] == sent["count"] + len(sentinels), (result["rejected_reasons"], sent)
+    assert result["forged"] == dict(Counter(key for _, key in sentinels)), "each sentinel, and nothing else"
     assert result["rejected_reasons"].get("too-large", 0) == sent["too-large"], (result["rejected_reasons"], sent)
     assert "conflict" not in result["rejected_reasons"] and "invalid" not in result["rejected_reasons"]
     assert result["process_digests"] == GOLDEN["digests"], "nothing well-formed went in: the match is unchanged"
+
+
+def waiting_receivers(rel: str) -> list[str]:
+    """The processes at the start barrier (all but a/0) that subscribe to `rel`, from the key table."""
+    receivers = next(r for k, _, r in routes(CFG["robots"]) if k == rel)
+    if rel == "field":
+        return []  # served, not subscribed to: the key table's "all" reads it with a query
+    return [p for p in receivers if p.startswith(("engine", "referee", "basestation/", "robot/")) and p != "robot/a/0"]
+
+
+def arrived(session, match_id: str, pubs: dict, timeout: float = 300.0) -> list[tuple[str, str]]:
+    """Wait until every payload put through `pubs` has been taken in by every waiting receiver.
+
+    The signal: after its payloads, each key gets one frame without a MAC, on the same publisher, so
+    after all of them on each link (zenoh keeps a publisher's order per link). A receiver counts it
+    as forged as it arrives, the first such frame on that key, and says so with a liveliness token
+    (`spoofing/<process>/<key>`, runtime/node.py `announce_spoofing`, at the start barrier too).
+    Returns the (process, key) of every sentinel, each counted once as forged."""
+    expected = {(p, key) for key in pubs for p in waiting_receivers(key)}
+    seen: set[tuple[str, str]] = set()
+    prefix = f"arena/{match_id}/spoofing/"
+
+    def on_token(sample) -> None:
+        user, _, rel = str(sample.key_expr).removeprefix(prefix).partition("/")
+        seen.add((user, rel))
+
+    sub = session.liveliness().declare_subscriber(prefix + "**", on_token, history=True)
+    for key, pub in pubs.items():
+        if waiting_receivers(key):
+            pub.put(b"\x80")  # an empty map, no attachment: counted as forged before it is decoded
+    try:
+        want = {(p.replace("/", "-"), key) for p, key in expected}
+        wait_for(lambda: want <= seen, timeout, "a sentinel's spoofing token from every receiver")
+    finally:
+        sub.undeclare()
+    return sorted(expected)
 
 
 @contextlib.contextmanager

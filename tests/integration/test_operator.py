@@ -17,14 +17,17 @@ from tests.integration.helpers import ARENA, free_port, spawn, wait_for, wait_un
 
 def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, tmp_path):
     from tests.integration.foxglove_client import FoxgloveClient, log_entry
+    from tests.integration.test_fuzz import Launcher
 
     port, live, mcap = free_port(), free_port(), tmp_path / "op.mcap"
     endpoint = f"tcp/127.0.0.1:{port}"
-    match = spawn(
-        "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "1.5", "--listen", endpoint,
-        "--match", "op", "--live", str(live), "--record", str(mcap), "--json",
+    match = Launcher(
+        reap, tmp_path / "logs", "match", "--home", "BS", "--away", "BS", "--realtime", "--half-time", "8",
+        "--listen", endpoint, "--match", "op", "--live", str(live), "--record", str(mcap), "--json",
     )  # fmt: skip
-    reap.append(match)
+    # The operator's credentials file (its MAC key), as arena match says where it is.
+    said = match.line("operator: arena operator", 60).split()
+    credentials = said[said.index("--credentials") + 1]
     client = FoxgloveClient(f"ws://127.0.0.1:{live}", timeout=60)
     assert "clientPublish" in client.info["capabilities"]
     client.subscribe("/referee_log")
@@ -32,7 +35,7 @@ def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, 
     teleport = '{"type": "teleport_ball", "x": 3.3, "y": -2.2, "vx": 0, "vy": 0}'
     corner = '{"type": "referee", "command": "CORNER", "team": "b"}'
     op = subprocess.run(
-        [*ARENA, "operator", "--match", "op", "--connect", endpoint, teleport, corner],
+        [*ARENA, "operator", "--match", "op", "--connect", endpoint, "--credentials", credentials, teleport, corner],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert op.returncode == 0 and "sent 2 action(s) to arena/op/operator" in op.stdout, op.stderr
@@ -48,8 +51,8 @@ def test_arena_operator_and_the_foxglove_publish_panel_drive_a_live_match(reap, 
     client.publish(channel, b'{"actions": [{"type": "teleport_ball", "x": -3.3, "y": 2.2, "vx": 0, "vy": 0}]}')
     client.publish(channel, b'{"actions": [{"type": "teleport_bal"}]}')  # refused, counted
     client.close()
-    out, err = match.communicate(timeout=120)
-    assert match.returncode == 0, err
+    out = match.finish(120)
+    assert match.proc.returncode == 0, "".join(match.err)
     result = json.loads(out)
     assert result["events"].get("CORNER", 0) >= 1
     assert result["rejected"] >= 1 and any("malformed" in r for r in result["rejected_reasons"]), result

@@ -109,3 +109,62 @@ def test_a_served_key_answers_an_ask_with_its_last_frame_and_nothing_before_one(
         assert got.wait(5.0) and answers == [b"r2"]
         tx.close()
         rx.close()
+
+
+def test_a_query_takes_only_the_answer_with_the_servers_mac_and_counts_every_other(tmp_path):
+    """How a process started by hand takes its configuration (tools/launch/run.py `fetch_config`): a
+    stranger's queryable answered first, and its `"home": "policy:/some/file.pkl"` was played."""
+    from arena.runtime.mac import Keyring, new_key
+
+    key = "arena/t/config"
+    engine_key = new_key()
+    endpoint = f"unixsock-stream/{tmp_path}/q.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as engine,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as stranger,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as robot,
+    ):
+        tx = ZenohTransport(engine, Keyring("engine", {"engine": engine_key}))
+        tx.serve(key, b"genuine", sign=tx.keyring.signer(key))
+        liar = ZenohTransport(stranger)
+        liar.serve(key, b"forged")  # no MAC: it has no key
+        liar.serve(key, b"forged", sign=Keyring("engine", {"engine": new_key()}).signer(key))  # a wrong one
+        rx = ZenohTransport(robot, Keyring("robot/a/0", {"engine": engine_key}))
+        forged: list[int] = []
+        verify = rx.keyring.verifier("engine", key)
+        deadline = time.monotonic() + 10
+        got = None
+        while got is None and time.monotonic() < deadline:
+            forged.clear()
+            got = rx.query(key, 2.0, verify=verify, on_forged=lambda: forged.append(1))
+        assert got == b"genuine" and len(forged) == 2, "both of the stranger's answers were looked at and counted"
+        assert rx.query(key, 2.0) in (b"genuine", b"forged"), "without a key: the first answer, whoever's"
+        for t in (tx, liar, rx):
+            t.close()
+
+
+def test_a_process_with_the_engines_key_never_takes_a_strangers_configuration(tmp_path):
+    """Only strangers answer: the process gives up, and says how many answers it ignored and why."""
+    import pytest
+
+    from arena.runtime.config import MatchConfig
+    from arena.runtime.mac import Keyring, new_key
+    from arena.runtime.node import StartupError
+    from arena.schemas.keys import Keys
+    from arena.tools.launch.run import fetch_config
+
+    keys = Keys("t")
+    endpoint = f"unixsock-stream/{tmp_path}/c.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as stranger,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as robot,
+    ):
+        liar = ZenohTransport(stranger)
+        liar.serve(keys.config(), MatchConfig(home="policy:/some/file.pkl").to_json().encode())
+        rx = ZenohTransport(robot, Keyring("robot/a/0", {"robot/a/0": new_key(), "engine": new_key()}))
+        forged = [0]
+        with pytest.raises(StartupError, match=r"ignored \d+ answer\(s\) without the engine's MAC"):
+            fetch_config(rx, keys, 2.5, forged=forged)
+        assert forged[0] >= 1
+        for t in (liar, rx):
+            t.close()

@@ -95,3 +95,56 @@ def test_cli_rejects_bad_live_flags_with_one_line_and_exit_2(flags, capfd):
         r = arena_in_process(argv, capfd)
     assert r.returncode == 2
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+
+
+def test_a_control_seq_that_jumps_past_the_window_is_refused_and_the_viewer_keeps_control():
+    """One forged `{"seq": 2**62, "paused": true}` held a live match paused for good: every genuine frame
+    after it had a lower seq. A frame may be at most SEQ_WINDOW past the last one (the viewer counts by one)."""
+    from arena.runtime.pace import SEQ_WINDOW
+
+    p = Pacer(0.02, 0.0)
+    assert p.control(Control(tick=0, seq=2**62, paused=True)) == (
+        "out-of-sequence",
+        f"seq {2**62} jumps more than {SEQ_WINDOW} past -1",
+    )
+    assert not p.paused and p.ready(0)
+    assert p.control(Control(tick=0, seq=1, paused=True)) is None and p.paused
+    assert p.control_raw(encode(Control(tick=0, seq=1 + SEQ_WINDOW + 1, paused=False)))[0] == "out-of-sequence"
+    assert p.paused and p.control(Control(tick=0, seq=1 + SEQ_WINDOW, paused=False)) is None and not p.paused
+
+
+def test_a_pause_in_pull_mode_lasts_at_most_its_timeout():
+    p = Pacer(0.02, 0.0, timeout=0.2)
+    p.control(Control(tick=0, seq=1, paused=True))
+    t0 = time.monotonic()
+    p.sync(0)
+    assert 0.2 <= time.monotonic() - t0 < 5.0 and not p.paused
+
+
+def test_a_pause_holds_a_reactive_engine_no_longer_than_its_wait_timeout():
+    """The Reactor bounds the pacer's wait as any other (runtime/drivers.py `_look`): then it plays on."""
+    import threading
+
+    from arena.runtime.clock import ManualClock
+    from arena.runtime.drivers import Reactor
+
+    clock = ManualClock()
+    p = Pacer(0.02, 0.0)
+    p.control(Control(tick=0, seq=1, paused=True))  # a pause set before the start holds tick 0
+    played: list[int] = []
+
+    def loop():
+        for k in range(3):
+            yield p, k
+            played.append(k)
+
+    reactor = Reactor(timeout=0.3, clock=clock)
+    runner = threading.Thread(target=reactor.run, args=(loop(),))
+    runner.start()
+    clock.until_sleeping(1)
+    clock.advance(0.1)
+    assert played == [] and runner.is_alive(), "held while paused"
+    for _ in range(4):
+        clock.advance(0.1)
+    runner.join(5.0)
+    assert not runner.is_alive() and played == [0, 1, 2] and not p.paused

@@ -16,6 +16,7 @@ from arena.rules.referee_box import Forced, RefereeState, Rules, process
 from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
 from arena.schemas.messages import (
     Condition,
+    Operator,
     RefereeOverride,
     Region,
     Step,
@@ -202,3 +203,73 @@ def test_a_killed_robot_process_is_found_dead_parked_and_repaired_out():
     log = [(e["command"], e.get("robot")) for e in summaries["referee"].extra["log"]]
     assert ("REPAIR_OUT", 1) in log
     assert abs(robot(worlds[-1], "b", 1).x) > 7
+
+
+def _inbox(kinds):
+    """An OperatorInbox on a memory bus (which carries no MACs: the zenoh path is
+    tests/integration/test_strangers.py), and what puts on its key."""
+    import logging
+    import types
+
+    from arena.processes.director import OperatorInbox
+    from arena.runtime.lockstep import Rejections
+    from arena.runtime.mac import Keyring
+    from arena.runtime.transport import MemoryBus, MemoryTransport
+    from arena.schemas.keys import Keys
+
+    bus = MemoryBus()
+    rejections = Rejections(logging.getLogger("t"))
+    node = types.SimpleNamespace(
+        keys=Keys("m"), cfg=MatchConfig(), rejections=rejections, transport=MemoryTransport(bus),
+        mac_check=lambda key, sender: (Keyring("engine").verifier(sender, key), lambda: rejections.forged(key, sender)),
+    )  # fmt: skip
+    return OperatorInbox(node, kinds), MemoryTransport(bus).publisher("arena/m/operator"), node.rejections
+
+
+@pytest.mark.parametrize(
+    ("action", "why"),
+    [
+        (TeleportBall(x=math.nan, y=0.0), "x is not finite"),
+        (TeleportBall(x=1e308, y=0.0), "x = 1e+308 is beyond +-7"),
+        (TeleportBall(x=0.0, y=5.5), "y = 5.5 is beyond +-5"),
+        (TeleportBall(x=0.0, y=0.0, vx=30.0, vy=0.0), "ball speed 30 is above the model's 13"),
+        (TeleportBall(x=0.0, y=0.0, z=50.0), "z = 50 is beyond"),
+        (TeleportRobot(team="a", robot=0, x=0.0, y=0.0, vx=6.0, vy=0.0), "speed 6 is above the model's 5"),
+        (TeleportRobot(team="a", robot=0, omega=math.inf), "omega is not finite"),
+        (TeleportRobot(team="a", robot=7, x=0.0, y=0.0), "robot 7: the match has 3 per team"),
+        (TeleportRobot(team="a", robot=0, orientation=1e308), "orientation = 1e+308"),
+        (RefereeOverride(command="FREEKICK", team="a", x=math.nan), "x is not finite"),
+    ],
+)
+def test_an_action_out_of_range_is_refused_with_its_reason_counted_and_the_rest_applies(action, why):
+    """A NaN from a stranger, or 1e308 from the real operator, reached the physics, and the match's own
+    recording then failed review."""
+    from arena.processes.director import check_action
+
+    assert why in check_action(MatchConfig(), action)
+    inbox, put, rejections = _inbox((TeleportBall, TeleportRobot, RefereeOverride))
+    good = TeleportBall(x=1.0, y=-1.0, vx=0.0, vy=0.0)
+    put(msgspec.msgpack.encode(Operator(seq=5, actions=[action, good])))
+    assert inbox.take(3) == [good]
+    assert rejections.by_reason == {"invalid": 1}
+    assert [(r["tick"], r["why"]) for r in inbox.refused] == [(3, check_action(MatchConfig(), action))]
+    assert inbox.summary()["operator"] == [{"tick": 3, "seq": 5, "action": msgspec.to_builtins(good)}]
+
+
+def test_a_frame_put_again_is_refused_as_out_of_sequence():
+    inbox, put, rejections = _inbox((TeleportBall,))
+    frame = msgspec.msgpack.encode(Operator(seq=7, actions=[TeleportBall(x=1.0, y=1.0)]))
+    put(frame)
+    put(frame)  # a genuine frame, MAC and all, put again by whoever saw it
+    assert len(inbox.take(0)) == 1 and rejections.by_reason == {"out-of-sequence": 1}
+
+
+def test_a_scenario_step_out_of_range_is_refused_by_the_engine_and_the_match_goes_on():
+    """A configuration made by hand (not through the scenario loader) reaches the engine as it is."""
+    cfg = MatchConfig(
+        half_time=0.2,
+        scenario=ScenarioParams(steps=(Step(at=2, actions=(TeleportBall(x=math.inf, y=0.0),)),)),
+    )
+    summaries, _ = play_in_process(cfg)
+    engine = summaries["engine"]
+    assert engine.rejected_reasons == {"invalid": 1} and engine.tick == cfg.total_ticks

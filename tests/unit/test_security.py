@@ -5,6 +5,8 @@ from __future__ import annotations
 import hashlib
 import json
 
+import pytest
+
 from arena.runtime.acl import access_control, permissions, principals
 from arena.runtime.credentials import Secrets, load_fragment
 from arena.runtime.mac import Keyring, tag
@@ -84,11 +86,16 @@ def test_fragments_hold_user_password_tls_root_and_keys(tmp_path):
     # Its own key, and the keys of the senders of what it receives (sense, field; its orders): every
     # frame it takes is authenticated, in every mode. No other robot's, no other team's.
     assert set(keys) == {"robot/b/1", "engine", "basestation/b"}
-    assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine"}
+    # the referee takes a live session's operator frames, the engine those and the viewer's control frames
+    assert set(load_fragment(str(paths["referee"]))["metadata"]["arena"]["keys"]) == {"referee", "engine", "operator"}
     bs = set(load_fragment(str(paths["basestation/a"]))["metadata"]["arena"]["keys"])
     assert bs == {"basestation/a", "engine", "referee", "robot/a/0", "robot/a/1", "robot/a/2"}  # field: engine
     engine = set(load_fragment(str(paths["engine"]))["metadata"]["arena"]["keys"])
-    assert engine == {"engine", "referee", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
+    assert engine == {"engine", "referee", "viewer", "operator", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
+    viewer = set(load_fragment(str(paths["viewer"]))["metadata"]["arena"]["keys"])
+    assert "operator" not in viewer, "the operator's key is lent to a local viewer only (tools/launch/launcher.py)"
+    lent = s.keyring("viewer", ("operator",))
+    assert lent.signer("arena/m1/operator", sender="operator") is not None and lent.own == s.mac_keys["viewer"]
     insecure = Secrets.new("m1", 3, NAMES, secure=False).fragment("robot/b/1")
     assert set(insecure) == {"metadata"}, "without --secure: the MAC key only, the zenoh settings untouched"
     json.dumps(frag)  # plain JSON, so valid JSON5
@@ -129,3 +136,44 @@ def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_
     assert puts == {"operator"} and reads == {"engine", "referee"}
     op = permissions("operator", P, 3)
     assert op["put/ingress"] == [key] and not any("/alive/" in k for k in op.get("liveliness_token/ingress", []))
+
+
+@pytest.mark.parametrize("lent", [False, True])
+def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_key(lent):
+    """A Foxglove client published `/operator` and the viewer put it as is: a stranger's goal counted.
+    Only a viewer started for a local operator holds the operator's key (tools/launch/launcher.py
+    `local_operator`) and signs with it; any other refuses the message, counted."""
+    from arena.processes.viewer import ViewerNode
+    from arena.runtime.config import MatchConfig, ProcessId
+    from arena.runtime.mac import Keyring, new_key
+    from arena.runtime.transport import MemoryBus, MemoryTransport
+    from arena.schemas.keys import Keys
+
+    bus = MemoryBus()
+    tr = MemoryTransport(bus)
+    tr.keyring = Keyring("viewer", {"viewer": new_key(), **({"operator": new_key()} if lent else {})})
+    engine_side = MemoryTransport(bus).subscribe("arena/m/operator")
+    viewer = ViewerNode(ProcessId("viewer"), MatchConfig(live=0, pace=1.0), tr, Keys("m"))
+    try:
+        viewer.on_client_message("/operator", b'{"actions": [{"type": "referee", "command": "GOAL", "team": "b"}]}')
+    finally:
+        viewer.server.stop()
+    got = engine_side.try_recv()
+    if lent:
+        assert got is not None and viewer.rejections.total == 0
+        assert viewer.operator_sign is not None
+    else:
+        assert got is None and viewer.rejections.by_reason == {"refused": 1}
+
+
+def test_only_a_viewer_started_here_on_loopback_without_secure_is_lent_the_operators_key():
+    from arena.runtime.config import MatchConfig, ProcessId
+    from arena.tools.launch.launcher import local_operator
+
+    live = MatchConfig(live=8765)
+    assert local_operator(live, False, "127.0.0.1", set())
+    assert local_operator(live, False, "::1", set())
+    assert not local_operator(live, True, "127.0.0.1", set()), "secure: only the operator principal may put"
+    assert not local_operator(live, False, "0.0.0.0", set()), "anybody on the network could publish"
+    assert not local_operator(live, False, "127.0.0.1", {ProcessId("viewer")}), "a viewer started elsewhere"
+    assert not local_operator(MatchConfig(), False, "127.0.0.1", set()), "no viewer"

@@ -255,7 +255,9 @@ def _fetch(transport: ZenohTransport, keys: Keys, children: list[Child]) -> Matc
         for c in children:
             if c.popen.poll() not in (None, 0):
                 raise _exited(c)
-        payload = transport.query(keys.config(), timeout=1.0)
+        ring = transport.keyring  # with the collector's credentials: only the engine's answer (its MAC)
+        verify = ring.verifier("engine", keys.config()) if ring is not None else None
+        payload = transport.query(keys.config(), timeout=1.0, verify=verify)
         if payload is not None:
             try:
                 return MatchConfig.from_json(payload.decode())

@@ -36,7 +36,7 @@ from arena.runtime.provision import provision
 from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.runtime.version import PACKAGES
-from arena.schemas.keys import Keys, routes
+from arena.schemas.keys import OPERATOR_PRINCIPAL, Keys, routes
 from arena.tools.launch import forkstart
 from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all, stopped_on_error
 from arena.tools.launch.claims import Claims
@@ -126,6 +126,14 @@ def relay_safe(router_zid: str, peer: str, match: str, robots: int, external: se
     return {"qos": {"network": rule}}
 
 
+def local_operator(cfg: MatchConfig, secure: bool, live_host: str, external) -> bool:
+    """Whether the live viewer may sign Foxglove's `/operator` messages as the operator: it is
+    started here (not `--external`), serves on a loopback address (whoever publishes there is on
+    this computer) and the match is not `--secure` (where only the operator principal may put)."""
+    local_viewer = cfg.live >= 0 and ProcessId("viewer") not in external
+    return local_viewer and not secure and loopback_only(f"tcp/{live_host}:0")
+
+
 def open_router(net: NetConfig, listen: str | None):
     """The match's router session; an endpoint that cannot be used is named as the user gave it."""
     try:
@@ -203,7 +211,10 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
             router_extra = (("id", json.dumps(router_zid)), *SPECTATOR_SAFE)
         # This match's own processes get theirs in the private temp dir (with this match's settings);
         # an external process's is in DIR, unchanged from match to match.
-        cred_paths = secrets.write(tmp / "credentials", more, launched={str(p) for p in local})
+        # The live viewer forwards Foxglove's `/operator` messages signed as the operator only for a
+        # local operator: a viewer this match starts, serving on a loopback address, not --secure.
+        lend = {"viewer": (OPERATOR_PRINCIPAL,)} if local_operator(cfg, secure, live_host, external) else {}
+        cred_paths = secrets.write(tmp / "credentials", more, launched={str(p) for p in local}, lend=lend)
         if credentials:
             cred_paths |= {str(p): Path(credentials) / f"{user_of(str(p))}.json5" for p in external}
     except BaseException:
@@ -242,6 +253,9 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
             if cfg.live >= 0 and announce is not None:
                 pace = "" if cfg.realtime else f", pace {cfg.pace:g} (Foxglove parameters: paused, step, pace)"
                 announce(f"live: connect the Foxglove app to ws://{live_host}:{cfg.live}{pace}")
+            if (cfg.live >= 0 or cfg.realtime) and announce is not None:
+                op = cred_paths[OPERATOR_PRINCIPAL]
+                announce(f"operator: arena operator --match {match} --connect {connect} --credentials {op} ACTION")
             joins = Joins(session, keys, external, announce)
             if external and announce is not None:
                 announce(instructions(sorted(external), match, endpoint, record, cred_paths, secure))

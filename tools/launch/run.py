@@ -8,7 +8,10 @@ Where the match configuration comes from:
 * `--config FILE` (what `arena match` passes to its children), or
 * for the engine, its own flags (`--home`, `--away`, `--robots`, ...), or
 * for everyone else, the engine's `arena/<m>/config` queryable, asked until the
-  startup timeout.
+  startup timeout. Only an answer with the engine's MAC counts (the key is in
+  the process's credentials file, `--credentials`); the others are counted as
+  forged on `config` and warned about. Without credentials a process can
+  verify nothing: it takes the first answer (docs/architecture.md, "Trust").
 """
 
 from __future__ import annotations
@@ -302,16 +305,30 @@ def fetch_config(
     tell=None,
     connect: tuple[str, ...] = (),
     refused=None,
+    forged: list[int] | None = None,
 ) -> MatchConfig:
-    """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`)."""
+    """Ask the engine for the match configuration until `timeout`; say what we wait for (`tell`).
+
+    With the engine's key (`transport.keyring`), only its answer counts: every other one is
+    counted in `forged` (`forged[0]`, before the process's node exists) and warned about once."""
     deadline = time.monotonic() + timeout
     state = said = ""  # what we wait for now, and what we last told
+    ring = transport.keyring
+    verify = ring.verifier("engine", keys.config()) if ring is not None else None
+    node_warns = forged is not None  # the caller's node warns (`Rejections.forged`)
+    forged = [0] if forged is None else forged
+
+    def on_forged() -> None:
+        forged[0] += 1
+        if not node_warns and forged[0] == 1:
+            logging.getLogger("arena.config").warning("possible spoofing on %s", keys.config())
+
     ep = None
     elsewhere = ""  # the other matches the router we reached hosts
     refused_since: float | None = None  # a router listens, and we are still not connected to it
     connected_since: float | None = None  # a fresh connection learns the engine's queryable a moment later
     while time.monotonic() < deadline:
-        payload = transport.query(keys.config(), timeout=1.0)
+        payload = transport.query(keys.config(), timeout=1.0, verify=verify, on_forged=on_forged)
         if payload is not None:
             return MatchConfig.from_json(payload.decode())
         if session is not None:
@@ -339,11 +356,20 @@ def fetch_config(
         time.sleep(0.2)
     if refused_since is not None and refused is not None and ep is not None:
         raise refused(ep)  # a router listens there and never took us: say why, not "no router"
+    ignored = (
+        f"; ignored {forged[0]} answer(s) without the engine's MAC (possible spoofing, or an engine "
+        "started without its --credentials)"
+        if forged[0]
+        else ""
+    )
     raise StartupError(
-        f"gave up after {timeout:g} s{' ' if state.startswith('waiting') else ': '}{state}"
-        if state
-        else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
-        f"{keys.match!r} running and reachable on the given endpoint?"
+        (
+            f"gave up after {timeout:g} s{' ' if state.startswith('waiting') else ': '}{state}"
+            if state
+            else f"no match configuration on {keys.config()} after {timeout:g} s: is the engine of match "
+            f"{keys.match!r} running and reachable on the given endpoint?"
+        )
+        + ignored
     )
 
 
@@ -465,9 +491,10 @@ def run(
     with open_until(net, startup_timeout, where, tell, refused) as session:
         transport = ZenohTransport(session, keyring)
         ref_sub = None
+        forged = [0]  # answers to our `config` query without the engine's MAC
         try:
             if cfg is None:
-                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell, net.connect, refused)
+                cfg = fetch_config(transport, keys, startup_timeout, session, where, tell, net.connect, refused, forged)
             if seed is not None and seed != cfg.seed:
                 raise ConfigError(f"--seed {seed} differs from the match's seed {cfg.seed}")
             if realtime and not cfg.realtime:
@@ -487,6 +514,8 @@ def run(
                     keys.key("referee"), lambda s: last_ref[:1].clear() or last_ref.append(s.payload.to_bytes())
                 )
             node = node_class(pid.kind)(pid, cfg, transport, keys, **extra, **driver(pid, cfg, transport, keys))
+            for _ in range(forged[0]):  # counted in its summary as every forged frame is (runtime/lockstep.py)
+                node.rejections.forged(keys.config(), "engine")
             node.on_waiting = lambda missing: tell(
                 f"waiting for: {', '.join(missing)} (up to {cfg.timing.startup_timeout:g} s)"
                 if missing
