@@ -105,7 +105,7 @@ class SentOff(msgspec.Struct):
 
 class MatchResult(msgspec.Struct, kw_only=True):
     """One match's result. Its fields, in order, are the keys of `arena match --json`
-    (README.md, "What a match prints"); those after `referee_log` are set by the
+    (README.md, "What `arena match --json` reports"); those after `referee_log` are set by the
     engine that played it, and a field left UNSET is not printed. `recording`, `refbox`,
     `refbox_follow` and `referee_log` are what the recorder, the RefBox bridge and the referee
     report of themselves (their Summary's `extra`), as they report it."""
