@@ -16,6 +16,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from arena.match.inprocess import play_in_process
 from arena.processes.recorder import data_topics
 from arena.recording import scene
 from arena.recording.analysis import NEEDED, analyse
@@ -27,7 +28,6 @@ from arena.schemas.messages import Cmd, TapBatch
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import registry
 from arena.tools.experiments import facts
-from arena.tools.launch.inprocess import play_in_process
 from arena.tools.review import replay, review
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")

@@ -11,6 +11,7 @@ import math
 import msgspec
 import pytest
 
+from arena.match.inprocess import play_in_process
 from arena.processes.director import referee_steps
 from arena.rules.referee_box import Forced, RefereeState, Rules, process
 from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
@@ -23,7 +24,6 @@ from arena.schemas.messages import (
     TeleportRobot,
     World,
 )
-from arena.tools.launch.inprocess import play_in_process
 
 
 def play(steps, ticks=60, stage="FIRST_HALF", seed=3, **kw):

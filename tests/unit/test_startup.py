@@ -43,7 +43,7 @@ def test_a_ctrl_c_inside_the_starters_close_does_not_make_the_next_close_fail(mo
 
     import pytest
 
-    from arena.tools.launch import forkstart
+    from arena.match import forkstart
 
     starter = forkstart.Starter.__new__(forkstart.Starter)
     starter._go_r, starter._go_w = fds = os.pipe()

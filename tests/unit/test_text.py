@@ -11,8 +11,8 @@ from msgspec.structs import replace
 from rich.console import Console
 
 from arena.match import MatchResult, play
+from arena.match.result import LinkStats
 from arena.runtime.config import MatchConfig
-from arena.tools.launch.result import LinkStats
 from arena.tools.review import report
 from tests.integration.helpers import arena_in_process
 

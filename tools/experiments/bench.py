@@ -15,10 +15,9 @@ from pathlib import Path
 from rich.markup import escape
 from rich.table import Table
 
-from arena.match import play
+from arena.match import play, zygote
 from arena.runtime.config import MatchConfig
 from arena.tools.console import console as make_console
-from arena.tools.launch import zygote
 
 
 def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
@@ -26,7 +25,7 @@ def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
     half_time, robots, link = base.half_time, base.robots, base.link
     console = make_console(stderr=True)
     results = []
-    # Before the first router: every match's processes are forked by the zygote (tools/launch/zygote.py),
+    # Before the first router: every match's processes are forked by the zygote (match/zygote.py),
     # the first match's too (warm: the zygote has imported everything before the first launch).
     zygote.start(ready=len(base.processes()))
     for i in range(runs):

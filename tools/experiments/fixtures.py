@@ -87,9 +87,7 @@ class Result:
     rtf: float = 0.0
     digest: str = ""
     engine: str = "processes"  # which engine played it (arena match --engine)
-    faults: list[dict] = field(
-        default_factory=list
-    )  # a team's crashed process: the match counts (tools/launch/faults.py)
+    faults: list[dict] = field(default_factory=list)  # a team's crashed process: the match counts (match/faults.py)
 
     @classmethod
     def played(cls, fx: Fixture, m: MatchResult, attempts: int, wall_seconds: float, engine: str) -> Result:
@@ -142,7 +140,7 @@ def load_results(directory: Path) -> dict[str, Result]:
 
 
 def void_reason(m: MatchResult) -> str:
-    """Why a match is no result ("" if it is one): a void match never counts (tools/launch/faults.py)."""
+    """Why a match is no result ("" if it is one): a void match never counts (match/faults.py)."""
     if m.outcome == "void" or m.void:
         return "void: " + "; ".join(m.outcome_reasons or ["no reason given"])
     return ""

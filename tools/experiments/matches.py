@@ -151,9 +151,6 @@ def _worker_init() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except OSError:
         pass
-    import arena.match
-    import arena.processes.engine
-    import arena.tools.launch.inprocess  # noqa: F401
 
 
 def _play_inprocess(cfg: MatchConfig) -> MatchResult:

@@ -71,7 +71,7 @@ def print_match(result: MatchResult, console: Console | None = None) -> None:
             f"{ignored} ignored, {fo['errors']} malformed"
         )
     rec = result.recording
-    if rec and "error" in rec:  # no recorder Summary (tools/launch/result.py)
+    if rec and "error" in rec:  # no recorder Summary (match/result.py)
         console.print(f"[red]not recorded[/]: {rec['error']} ({rec['path']})")
     elif rec:
         state = "complete" if rec["complete"] else f"[yellow]incomplete, missing {', '.join(rec['missing'])}[/]"

@@ -21,6 +21,7 @@ import os
 import time
 from typing import TYPE_CHECKING
 
+from arena.match.result import MatchError
 from arena.processes import node_class
 from arena.runtime import coop
 from arena.runtime.config import MatchConfig, ProcessId
@@ -28,12 +29,11 @@ from arena.runtime.coop import CoopBus, NodeFailed, Task
 from arena.runtime.node import killed_at, match_heap
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
-from arena.tools.launch.result import MatchError
 
 if TYPE_CHECKING:
+    from arena.match.result import MatchResult
     from arena.runtime.node import Node
     from arena.schemas.messages import Summary
-    from arena.tools.launch.result import MatchResult
 
 ENGINE = "inprocess"
 LOCKSTEP_KINDS = {"engine", "referee", "basestation", "robot", "recorder"}  # what this engine can host
@@ -150,7 +150,7 @@ def play_in_process(
 def play_match(cfg: MatchConfig, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
     """Play one match in-process and return the result of `arena match --json`; `record`: an MCAP path;
     `watch`: keys whose payloads the result keeps (`frames`)."""
-    from arena.tools.launch.result import Collected, assemble
+    from arena.match.result import Collected, assemble
 
     if cfg.realtime:
         raise InprocessError("--engine inprocess plays in lockstep only (no --realtime)")

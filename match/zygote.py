@@ -1,6 +1,6 @@
 """A fork server: every match of a long-lived process gets forked, warm children.
 
-`tools/launch/forkstart.py` forks a match's processes from the launcher itself, which
+`match/forkstart.py` forks a match's processes from the launcher itself, which
 works only while the launcher has never opened zenoh: zenoh's runtime threads
 outlive a session and a fork lacks them. A process that plays match after match
 (`arena bench match`, a tournament worker) opens a router for its first one, so
@@ -42,8 +42,8 @@ from pathlib import Path
 
 import msgspec
 
-from arena.tools.launch import forkstart
-from arena.tools.launch.run import Job
+from arena.match import forkstart
+from arena.match.run import Job
 
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36

@@ -25,6 +25,8 @@ from pathlib import Path
 import msgspec
 import zenoh
 
+from arena.match.claims import hold_identity
+from arena.match.connect import why_refused
 from arena.processes import OBSERVERS, node_class
 from arena.runtime.acl import user_of
 from arena.runtime.config import ConfigError, MatchConfig, ProcessId
@@ -36,8 +38,6 @@ from arena.runtime.session import EndpointError, NetConfig, check_endpoint, list
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id
 from arena.schemas.messages import Referee
-from arena.tools.launch.claims import hold_identity
-from arena.tools.launch.connect import why_refused
 
 
 class Job(msgspec.Struct, frozen=True, omit_defaults=True):
@@ -118,7 +118,7 @@ def start(job: Job, cfg: MatchConfig | None = None) -> int:
     configure_logging(job.log_level or "WARNING", by_hand=job.config is None)
     net = NetConfig(mode=job.mode or "peer", connect=job.connect, listen=job.listen)
     if job.kind == "router":
-        from arena.tools.launch.router import run_router
+        from arena.match.router import run_router
 
         return main_guarded(run_router, job.match, net, job.credentials)
     keyring = None
@@ -277,7 +277,7 @@ def refused_by(connect: tuple[str, ...]) -> str | None:
 
 
 def refusal(ep: str, net: NetConfig, credentials: str | None, pid: str) -> ConfigError:
-    """The refusal of the router at `ep`, with its cause (tools/launch/connect.py)."""
+    """The refusal of the router at `ep`, with its cause (match/connect.py)."""
     fragment = json.loads(net.base) if net.base else None
     return ConfigError(why_refused(ep, fragment, credentials, user_of(pid)))
 

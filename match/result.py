@@ -15,11 +15,11 @@ from typing import Any
 import msgspec
 from msgspec import UNSET, UnsetType
 
+from arena.match.faults import Fault
+from arena.match.faults import outcome as match_outcome
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.stats import percentile
 from arena.schemas.messages import Referee, Summary
-from arena.tools.launch.faults import Fault
-from arena.tools.launch.faults import outcome as match_outcome
 
 # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
 # what the teams sent (no process's input): the digest is the same with or without them.
@@ -110,7 +110,7 @@ class MatchResult(msgspec.Struct, kw_only=True):
     `refbox_follow` and `referee_log` are what the recorder, the RefBox bridge and the referee
     report of themselves (their Summary's `extra`), as they report it."""
 
-    outcome: str  # completed | void (tools/launch/faults.py)
+    outcome: str  # completed | void (match/faults.py)
     void: bool
     outcome_reasons: list[str]
     home: str
@@ -151,7 +151,7 @@ class MatchResult(msgspec.Struct, kw_only=True):
     services: list[str] | UnsetType = UNSET  # arena up
     secure: bool | UnsetType = UNSET  # processes, arena up
     digests_verified: list[str] | UnsetType = UNSET  # processes
-    refused_starts: list[dict] | UnsetType = UNSET  # processes: turned away at connect (tools/launch/claims.py)
+    refused_starts: list[dict] | UnsetType = UNSET  # processes: turned away at connect (match/claims.py)
     startup_seconds: float | None | UnsetType = UNSET  # processes, inprocess
     launch: str | UnsetType = UNSET  # processes: exec | fork | zygote; inprocess
     play_started_unix: float | None | UnsetType = UNSET  # processes, inprocess
@@ -258,7 +258,7 @@ def assemble(
         half_time=cfg.half_time,
         link=cfg.link,
         realtime=cfg.realtime,
-        engine="processes",  # tools/launch/inprocess.py says "inprocess"
+        engine="processes",  # match/inprocess.py says "inprocess"
         ticks=ticks,
         sim_seconds=round(sim_seconds, 3),
         wall_seconds=round(wall_total, 3),

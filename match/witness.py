@@ -9,7 +9,7 @@ match's router) subscribes to every data key that process sends and
 recomputes the digest from the frames as they arrive. zenoh keeps one
 session's puts in order, and the frames come before the Summary, so by the
 time its Summary arrives the witness has seen all of them: a Summary whose
-digest differs is refused (tools/launch/supervise.py `supervise`).
+digest differs is refused (match/supervise.py `supervise`).
 
 Send order is not quite wire order. In lockstep a robot holds its `cmd`
 frames, and the engine its `sense` frames, for up to L ticks and puts them as

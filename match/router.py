@@ -1,6 +1,6 @@
 """`arena run router`: a zenoh router for one match, started by hand (hardware in the loop,
 `compose.yaml`); with `--credentials DIR` a secure one that provisions DIR once
-(runtime/provision.py) and gives out one identity per process (tools/launch/claims.py)."""
+(runtime/provision.py) and gives out one identity per process (match/claims.py)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,13 @@ from pathlib import Path
 
 import zenoh
 
+from arena.match.claims import Claims
 from arena.runtime.config import ConfigError
 from arena.runtime.credentials import COLLECTOR_PRINCIPAL, match_directory, secure_endpoint
 from arena.runtime.mac import Keyring
 from arena.runtime.provision import load, provision
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas.keys import Keys, process_names
-from arena.tools.launch.claims import Claims
 
 
 def _sigterm(signum, frame):
@@ -75,7 +75,7 @@ def _route(match: str, net: NetConfig, keyring: Keyring | None) -> int:
     with open_session(NetConfig(mode="router", listen=net.listen, connect=net.connect, extra=net.extra)) as session:
         sub = session.liveliness().declare_subscriber(keys.alive_all(), on_change, history=True)
         said = lambda text: print(f"arena run: router: {text}", file=sys.stderr, flush=True)
-        claims = Claims(session, keys, keyring, {}, said)  # one process per identity (tools/launch/claims.py)
+        claims = Claims(session, keys, keyring, {}, said)  # one process per identity (match/claims.py)
         try:
             while not (seen[0] and not alive):
                 time.sleep(0.2)

@@ -1,5 +1,5 @@
 """The OS processes of a match the launcher starts: exec'd (`spawn`) or forked
-(tools/launch/forkstart.py), each a `Child` with its log; stopped together."""
+(match/forkstart.py), each a `Child` with its log; stopped together."""
 
 from __future__ import annotations
 
@@ -13,9 +13,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from arena.match.result import JoinError, MatchError
+from arena.match.run import Job
 from arena.runtime.config import ProcessId
-from arena.tools.launch.result import JoinError, MatchError
-from arena.tools.launch.run import Job
 
 __all__ = ["Child", "JoinError", "MatchError", "run_argv", "spawn", "stop_all", "stopped_on_error"]
 

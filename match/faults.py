@@ -39,7 +39,7 @@ from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:
-    from arena.tools.launch.result import MatchResult
+    from arena.match.result import MatchResult
 
 # A failure of one of these makes the match void: without them there is no game.
 VOIDING = ("engine", "referee")

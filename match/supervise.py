@@ -12,14 +12,14 @@ from dataclasses import dataclass
 
 import msgspec
 
+from arena.match.children import Child, MatchError
+from arena.match.faults import VOIDING, exit_reason, lapses
+from arena.match.result import Collected
+from arena.match.witness import Witness
 from arena.runtime.config import MatchConfig
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import SPOOFING, Keys
 from arena.schemas.messages import Referee, Summary
-from arena.tools.launch.children import Child, MatchError
-from arena.tools.launch.faults import VOIDING, exit_reason, lapses
-from arena.tools.launch.result import Collected
-from arena.tools.launch.witness import Witness
 
 
 @dataclass
@@ -178,7 +178,7 @@ def supervise(  # noqa: C901, PLR0912, PLR0915 - one supervision loop: every way
 
     `strict`: the first child to fail ends the match (MatchError), as for CI.
     Otherwise a failed team process or recorder is a fault and the match plays
-    on; a failed engine or referee makes it void at once (tools/launch/faults.py).
+    on; a failed engine or referee makes it void at once (match/faults.py).
     `announce(text)` hears of each failure when it happens (a viewer that
     could not serve, say), with the last line of the process's log.
     """

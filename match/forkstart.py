@@ -5,7 +5,7 @@ eleven interpreters, each importing zenoh, numpy, pymunk and the strategies,
 which took about 1.4 s of a match's wall time on a quiet host and ~2.5 s of
 its CPU. Here the launcher imports every process kind once (`preload`) and
 `os.fork`s one child per process. A child runs the same typed entry as
-`arena run <kind> ...` (`arena.tools.launch.run.start` with the launcher's
+`arena run <kind> ...` (`arena.match.run.start` with the launcher's
 `Job`), so every process, and the per-process one for hardware in the loop,
 starts one way; no child parses a command line.
 
@@ -24,7 +24,7 @@ Rules kept:
 `ARENA_LAUNCH=exec` keeps the former exec start (for comparison runs and as a
 fallback). It is also used off the main thread, and in a process that has
 already opened a zenoh session (a second match played by the same process)
-unless that process started a fork server first (tools/launch/zygote.py, as `arena
+unless that process started a fork server first (match/zygote.py, as `arena
 bench match` does): zenoh's runtime threads outlive the session, and a fork
 would inherit its state without them (measured: the children of such a fork
 did not play).
@@ -45,7 +45,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from arena.tools.launch.run import Job
+    from arena.match.run import Job
 
 _PR_SET_PDEATHSIG = 1
 
@@ -63,9 +63,9 @@ def enabled() -> bool:
 
 def preload(kinds: set[str], strategies: set[str]) -> None:
     """Import what the match's processes import (their kinds, its strategies), once, before forking."""
+    from arena.match import run  # noqa: F401
     from arena.processes import node_class
     from arena.strategies import registry
-    from arena.tools.launch import run  # noqa: F401
 
     for kind in kinds:
         node_class(kind)
@@ -142,8 +142,8 @@ class ForkedProcess:
 
 def starter(count: int, kinds: set[str], strategies: set[str]) -> Starter | None:
     """How to start a match's `count` processes: this process's zygote if it has one
-    (tools/launch/zygote.py), else a fork of this process if it can, else None (exec)."""
-    from arena.tools.launch import zygote
+    (match/zygote.py), else a fork of this process if it can, else None (exec)."""
+    from arena.match import zygote
 
     z = zygote.running()
     if z is not None:
@@ -161,7 +161,7 @@ class Starter:
     """Forks the children of one match; `release` lets them open their sessions."""
 
     def __init__(self, zygote=None, count: int = 0) -> None:
-        """Fork here, or with `zygote` (tools/launch/zygote.py) hand `count` jobs to its parked children."""
+        """Fork here, or with `zygote` (match/zygote.py) hand `count` jobs to its parked children."""
         self._go_r, self._go_w = os.pipe()
         self._count = 0
         self._frozen = False
@@ -285,7 +285,7 @@ def _child(job: Job, log_path: Path, go_r: int, go_w: int, parent: int) -> None:
         os.close(go_r)
         # Named `arena run ...` only now: whoever sees one (ps, a test) can count on the router being up.
         retitle(job.argv())
-        from arena.tools.launch.run import start
+        from arena.match.run import start
 
         code = start(job)
     except SystemExit as exc:

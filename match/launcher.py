@@ -2,9 +2,9 @@
 
 The launcher hosts the match's zenoh router (a unix socket in a private temp
 dir unless `--listen` says otherwise), starts every process with the same
-job a user would start with `arena run <kind> ...` (tools/launch/run.py), waits
-for each one's `Summary` (tools/launch/supervise.py), and assembles the match
-result (tools/launch/result.py). Ctrl-C, or any child exiting with
+job a user would start with `arena run <kind> ...` (match/run.py), waits
+for each one's `Summary` (match/supervise.py), and assembles the match
+result (match/result.py). Ctrl-C, or any child exiting with
 an error, ends the whole group; children also die with the launcher
 (PR_SET_PDEATHSIG), so no orphan survives.
 """
@@ -21,6 +21,14 @@ import sys
 import time
 from pathlib import Path
 
+from arena.match import forkstart
+from arena.match.children import Child, MatchError, run_argv, spawn, stop_all, stopped_on_error
+from arena.match.claims import Claims
+from arena.match.joins import Joins, instructions
+from arena.match.result import MatchResult, assemble, startup_seconds
+from arena.match.run import run_job
+from arena.match.supervise import Progress, open_collector, supervise, watch_spoofing
+from arena.match.witness import Witness
 from arena.runtime.acl import user_of
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.credentials import (
@@ -37,14 +45,6 @@ from arena.runtime.session import EndpointError, NetConfig, check_endpoint, open
 from arena.runtime.transport import ZenohTransport
 from arena.runtime.version import PACKAGES
 from arena.schemas.keys import Keys, routes
-from arena.tools.launch import forkstart
-from arena.tools.launch.children import Child, MatchError, run_argv, spawn, stop_all, stopped_on_error
-from arena.tools.launch.claims import Claims
-from arena.tools.launch.joins import Joins, instructions
-from arena.tools.launch.result import MatchResult, assemble, startup_seconds
-from arena.tools.launch.run import run_job
-from arena.tools.launch.supervise import Progress, open_collector, supervise, watch_spoofing
-from arena.tools.launch.witness import Witness
 
 # Every package of the distribution; compiling one compiles its subpackages
 # (arena.sim.physics, arena.strategies.iris, ...) too.
@@ -162,7 +162,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
     holds is kept, what is missing made; the externals' files are named from it (default: a
     fresh set in the match's private temp dir, gone with it).
     A failed process is a fault in the result (`outcome`, `faults`: see
-    tools/launch/faults.py); with `strict`, it raises MatchError instead, as does a
+    match/faults.py); with `strict`, it raises MatchError instead, as does a
     match that cannot start.
     """
     if listen:  # a malformed endpoint is said before the match's processes are forked
@@ -213,7 +213,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
     keep = False  # a failed match keeps its logs (and says where); anything else leaves nothing behind
     starter = None
     try:
-        # Fork the processes before any zenoh session exists here (tools/launch/forkstart.py);
+        # Fork the processes before any zenoh session exists here (match/forkstart.py);
         # they open theirs once the router is up.
         starter = forkstart.starter(len(local), {p.kind for p in local}, {cfg.home, cfg.away})
         if starter is not None:
@@ -226,7 +226,7 @@ def play_match(  # noqa: C901, PLR0912, PLR0915 - start, supervise and collect a
             transport = ZenohTransport(session, secrets.keyring("launcher"))
             collector = open_collector(transport, keys, names)
             watch_spoofing(transport, keys, announce)
-            # An external's digest is recomputed from the frames it puts (tools/launch/witness.py).
+            # An external's digest is recomputed from the frames it puts (match/witness.py).
             witness = Witness(transport, keys, cfg.robots, {str(p) for p in external}, cfg.timing.periods())
             if starter is not None:
                 starter.release()

@@ -133,7 +133,7 @@ class Claims:
 
 # ---------------------------------------------------------------- the claimant's side (`arena run`)
 def claim(session, keys: Keys, pid: ProcessId, keyring: Keyring | None, timeout: float = 3.0):
-    """Ask the match's router for this identity (tools/launch/claims.py); ConfigError with the
+    """Ask the match's router for this identity (match/claims.py); ConfigError with the
     router's reason if refused. Returns the liveliness token that holds it (keep it while running),
     or None if nobody answers (a router that gives out no identities)."""
     name = str(pid)

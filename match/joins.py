@@ -8,10 +8,10 @@ from pathlib import Path
 
 import zenoh
 
+from arena.match.children import Child, JoinError
+from arena.match.run import run_job
 from arena.runtime.config import ProcessId
 from arena.schemas.keys import Keys
-from arena.tools.launch.children import Child, JoinError
-from arena.tools.launch.run import run_job
 
 
 def lan_addresses() -> list[str]:
