@@ -11,8 +11,8 @@ a stretch at a time (`InProcess.stepped`: the learning environments, replay). `c
 one place that says which processes' digests make the match's. Also here: `arena up`'s compose
 files (compose.py) and a match in a process of its own (child.py, `python -m arena.match`).
 
-May import every package below it (processes and down); imported by tools.review,
-tools.experiments, scenarios, learn and the command line, never by them in turn."""
+May import every package below it (processes and down); imported by review, experiments,
+scenarios, learn and the command line, never by them in turn."""
 
 from __future__ import annotations
 

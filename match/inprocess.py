@@ -51,7 +51,7 @@ class Stepped:
     `play()` plays it to the end (what `play_match` does); a caller that pauses the match drives
     the tasks itself and runs them a stretch at a time with `run()` (learn/match.py stops where a
     learner needs an action), or builds `only` some processes and feeds them recorded inputs
-    (tools/review/replay.py). `match`: the key prefix (never part of a digest)."""
+    (review/replay.py). `match`: the key prefix (never part of a digest)."""
 
     def __init__(
         self,

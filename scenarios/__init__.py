@@ -10,6 +10,9 @@ expectations that must come true. The stable API:
   its `scenario` field carries the start and the steps, which the engine and
   the referee apply at their ticks (processes/director.py), on either engine;
 * `run_one(scenario, seed, engine) -> Verdict`: play and judge one run.
+
+May import arena.match, arena.experiments (its benchmark's table) and every package
+below them; imported by learn (a scenario's reset) and the CLI.
 """
 
 from arena.scenarios.model import Scenario, ScenarioError, discover, load, load_all

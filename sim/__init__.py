@@ -2,4 +2,4 @@
 drive (drive.py) and the robots' noisy sensors (sensors.py). No transport and
 no clock: the engine process calls it once per tick. May import
 `arena.navigation`, `arena.runtime` and `arena.schemas`; imported by
-`arena.processes` and `arena.tools`."""
+`arena.processes` and the packages above it."""

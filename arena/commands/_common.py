@@ -105,7 +105,7 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
     each. A void match (match/faults.py) exits 1 with one line naming the cause.
     """
     from arena.match import faults
-    from arena.tools.review import report
+    from arena.review import report
 
     if as_json:
         printed = match.to_dict()

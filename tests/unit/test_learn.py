@@ -171,7 +171,7 @@ def test_docs_learning_md_lists_every_observation_part_and_discrete_action():
 
 
 def test_a_tournament_names_a_policy_files_matches_by_its_file_name():
-    from arena.tools.experiments.fixtures import Fixture
+    from arena.experiments.fixtures import Fixture
 
     fx = Fixture(3, "policy:/runs/x/keeper.pkl", "advance-dynamic", 2, "policy:/runs/x/keeper.pkl", "AD", 1)
     assert fx.id == "003-policy-keeper.pkl-AD-leg02"

@@ -16,7 +16,7 @@ def test_a_lone_router_does_not_sleep_before_it_starts():
 
 
 def test_bench_throughput_reports_both_start_ups_with_their_definitions():
-    from arena.tools.experiments import throughput
+    from arena.experiments import throughput
 
     def run(rtf, command, play_match):
         return {

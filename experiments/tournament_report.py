@@ -10,8 +10,8 @@ from dataclasses import asdict
 from itertools import combinations
 from pathlib import Path
 
-from arena.tools.experiments.fixtures import Result, plural, short, write_atomic
-from arena.tools.experiments.ratings import coverage, ratings, standings
+from arena.experiments.fixtures import Result, plural, short, write_atomic
+from arena.experiments.ratings import coverage, ratings, standings
 
 
 def show_value(value) -> str:
@@ -199,7 +199,7 @@ def report(
 def print_summary(summary: dict) -> None:
     from rich.table import Table
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     c = make_console()
     t = Table(title="standings (3/1/0; by P, GD, GF)")

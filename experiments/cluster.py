@@ -42,7 +42,7 @@ from arena.runtime.config import ConfigError
 from arena.runtime.version import PACKAGES
 
 if TYPE_CHECKING:
-    from arena.tools.experiments.tournament import TournamentOptions
+    from arena.experiments.tournament import TournamentOptions
 
 # CPUs a match needs, by engine: the distributed engine runs ~11 processes
 # that keep about two cores busy; the in-process engine is one thread.
@@ -285,8 +285,8 @@ def _shutdown(ray) -> None:
 
 def _play(opts: TournamentOptions, runner, todo: list, on_result):
     """(ray, interrupted); Ray is shut down here only if this raises."""
-    from arena.tools.experiments import tournament as T
-    from arena.tools.experiments.matches import default_jobs
+    from arena.experiments import tournament as T
+    from arena.experiments.matches import default_jobs
 
     cpus = task_cpus(opts.engine)
     jobs = opts.jobs or default_jobs()
@@ -340,7 +340,7 @@ def _play(opts: TournamentOptions, runner, todo: list, on_result):
 
 def finish(runner, fx, attempt: int, got: dict):
     """The Result of one attempt, written to --out; None if the match is to be played again."""
-    from arena.tools.experiments.fixtures import Result, void_reason, write_atomic
+    from arena.experiments.fixtures import Result, void_reason, write_atomic
 
     log = runner.logs_dir / f"{fx.id}.log"
     reason = got.get("reason", "")

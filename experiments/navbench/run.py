@@ -8,14 +8,14 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from arena.experiments.navbench.console import print_report
+from arena.experiments.navbench.loader import load
+from arena.experiments.navbench.minima import run_local_minimum
+from arena.experiments.navbench.plots import write_plots
+from arena.experiments.navbench.report import Report
+from arena.experiments.navbench.spec import BenchSpec, Clock
+from arena.experiments.navbench.trials import Trial, run_trial
 from arena.runtime.config import ConfigError
-from arena.tools.experiments.navbench.console import print_report
-from arena.tools.experiments.navbench.loader import load
-from arena.tools.experiments.navbench.minima import run_local_minimum
-from arena.tools.experiments.navbench.plots import write_plots
-from arena.tools.experiments.navbench.report import Report
-from arena.tools.experiments.navbench.spec import BenchSpec, Clock
-from arena.tools.experiments.navbench.trials import Trial, run_trial
 
 
 def run_bench(
@@ -89,7 +89,7 @@ def main(
         out = Path(plots)
         if out.exists() and not out.is_dir():
             raise ConfigError(f"--plots {plots}: exists and is not a directory")
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     err = make_console(stderr=True)
     with Progress(

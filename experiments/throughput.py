@@ -32,9 +32,9 @@ from typing import TYPE_CHECKING
 
 from msgspec import UNSET
 
+from arena.experiments.matches import default_jobs
 from arena.match import child
-from arena.tools.console import console as make_console
-from arena.tools.experiments.matches import default_jobs
+from arena.review.console import console as make_console
 
 if TYPE_CHECKING:
     from arena.runtime.config import MatchConfig

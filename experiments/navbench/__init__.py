@@ -35,14 +35,14 @@ rows and tables), `plots.py` (trajectory plots), `run.py` (the bench and
 `arena bench nav`).
 """
 
-from arena.tools.experiments.navbench.console import print_report
-from arena.tools.experiments.navbench.loader import builtin_text, load
-from arena.tools.experiments.navbench.minima import run_local_minimum
-from arena.tools.experiments.navbench.plots import write_plots
-from arena.tools.experiments.navbench.report import Report, method_rows, minima_rows, results_rows, timing
-from arena.tools.experiments.navbench.run import main, run_bench, select, work_units
-from arena.tools.experiments.navbench.spec import BenchSpec, LocalMinimum, Scenario, ScenarioError, Scheme
-from arena.tools.experiments.navbench.trials import Trial, run_trial, trial_rng
+from arena.experiments.navbench.console import print_report
+from arena.experiments.navbench.loader import builtin_text, load
+from arena.experiments.navbench.minima import run_local_minimum
+from arena.experiments.navbench.plots import write_plots
+from arena.experiments.navbench.report import Report, method_rows, minima_rows, results_rows, timing
+from arena.experiments.navbench.run import main, run_bench, select, work_units
+from arena.experiments.navbench.spec import BenchSpec, LocalMinimum, Scenario, ScenarioError, Scheme
+from arena.experiments.navbench.trials import Trial, run_trial, trial_rng
 
 __all__ = [
     "BenchSpec",

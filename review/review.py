@@ -10,7 +10,7 @@ frames, link statistics and timing from the processes' Summaries.
 
 A truncated recording (the recorder was killed) is reviewed up to where it
 ends, and the report says so. `--plots DIR` adds PNG charts and an animated
-GIF (tools/review/plots.py and tools/review/animation.py).
+GIF (review/plots.py and review/animation.py).
 """
 
 from __future__ import annotations
@@ -24,10 +24,10 @@ from rich.table import Table
 
 from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import Recording, RecordingError, load
+from arena.review import animation
+from arena.review import plots as pictures
+from arena.review.console import console as make_console
 from arena.schemas.messages import Referee, World
-from arena.tools.console import console as make_console
-from arena.tools.review import animation
-from arena.tools.review import plots as pictures
 
 TEAM_COLOURS = {"a": "#00bfff", "b": "#ff1abf"}  # MSL cyan and magenta, as in the Foxglove scene
 
@@ -196,7 +196,7 @@ def _draw_field(ax, cfg, grass: bool = True) -> None:
 def write_plots(rec: Recording, review: dict, out_dir: str, goalkeepers: bool = False) -> list[str]:
     """PNG charts and an animated GIF of the match; returns the paths written.
 
-    Trajectories and heatmaps are tools/review/plots.py's; `goalkeepers` puts them in the heatmaps.
+    Trajectories and heatmaps are review/plots.py's; `goalkeepers` puts them in the heatmaps.
     """
     import matplotlib
 
@@ -260,7 +260,7 @@ def main(
         if plots:
             review["plots"] = write_plots(rec, review, plots, goalkeepers)
         if html:
-            from arena.tools.review.replay_page import write_page
+            from arena.review.replay_page import write_page
 
             try:
                 review["html"] = write_page(rec, html)

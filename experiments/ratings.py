@@ -7,7 +7,7 @@ import math
 import random
 from dataclasses import replace
 
-from arena.tools.experiments.fixtures import Result, plural, short
+from arena.experiments.fixtures import Result, plural, short
 
 
 def standings(results: list[Result], teams: list[str]) -> list[dict]:

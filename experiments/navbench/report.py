@@ -6,8 +6,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from arena.tools.experiments.navbench.metrics import _avg_iterations, _free, _median_us, _ordered, _safe
-from arena.tools.experiments.navbench.spec import (
+from arena.experiments.navbench.metrics import _avg_iterations, _free, _median_us, _ordered, _safe
+from arena.experiments.navbench.spec import (
     FSFM_BUDGET_US,
     METHODS,
     PAPER_FIS_OVERHEAD,
@@ -15,7 +15,7 @@ from arena.tools.experiments.navbench.spec import (
     PAPER_SFM_MS,
     BenchSpec,
 )
-from arena.tools.experiments.navbench.trials import Trial
+from arena.experiments.navbench.trials import Trial
 
 
 @dataclass

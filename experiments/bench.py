@@ -16,8 +16,8 @@ from rich.markup import escape
 from rich.table import Table
 
 from arena.match import play, zygote
+from arena.review.console import console as make_console
 from arena.runtime.config import MatchConfig
-from arena.tools.console import console as make_console
 
 
 def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import statistics
 from collections.abc import Iterable
 
-from arena.tools.experiments.navbench.spec import ORDER
-from arena.tools.experiments.navbench.trials import Trial
+from arena.experiments.navbench.spec import ORDER
+from arena.experiments.navbench.trials import Trial
 
 
 def _median_us(ns: Iterable[int]) -> float | None:

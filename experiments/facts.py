@@ -10,7 +10,7 @@ World/Referee streams (`arena.recording.analysis.measure`, which also serves
 summary; `--home AD --away BS` picks the strategies. `--round-robin AD,AS,BD,BS
 --legs 4` plays every pairing `legs` times, home and away alternating, and
 prints the paper's Table 2 and the robot 1 / robot 2 coverage ratio (Fig. 9),
-with the tournament's own table code (tools/experiments/tournament.py).
+with the tournament's own table code (experiments/tournament.py).
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ from itertools import combinations
 
 import msgspec
 
+from arena.experiments import facts_table, pools
 from arena.match import play
 from arena.recording.analysis.facts import MatchFacts, measure
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.schemas.messages import Referee, World
-from arena.tools.experiments import facts_table, pools
 
 
 def match_facts(cfg: MatchConfig) -> MatchFacts:
@@ -45,7 +45,7 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
     One match is played in this process: a spawned worker imported the engine again (~0.5 s of CPU)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     console, bar_shown = make_console(stderr=True), progress and sys.stderr.isatty()
     if len(cfgs) == 1:
@@ -57,7 +57,7 @@ def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = F
     columns = (TextColumn("[bold]facts[/]"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     context = multiprocessing.get_context("spawn")
     pool, stopped = ProcessPoolExecutor(workers or min(len(cfgs), os.cpu_count() or 1), mp_context=context), True
-    try:  # Ctrl-C or SIGTERM: the workers are killed, not waited for (tools/experiments/pools.py)
+    try:  # Ctrl-C or SIGTERM: the workers are killed, not waited for (experiments/pools.py)
         futures = {pool.submit(match_facts, cfg): cfg for cfg in cfgs}
         with Progress(*columns, console=console, disable=not bar_shown) as bar:
             task = bar.add_task("m", total=len(cfgs))
@@ -77,8 +77,8 @@ def round_robin(
 ) -> tuple[list, list[MatchFacts]]:
     """Every pairing `legs` times, home and away alternating, matches like `every`, in-process;
     returns (Results, facts)."""
+    from arena.experiments.fixtures import Result
     from arena.runtime import seeds
-    from arena.tools.experiments.fixtures import Result
 
     fixtures = []
     for first, second in combinations(strategies, 2):

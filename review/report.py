@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 from rich.table import Table
 
-from arena.tools.console import console as make_console
+from arena.review.console import console as make_console
 
 if TYPE_CHECKING:
     from arena.match import MatchResult

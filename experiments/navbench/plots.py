@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from arena.tools.experiments.navbench.metrics import _safe
-from arena.tools.experiments.navbench.report import Report
-from arena.tools.experiments.navbench.spec import METHODS, Scheme
+from arena.experiments.navbench.metrics import _safe
+from arena.experiments.navbench.report import Report
+from arena.experiments.navbench.spec import METHODS, Scheme
 
 METHOD_COLOURS = {"apf": "tab:red", "sfm": "tab:orange", "f-sfm": "goldenrod", "mapf": "tab:purple"}
 

@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
+from arena.experiments.navbench.spec import Clock, LocalMinimum
+from arena.experiments.navbench.trials import Trial, World
 from arena.navigation import NAVIGATORS, diffdrive
 from arena.schemas.messages import Cmd
-from arena.tools.experiments.navbench.spec import Clock, LocalMinimum
-from arena.tools.experiments.navbench.trials import Trial, World
 
 
 def run_local_minimum(lm: LocalMinimum, method: str, params: Any, clock: Clock = time.perf_counter_ns) -> Trial:

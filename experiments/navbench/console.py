@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from arena.tools.experiments.navbench.report import Report, method_rows, minima_rows, results_rows, timing
-from arena.tools.experiments.navbench.spec import (
+from arena.experiments.navbench.report import Report, method_rows, minima_rows, results_rows, timing
+from arena.experiments.navbench.spec import (
     FSFM_BUDGET_US,
     METHODS,
     PAPER_FIS_OVERHEAD,
@@ -19,7 +19,7 @@ def print_report(r: Report, console: Any = None) -> None:
     from rich.table import Table
 
     if console is None:
-        from arena.tools.console import console as make_console
+        from arena.review.console import console as make_console
 
         console = make_console()
     rows = results_rows(r)

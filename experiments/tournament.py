@@ -24,10 +24,10 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from arena.experiments.fixtures import Result, load_results, schedule, short, write_atomic
+from arena.experiments.matches import Runner, play_local
+from arena.experiments.tournament_report import report, show_value
 from arena.runtime.config import MatchConfig
-from arena.tools.experiments.fixtures import Result, load_results, schedule, short, write_atomic
-from arena.tools.experiments.matches import Runner, play_local
-from arena.tools.experiments.tournament_report import report, show_value
 
 # Settings that decide what a match is: --resume refuses to mix results played with other values.
 BINDING = (
@@ -148,7 +148,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
     """Play (or resume) the tournament. Returns (summary, interrupted)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     strategies = list(opts.strategies)
     out = Path(opts.out)
@@ -156,7 +156,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
     if opts.resume:
         check_resume(out, setup)
     if opts.ray is not None:
-        from arena.tools.experiments import cluster
+        from arena.experiments import cluster
 
         cluster.preflight(opts)  # before anything is written: a failure leaves no empty tournament behind
     out.mkdir(parents=True, exist_ok=True)
@@ -202,7 +202,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
 
         try:
             if opts.ray is not None:
-                from arena.tools.experiments import cluster  # imports Ray; never without --ray
+                from arena.experiments import cluster  # imports Ray; never without --ray
 
                 interrupted = cluster.play(opts, runner, todo, arrived)
             else:
@@ -226,7 +226,7 @@ def run(opts: TournamentOptions) -> tuple[dict, bool]:
         )
     finally:
         if opts.ray is not None:
-            from arena.tools.experiments import cluster
+            from arena.experiments import cluster
 
             cluster.closed()  # Ray shut down in the background while the report was written
     summary["skipped"] = len(fixtures) - len(todo)

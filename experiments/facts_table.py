@@ -98,7 +98,7 @@ def summary(facts: list[MatchFacts]) -> list[str]:
         "strategy  sides  W  D  L  GF  GA  goals/side  shots  on-target  faced  saves  blocks  "
         "stuck-s/side  longest-stuck  corner-s/side  conceded-stuck  pushing  robot1/robot2"
     )
-    from arena.tools.experiments.fixtures import short
+    from arena.experiments.fixtures import short
 
     for s, r in sorted(per.items()):
         s = short(s)
@@ -150,7 +150,7 @@ def workloads(facts: list[MatchFacts]) -> dict[str, dict[str, dict[str, float]]]
 
 def workload_lines(facts: list[MatchFacts]) -> list[str]:
     """Where each outfield robot's metres go (per match, per strategy), every send-off and the pushing fouls."""
-    from arena.tools.experiments.fixtures import short
+    from arena.experiments.fixtures import short
 
     out = ["metres per match by team mode | Fig. 5 area | activity (arena.recording.analysis.workload):"]
     for s, per in workloads(facts).items():
@@ -189,8 +189,8 @@ def workload_lines(facts: list[MatchFacts]) -> list[str]:
 
 def round_robin_lines(results: list, facts: list[MatchFacts], names: list[str]) -> list[str]:
     """A round robin: one line per match, then the paper's Table 2 with the Fig. 9 coverage."""
-    from arena.tools.experiments.fixtures import short
-    from arena.tools.experiments.ratings import coverage, standings
+    from arena.experiments.fixtures import short
+    from arena.experiments.ratings import coverage, standings
 
     out = [
         f"{short(r.home):3s} {m.score[0]}:{m.score[1]} {short(r.away):3s}  seed {r.seed}"
@@ -222,7 +222,7 @@ def as_json(facts: list[MatchFacts], latency: int, seconds: float, results: list
         "seconds": round(seconds, 1),
     }
     if results is not None:
-        from arena.tools.experiments.ratings import coverage, standings
+        from arena.experiments.ratings import coverage, standings
 
         out["standings"] = standings(results, names)
         out["coverage"] = coverage(results, names)

@@ -16,14 +16,14 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from arena.experiments import pools
+from arena.experiments.fixtures import Fixture, Result, void_reason, write_atomic
 from arena.match import child
-from arena.tools.experiments import pools
-from arena.tools.experiments.fixtures import Fixture, Result, void_reason, write_atomic
 
 if TYPE_CHECKING:
+    from arena.experiments.tournament import TournamentOptions
     from arena.match import MatchResult
     from arena.runtime.config import MatchConfig
-    from arena.tools.experiments.tournament import TournamentOptions
 
 
 class Runner:

@@ -2,7 +2,7 @@
 
 One frame every FRAME_PERIOD seconds of play, FRAME_MS apart when played (5 x
 real time), WIDTH pixels wide. Every robot has its colour and marker of
-trajectories.png (tools/review/plots.py) and its number; the ball is orange and larger
+trajectories.png (review/plots.py) and its number; the ball is orange and larger
 when in the air. A header gives the score and the clock, a banner the last goal
 or restart, and a timeline strip under the field marks every goal and restart,
 half time and now, with a legend.
@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from arena.recording.analysis.timeline import last_mark, score_at, timeline
+from arena.review.plots import BALL, robot_colour, robot_marker
 from arena.schemas.messages import Referee, World
-from arena.tools.review.plots import BALL, robot_colour, robot_marker
 
 FRAME_PERIOD = 0.5  # [s] of play between two frames
 FRAME_MS = 100  # [ms] between two frames when the GIF plays

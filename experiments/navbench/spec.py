@@ -10,7 +10,7 @@ import msgspec
 
 from arena.runtime.config import ConfigError, RobotParams
 
-BUILTIN = "navbench.toml"  # package data of arena.tools.experiments.navbench
+BUILTIN = "navbench.toml"  # package data of arena.experiments.navbench
 
 
 METHODS = ("apf", "sfm", "f-sfm", "mapf")

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from arena.experiments.navbench.spec import PARK_Y, Clock, Scenario, Scheme
 from arena.navigation import NAVIGATORS, pid
 from arena.navigation.frames import field_to_robot, robot_to_field
 from arena.runtime.config import MatchConfig, RobotParams, RulesParams, SensorParams, TimingParams
@@ -18,7 +19,6 @@ from arena.schemas.messages import Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics
 from arena.sim.sensors import sense
-from arena.tools.experiments.navbench.spec import PARK_Y, Clock, Scenario, Scheme
 
 
 class World:

@@ -9,10 +9,8 @@ from typing import Any
 
 import msgspec
 
-from arena.navigation import NAVIGATORS, PARAMS
-from arena.sim.drive import Drive
-from arena.tools.experiments.navbench.checks import _check_timing, _merge, _on_field, _override, _robot, _unique
-from arena.tools.experiments.navbench.spec import (
+from arena.experiments.navbench.checks import _check_timing, _merge, _on_field, _override, _robot, _unique
+from arena.experiments.navbench.spec import (
     BUILTIN,
     BenchFile,
     BenchSpec,
@@ -21,10 +19,12 @@ from arena.tools.experiments.navbench.spec import (
     ScenarioError,
     Scheme,
 )
+from arena.navigation import NAVIGATORS, PARAMS
+from arena.sim.drive import Drive
 
 
 def builtin_text() -> str:
-    return resources.files("arena.tools.experiments.navbench").joinpath(BUILTIN).read_text(encoding="utf-8")
+    return resources.files("arena.experiments.navbench").joinpath(BUILTIN).read_text(encoding="utf-8")
 
 
 def load(path: str | Path | None = None) -> BenchSpec:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from arena.experiments.navbench.spec import ScenarioError
 from arena.runtime import config as runtime_config
 from arena.runtime.config import RobotParams
 from arena.sim.drive import Drive
-from arena.tools.experiments.navbench.spec import ScenarioError
 
 
 def _robot(preset: str, overrides: dict[str, Any], where: str) -> RobotParams:
