@@ -2,7 +2,7 @@
 
 Every pairing of the strategies plays `legs` matches, alternating home and
 away, each with a seed derived from the tournament seed. Every match is a full,
-isolated `arena match` process group; `--jobs` of them run at once. Each
+isolated match process group (`python -m arena.match`); `--jobs` of them run at once. Each
 result is written atomically to `<out>/matches/<id>.json` as soon as it is in,
 so `--resume` skips what is done, Ctrl-C keeps it, and a crashed match (retried
 once) is recorded as failed with its reason instead of corrupting the tables.

@@ -98,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"{flag} does not apply to arena bench {args.what} (it takes {takes} and --json)")
     if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
         base = match_config(args, seed=False)  # --seed is nav's
-        if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
+        if args.what == "throughput":  # its matches are processes of their own: a bad name would fail in each
             strategy = registry.resolve_name(args.strategy)
     if args.what == "record":
         return bench.bench_record(base, args.runs, args.json)
