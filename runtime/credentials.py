@@ -141,11 +141,11 @@ class Secrets:
         """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
 
         `more`: zenoh settings added to some principals' fragments (top-level keys),
-        e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`).
+        e.g. the launcher's own peers' `qos` (match/launcher.py, `relay_safe`).
         `launched`: the principals `arena match` starts itself, whose identity it holds for them
-        (`metadata.arena.launched`; the match gives them their identity by OS pid, tools/launch/claims.py).
+        (`metadata.arena.launched`; the match gives them their identity by OS pid, match/claims.py).
         `lend`: principal -> the other principals whose keys its fragment holds too (the live viewer
-        of a local operator gets the operator's, tools/launch/launcher.py)."""
+        of a local operator gets the operator's, match/launcher.py)."""
         private_directory(directory, create=True)
         out = {}
         for p in principals(self.processes):

@@ -131,10 +131,11 @@ def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
     return out
 
 
-def load(path: str) -> MatchConfig:
-    """Read and validate FILE.toml; ConfigError naming the file and the bad key."""
+def load(path: str, under: dict[str, Any] | None = None) -> MatchConfig:
+    """Read and validate FILE.toml; ConfigError naming the file and the bad key. `under`: values of
+    the top-level keys (`TOP`) that apply where the file has none (a command's own defaults)."""
     data = userfile.load_toml(path, "--config")  # regular, bounded, UTF-8, nesting bounded
-    raw = to_dict(data, path)
+    raw = {**{k: v for k, v in (under or {}).items() if k in TOP}, **to_dict(data, path)}
     try:
         cfg = MatchConfig.from_dict(raw)
     except ConfigError as exc:

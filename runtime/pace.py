@@ -9,7 +9,8 @@ lockstep loop yields `(pacer, k)`, and the pacer is ready for tick k when
 
 The pacer only ever delays a tick; what the engine computes and sends at tick
 k is the same whenever it runs, so pacing and pausing never change a digest.
-The wall clock is read for waiting only, never for behaviour.
+The wall clock (the engine's `Clock`, runtime/clock.py) is read for waiting
+only, never for behaviour.
 
 The viewer sends `Control` frames on `arena/<m>/control`, with its MAC: the
 engine takes only the viewer's (processes/engine.py), and hands them to
@@ -34,9 +35,9 @@ from __future__ import annotations
 import logging
 import math
 import threading
-import time
 from collections.abc import Callable
 
+from arena.runtime.clock import MONOTONIC, Clock
 from arena.runtime.lockstep import EVERY_TICK
 from arena.schemas.messages import Control
 
@@ -95,7 +96,15 @@ class Pacer:
     paired = False  # a held tick is a wait like any other: the engine puts its held `sense` batches first
     schedule = EVERY_TICK  # the Reactor's bound on a wait names the tick waited for (runtime/drivers.py `_look`)
 
-    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None, timeout: float = math.inf):
+    def __init__(
+        self,
+        dt: float,
+        pace: float,
+        log: logging.Logger | None = None,
+        timeout: float = math.inf,
+        clock: Clock = MONOTONIC,
+    ):
+        self.clock = clock  # the wall time it paces to (a test's ManualClock)
         self.dt = dt
         self.pace = pace
         self.timeout = timeout  # [s] wall: the longest pause in pull mode (`sync`); the Reactor bounds its own waits
@@ -131,7 +140,7 @@ class Pacer:
                 self._due = None
                 return False
             if self.pace > 0.0 and not self.paused:
-                now = time.monotonic()
+                now = self.clock.monotonic()
                 if self._anchor is None:
                     self._anchor = (now, k)
                 t0, k0 = self._anchor
@@ -152,20 +161,20 @@ class Pacer:
 
     def sync(self, k: int) -> None:
         """Pull mode: block until tick k may play, at most `timeout` seconds (then `give_up`)."""
-        since = time.monotonic()
+        since = self.clock.monotonic()
         while True:
             if self._pending is not None:
                 while (raw := self._pending()) is not None:
                     (self._take or self.control_raw)(raw)
             if self.ready(k):
                 return
-            if time.monotonic() - since >= self.timeout:
+            if self.clock.monotonic() - since >= self.timeout:
                 self.give_up(f"held for {self.timeout:g} s before tick {k}")
                 continue
             with self._cond:
-                left = POLL_S if self._due is None else min(POLL_S, self._due - time.monotonic())
+                left = POLL_S if self._due is None else min(POLL_S, self._due - self.clock.monotonic())
                 if left > 0:
-                    self._cond.wait(left)
+                    self.clock.wait_on(self._cond, left)
 
     def drain(self) -> None:
         """Nothing to take in: control frames come through `pull_from` or `control`."""
@@ -233,11 +242,11 @@ class Pacer:
                     return
                 due = self._due
                 if due is None:
-                    self._cond.wait(0.5)
+                    self.clock.wait_on(self._cond, 0.5)
                     continue
-                left = due - time.monotonic()
+                left = due - self.clock.monotonic()
                 if left > 0:
-                    self._cond.wait(left)
+                    self.clock.wait_on(self._cond, left)
                     continue
                 self._due = None
             self._poke()

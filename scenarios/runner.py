@@ -11,11 +11,9 @@ its 95 % Wilson score interval, and the scenario's verdict (`min_pass`)."""
 
 from __future__ import annotations
 
-import hashlib
 import math
 import shlex
 import sys
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -169,46 +167,21 @@ def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: 
     )
 
 
-def combined_digest(cfg, digests: dict[str, str]) -> str:
-    """The match digest of `arena match --json` (tools/launch/result.py `assemble`): every process's, in order."""
-    combined = hashlib.blake2b(digest_size=16)
-    for p in cfg.processes():
-        name = str(p)
-        if name in digests and p.kind not in ("recorder", "refbox", "viewer"):
-            combined.update(name.encode() + b"=" + digests[name].encode() + b";")
-    return combined.hexdigest()
+def _play(sc: Scenario, seed: int, engine: str, record: str):
+    from arena.match import Processes, play
 
-
-def _inprocess(sc: Scenario, seed: int, record: str):
-    from arena.tools.launch.inprocess import play_in_process
-
-    cfg = sc.config(seed)
-    summaries, frames = play_in_process(cfg, watch=("world", "referee", "events"), record=record)
+    # An --external process is started by hand: the launcher says the command to type there.
+    announce = lambda text: print(text, file=sys.stderr, flush=True)
+    on = Processes(strict=True, announce=announce) if engine == "processes" else engine
+    events = "events" if engine == "inprocess" else "engine/events"  # a key here, a recording's topic there
+    result = play(sc.config(seed), engine=on, record=record, watch=("world", "referee", events))
     wdec = msgspec.msgpack.Decoder(World).decode
     rdec = msgspec.msgpack.Decoder(Referee).decode
     edec = msgspec.msgpack.Decoder(EngineEvents).decode
-    worlds = [wdec(p) for p in frames["world"]]
-    referees = [rdec(p) for p in frames["referee"]]
-    events = [edec(p) for p in frames["events"]]
-    digests = {name: s.digest for name, s in summaries.items() if name != "recorder"}
-    return worlds, referees, digests, combined_digest(cfg, digests), events
-
-
-def _processes(sc: Scenario, seed: int, record: str):
-    from arena.recording.reader import load
-    from arena.tools.launch.launcher import play_match
-
-    with tempfile.TemporaryDirectory(prefix="arena-scenario-") as tmp:
-        path = record or str(Path(tmp) / "run.mcap")
-        # An --external process is started by hand: the launcher says the command to type there.
-        announce = lambda text: print(text, file=sys.stderr, flush=True)
-        result = play_match(sc.config(seed), record=path, strict=True, announce=announce)
-        rec = load(path, keep={"world", "referee", "engine/events"})
-        worlds = rec.decoded("world", World)
-        referees = rec.decoded("referee", Referee)
-        events = rec.decoded("engine/events", EngineEvents)
-    digests = {k: v for k, v in result.process_digests.items() if k != "recorder"}
-    return worlds, referees, digests, result.digest, events
+    worlds = [wdec(p) for p in result.frames["world"]]
+    referees = [rdec(p) for p in result.frames["referee"]]
+    evs = [edec(p) for p in result.frames[events]]
+    return worlds, referees, dict(result.process_digests), result.digest, evs
 
 
 def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:
@@ -218,9 +191,8 @@ def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = ""
     """
     if sc.spec.play.external and engine != "processes":
         raise ValueError(f"{sc.path}: scenario {sc.name!r} has external processes: it needs --engine processes")
-    play = _inprocess if engine == "inprocess" else _processes
     t0 = time.perf_counter()
-    worlds, referees, digests, total, events = play(sc, seed, record)
+    worlds, referees, digests, total, events = _play(sc, seed, engine, record)
     trace = _trace(sc, worlds, referees, digests, events)
     failures = []
     end = run_end(resolve_draws(sc.spec, seed)[0], sc.dt)[0]  # time_limit, or the match's end if sooner

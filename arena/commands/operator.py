@@ -70,9 +70,9 @@ def parse_actions(texts: list[str]) -> list:
 
 def _open(net, credentials: str | None):
     """The session; a router that listens but refuses it is ConfigError with the cause, as `arena run` says it."""
+    from arena.match.run import refusal, refused_by
     from arena.runtime.session import EndpointError, open_session
     from arena.schemas.keys import OPERATOR_PRINCIPAL
-    from arena.tools.launch.run import refusal, refused_by
 
     try:
         return open_session(net)
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         actions = parse_actions(args.actions)
         base, mode, sign = "", args.mode, None
         if args.credentials:
-            from arena.tools.launch.run import load_credentials
+            from arena.match.run import load_credentials
 
             base, asked, keyring = load_credentials(args.credentials, OPERATOR_PRINCIPAL)
             mode = asked or mode

@@ -119,8 +119,8 @@ def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
     if args.record and (len(scenarios) != 1 or len(seeds) != 1):
         raise ScenarioError("--record needs one scenario (--name) and one seed (--seed)")
     if args.record:  # as arena match --record: a new file, never an existing recording overwritten
+        from arena.match.run import record_path
         from arena.runtime.config import ConfigError
-        from arena.tools.launch.run import record_path
 
         try:
             Path(args.record).expanduser().parent.mkdir(parents=True, exist_ok=True)
@@ -186,7 +186,7 @@ def run(args: argparse.Namespace) -> int:
 
 def play_all(items: list, jobs: int, done) -> tuple[list, KeyboardInterrupt | None]:
     """Every run, `done(verdict)` as each ends; Ctrl-C (or SIGTERM) stops and returns the runs finished."""
-    from arena.tools.experiments import pools
+    from arena.experiments import pools
 
     verdicts: list = []
     try:

@@ -32,11 +32,11 @@ import threading
 import pytest
 import zenoh
 
+from arena.match.inprocess import play_match
 from arena.recording.reader import load
 from arena.runtime.config import MatchConfig
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
-from arena.tools.launch.inprocess import play_match
 from tests.integration.helpers import ARENA, descendants, free_port, wait_for
 from tests.integration.test_fuzz import CFG, GOLDEN, Launcher, stacks_after
 

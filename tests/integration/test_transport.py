@@ -112,7 +112,7 @@ def test_a_served_key_answers_an_ask_with_its_last_frame_and_nothing_before_one(
 
 
 def test_a_query_takes_only_the_answer_with_the_servers_mac_and_counts_every_other(tmp_path):
-    """How a process started by hand takes its configuration (tools/launch/run.py `fetch_config`): a
+    """How a process started by hand takes its configuration (match/run.py `fetch_config`): a
     stranger's queryable answered first, and its `"home": "policy:/some/file.pkl"` was played."""
     from arena.runtime.mac import Keyring, new_key
 
@@ -147,11 +147,11 @@ def test_a_process_with_the_engines_key_never_takes_a_strangers_configuration(tm
     """Only strangers answer: the process gives up, and says how many answers it ignored and why."""
     import pytest
 
+    from arena.match.run import fetch_config
     from arena.runtime.config import MatchConfig
     from arena.runtime.mac import Keyring, new_key
     from arena.runtime.node import StartupError
     from arena.schemas.keys import Keys
-    from arena.tools.launch.run import fetch_config
 
     keys = Keys("t")
     endpoint = f"unixsock-stream/{tmp_path}/c.sock"

@@ -1,4 +1,4 @@
-"""Issue 19 part 5: the trajectory and heatmap pictures' data (tools/review/plots.py)."""
+"""Issue 19 part 5: the trajectory and heatmap pictures' data (review/plots.py)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import math
 import numpy as np
 from matplotlib.colors import to_rgb
 
+from arena.review import plots
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RobotState, World
-from arena.tools.review import plots
 
 CFG = MatchConfig(half_time=1.0)  # 50 ticks a half
 
@@ -72,7 +72,7 @@ def test_the_heatmap_cell_grows_for_a_short_match():
     the 0.5 m cells, a patchwork of single strokes: the cell follows the amount of play."""
     import numpy as np
 
-    from arena.tools.review.plots import MAX_CELL, MIN_CELL, cell_size
+    from arena.review.plots import MAX_CELL, MIN_CELL, cell_size
 
     def path(metres: float, step: float = 0.05):  # back and forth along x within the field
         s = np.arange(0.0, metres, step)

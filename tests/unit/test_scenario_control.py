@@ -1,6 +1,6 @@
 """Control as messages: teleports and referee overrides applied at a tick, inside the digest.
 
-processes/director.py (the engine's share), rules/referee_box.py `Forced` (the
+sim/director.py (the engine's share), rules/referee_box.py `Forced` (the
 referee's); played in process, where the digests are those of real processes.
 """
 
@@ -11,7 +11,7 @@ import math
 import msgspec
 import pytest
 
-from arena.processes.director import referee_steps
+from arena.match.inprocess import play_in_process
 from arena.rules.referee_box import Forced, RefereeState, Rules, process
 from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
 from arena.schemas.messages import (
@@ -24,7 +24,7 @@ from arena.schemas.messages import (
     TeleportRobot,
     World,
 )
-from arena.tools.launch.inprocess import play_in_process
+from arena.sim.director import referee_steps
 
 
 def play(steps, ticks=60, stage="FIRST_HALF", seed=3, **kw):
@@ -211,11 +211,11 @@ def _inbox(kinds):
     import logging
     import types
 
-    from arena.processes.director import OperatorInbox
     from arena.runtime.lockstep import Rejections
     from arena.runtime.mac import Keyring
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
+    from arena.sim.director import OperatorInbox
 
     bus = MemoryBus()
     rejections = Rejections(logging.getLogger("t"))
@@ -244,7 +244,7 @@ def _inbox(kinds):
 def test_an_action_out_of_range_is_refused_with_its_reason_counted_and_the_rest_applies(action, why):
     """A NaN from a stranger, or 1e308 from the real operator, reached the physics, and the match's own
     recording then failed review."""
-    from arena.processes.director import check_action
+    from arena.sim.director import check_action
 
     assert why in check_action(MatchConfig(), action)
     inbox, put, rejections = _inbox((TeleportBall, TeleportRobot, RefereeOverride))

@@ -1,7 +1,7 @@
 """A ball put down out of play is called; teleports that land on a robot; robots driven by a step.
 
 docs/rules.md rules 10-13 for a ball at rest beyond a line, rule 22 for the
-penalty's placement; processes/director.py for `safely`, `roll`, unstacking and
+penalty's placement; sim/director.py for `safely`, `roll`, unstacking and
 `ControlRobot` (docs/scenarios.md)."""
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ import math
 import msgspec
 import pytest
 
+from arena.match.inprocess import play_in_process
 from arena.rules.setpieces import penalty_positions
 from arena.runtime.config import MatchConfig, ScenarioParams
 from arena.scenarios import ScenarioError, load, run_one
 from arena.schemas.messages import ControlRobot, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot, World
-from arena.tools.launch.inprocess import play_in_process
 
 HEAD = '[[scenario]]\nname = "{name}"\ntime_limit = {limit}\n[scenario.play]\nrobots = 2\n'
 

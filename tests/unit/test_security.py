@@ -38,7 +38,7 @@ def test_robot_a1_puts_only_on_its_cmd_and_report():
         "ack/robot/a/1",
     }
     # its liveliness, and the tokens that announce its long lockstep waits (runtime/drivers.py Reactor)
-    # ... the token that holds its identity (one process per identity: tools/launch/claims.py), and the
+    # ... the token that holds its identity (one process per identity: match/claims.py), and the
     # tokens that say it saw forged or conflicting frames on a key (the launcher prints them)
     assert _rel(perms["liveliness_token/ingress"]) == {
         "alive/robot/a/1",
@@ -93,7 +93,7 @@ def test_fragments_hold_user_password_tls_root_and_keys(tmp_path):
     engine = set(load_fragment(str(paths["engine"]))["metadata"]["arena"]["keys"])
     assert engine == {"engine", "referee", "viewer", "operator", *(f"robot/{t}/{n}" for t in "ab" for n in range(3))}
     viewer = set(load_fragment(str(paths["viewer"]))["metadata"]["arena"]["keys"])
-    assert "operator" not in viewer, "the operator's key is lent to a local viewer only (tools/launch/launcher.py)"
+    assert "operator" not in viewer, "the operator's key is lent to a local viewer only (match/launcher.py)"
     lent = s.keyring("viewer", ("operator",))
     assert lent.signer("arena/m1/operator", sender="operator") is not None and lent.own == s.mac_keys["viewer"]
     insecure = Secrets.new("m1", 3, NAMES, secure=False).fragment("robot/b/1")
@@ -141,7 +141,7 @@ def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_
 @pytest.mark.parametrize("lent", [False, True])
 def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_key(lent):
     """A Foxglove client published `/operator` and the viewer put it as is: a stranger's goal counted.
-    Only a viewer started for a local operator holds the operator's key (tools/launch/launcher.py
+    Only a viewer started for a local operator holds the operator's key (match/launcher.py
     `local_operator`) and signs with it; any other refuses the message, counted."""
     from arena.processes.viewer import ViewerNode
     from arena.runtime.config import MatchConfig, ProcessId
@@ -167,8 +167,8 @@ def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_
 
 
 def test_only_a_viewer_started_here_on_loopback_without_secure_is_lent_the_operators_key():
+    from arena.match.launcher import local_operator
     from arena.runtime.config import MatchConfig, ProcessId
-    from arena.tools.launch.launcher import local_operator
 
     live = MatchConfig(live=8765)
     assert local_operator(live, False, "127.0.0.1", set())
