@@ -41,9 +41,10 @@ from pettingzoo import ParallelEnv
 
 from arena.learn.match import SteppedMatch
 from arena.learn.rewards import GoalReward, Outcome
-from arena.runtime.config import MatchConfig, ProcessId
+from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 from arena.strategies import registry
-from arena.strategies.learned import DISCRETE, RecordedActions, View, obs_fields, observe, save_policy
+from arena.strategies.learned import DISCRETE, View, discrete_index, obs_fields, observe
+from arena.strategies.policy_file import save_recorded
 
 
 def agent_name(text: str) -> str:
@@ -75,9 +76,15 @@ class SoccerParallelEnv(ParallelEnv):
         config: MatchConfig | None = None,
     ):
         base = config or MatchConfig()
+        if isinstance(robots, bool) or not isinstance(robots, int) or not 1 <= robots <= 6:
+            raise ValueError(f"robots must be 1..6 a team, goalkeeper included, got {robots!r}")
+        if isinstance(half_time, bool) or not isinstance(half_time, int | float) or not 0 < half_time <= MAX_HALF_TIME:
+            raise ValueError(f"half_time must be in (0, {MAX_HALF_TIME:g}] seconds a half, got {half_time!r}")
         self.cfg = base.replace(
             home=registry.resolve_name(home), away=registry.resolve_name(away), robots=robots, half_time=half_time
         )
+        if isinstance(agents, str):  # "a/1": one agent, not the characters of its name
+            agents = [agents]
         names = [agent_name(a) for a in agents]
         if not names or len(set(names)) != len(names):
             raise ValueError(f"agents must be distinct robots, got {list(agents)}")
@@ -152,6 +159,7 @@ class SoccerParallelEnv(ParallelEnv):
         m = self.match
         if m is None or not self.agents:
             raise RuntimeError("step() before reset(), or after the episode ended")
+        self._check(actions)
         for a in self.agents:
             self.recorded[a].append(np.array(actions[a]))  # a copy: callers may reuse one array
         m.act(actions)
@@ -192,6 +200,33 @@ class SoccerParallelEnv(ParallelEnv):
     def close(self) -> None:
         self.match = None
 
+    def _check(self, actions: dict[str, Any]) -> None:
+        """ValueError, naming the agent, for an action that is missing, of the wrong shape, not finite or
+        out of range (a NaN would play as full reverse, a discrete -1 as the last move)."""
+        if not isinstance(actions, dict):
+            raise ValueError(f"step() takes a dict of actions by agent, got {type(actions).__name__}")
+        missing = [a for a in self.agents if a not in actions]
+        if missing:
+            raise ValueError(f"no action for {', '.join(missing)} (step() needs one for every agent: {self.agents})")
+        for a in self.agents:
+            act = actions[a]
+            if self.discrete:
+                try:
+                    discrete_index(act)
+                except ValueError as exc:
+                    raise ValueError(f"{a}: {exc}") from None
+                continue
+            try:
+                v = np.asarray(act, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ValueError(f"{a}: a box action is 4 numbers in [-1, 1], got {act!r:.80}") from None
+            if v.shape != (4,):
+                raise ValueError(f"{a}: a box action has shape (4,) (vx, vy, omega, kick), got {v.shape}")
+            if not np.isfinite(v).all():
+                raise ValueError(f"{a}: a box action's numbers must be finite, got {v.tolist()}")
+            if (np.abs(v) > 1.0).any():
+                raise ValueError(f"{a}: a box action's numbers are in [-1, 1], got {v.tolist()}")
+
     # -------------------------------------------------------------- extras
     def digests(self) -> dict[str, str]:
         """Every process's digest so far: after a whole episode, those of `arena match` (docs/learning.md)."""
@@ -200,9 +235,9 @@ class SoccerParallelEnv(ParallelEnv):
     def save_actions(self, team: str, path) -> str:
         """A policy file that replays this episode's actions of `team`'s learners, the rest of the team
         by its strategy: `arena match --home policy:PATH` (team a) plays this episode again."""
-        mine = {int(a.split("/")[1]): RecordedActions(self.recorded[a]) for a in self.recorded if a[0] == team}
+        mine = {int(a.split("/")[1]): self.recorded[a] for a in self.recorded if a[0] == team}
         cfg = self.match.cfg if self.match is not None else self.cfg  # a scenario names its own strategies
-        return str(save_policy(path, mine, cfg.strategy_of(team), self.frame_skip, self.discrete, cfg.robots))
+        return str(save_recorded(path, mine, cfg.strategy_of(team), self.frame_skip, self.discrete, cfg.robots))
 
     def observe(self, agent: str) -> Any:
         return self._shape(observe(*self.match.seen(agent), self._views[agent]))

@@ -50,6 +50,28 @@ def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tru
     )
 
 
+class _AllowPickle(argparse.Action):
+    """`--allow-pickle`: from the moment it is parsed, this process and every process it starts load
+    pickle policy files (ARENA_ALLOW_PICKLE=1)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from arena.strategies.policy_file import allow_pickle
+
+        allow_pickle()
+        setattr(namespace, self.dest, True)
+
+
+def allow_pickle_flag(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--allow-pickle",
+        action=_AllowPickle,
+        nargs=0,
+        default=False,
+        help="load pickle policy files (policy:FILE.pkl): loading a pickle RUNS ANY CODE IT HOLDS, so only for "
+        "files you trust; an ONNX policy file needs no flag (docs/learning.md)",
+    )
+
+
 def every_match_latency(p: argparse.ArgumentParser) -> None:
     """`--perception-latency` of a command that plays many matches (tournament, facts)."""
     p.add_argument(

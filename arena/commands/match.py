@@ -8,7 +8,7 @@ import sys
 
 from arena.commands._common import ENGINE_FLAG, add_command, emit_match, one_line, seconds
 from arena.commands._live import add_live_flags, full_config
-from arena.commands._match_flags import add_match_flags
+from arena.commands._match_flags import add_match_flags, allow_pickle_flag
 from arena.commands._refbox_flags import add_refbox_flags, warn_unreachable_refbox
 from arena.runtime.config import ConfigError, MatchConfig
 
@@ -42,6 +42,7 @@ EXAMPLES = """examples:
 def add_parser(sub) -> None:
     m = add_command(sub, "match", "play one match, every process its own OS process, and print the score", EXAMPLES)
     add_match_flags(m, required=False)
+    allow_pickle_flag(m)
     m.add_argument(
         "--config",
         dest="config_file",

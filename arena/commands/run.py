@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from arena.commands._common import add_command, seconds
-from arena.commands._match_flags import add_match_flags, match_config
+from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
 from arena.runtime.config import KINDS, ConfigError
 
 EXAMPLES = """examples:
@@ -46,6 +46,7 @@ def add_parser(sub) -> None:
         help="robot, basestation: this computer's copy of the policy file the team plays (its strategy is "
         "policy:PATH, a path on the computer that started the match; docs/learning.md)",
     )
+    allow_pickle_flag(r)
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
     r.add_argument(
         "--credentials",

@@ -174,7 +174,7 @@ BAD = [
     (["config", "--check", "/nonexistent.toml"], "cannot read"),
     (["config", "--check", "{file}"], "not valid TOML"),
     (["match", "--config", "{file}"], "not valid TOML"),
-    (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
+    (["match", "--home", "policy:{file}", "--away", "BS"], "is not a valid ONNX model"),
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
     (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),

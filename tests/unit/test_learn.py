@@ -66,7 +66,7 @@ def test_an_episodes_actions_replayed_as_a_policy_strategy_give_the_envs_digests
     match: tests/integration/test_learn_deploy.py)."""
     env = SoccerParallelEnv(agents=["a/1", "a/2"], home="AD", away="BS", half_time=1.0, end_on_goal=False, frame_skip=3)
     digests, _ = play(env, seed=8)
-    path = env.save_actions("a", tmp_path / "actions.pkl")
+    path = env.save_actions("a", tmp_path / "actions.json")
     cfg = MatchConfig(seed=8, home=registry.resolve_name(f"policy:{path}"), away="basic-static", half_time=1.0)
     summaries, _ = play_in_process(cfg, watch=())
     assert {name: s.digest for name, s in summaries.items()} == digests
@@ -244,7 +244,7 @@ def test_a_policy_trained_on_two_robots_a_team_plays_a_3v3_match(tmp_path):
 
     size = sum(n for _, n, *_ in obs_fields(2))
     policy = LinearPolicy(np.zeros((4, size)), np.array([0.5, 0.0, 0.0, 0.0]))
-    path = save_policy(tmp_path / "p.pkl", {1: policy}, base="BS", robots=2)
+    path = save_policy(tmp_path / "p.onnx", {1: policy}, base="BS", robots=2)
     cfg = MatchConfig(seed=1, home=registry.resolve_name(f"policy:{path}"), away="basic-static", half_time=0.5)
     summaries, _ = play_in_process(cfg, watch=())  # a 69-number observation would fail the 4 x 57 weights
     assert summaries["robot/a/1"].tick == cfg.total_ticks
@@ -262,7 +262,7 @@ def test_the_learning_example_runs(tmp_path):
     assert r.returncode == 0, r.stderr
     result = json.loads((tmp_path / "results.json").read_text())
     assert set(result) >= {"trained", "untrained", "curve"} and (tmp_path / "learning-curve.png").stat().st_size
-    assert registry.resolve_name(f"policy:{tmp_path / 'policy.pkl'}").startswith("policy:/")
+    assert registry.resolve_name(f"policy:{tmp_path / 'policy.onnx'}").startswith("policy:/")
 
 
 PUSH = """
