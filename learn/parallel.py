@@ -47,6 +47,11 @@ from arena.strategies.learned import DISCRETE, View, discrete_index, obs_fields,
 from arena.strategies.policy_file import save_recorded
 
 
+def episode_seed(stream: np.random.SeedSequence) -> int:
+    """The next match seed (0 .. 2**63 - 1) of a stream: a fresh child's first 63 bits."""
+    return int(stream.spawn(1)[0].generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
 def agent_name(text: str) -> str:
     """ "a/1", "robot/a/1" -> "a/1"; ValueError for anything else."""
     pid = ProcessId.parse(text)
@@ -121,6 +126,7 @@ class SoccerParallelEnv(ParallelEnv):
         self._act_space = spaces.Discrete(len(DISCRETE)) if self.discrete else spaces.Box(-1.0, 1.0, (4,), np.float32)
         self.match: SteppedMatch | None = None
         self._seed = self.cfg.seed
+        self._stream: np.random.SeedSequence | None = None
         self.recorded: dict[str, list[Any]] = {}
         self.scenario = None
         self.verdict: dict[str, Any] | None = None
@@ -134,9 +140,16 @@ class SoccerParallelEnv(ParallelEnv):
 
     # ---------------------------------------------------------------- API
     def reset(self, seed: int | None = None, options: dict | None = None):
-        """Start the match of `seed` (the previous seed + 1 when None), or with `options={"scenario": S}`
+        """Start the match of `seed` (when None: the next of a stream of seeds that the last given seed, or
+        fresh entropy, began; the seed played is in the infos), or with `options={"scenario": S}`
         the run of scenario S (a file with one scenario, a (path, name) pair, or an `arena.scenarios.Scenario`)."""
-        self._seed = (self._seed + 1) % 2**63 if seed is None else int(seed) % 2**63
+        if seed is not None:
+            self._seed = int(seed) % 2**63
+            self._stream = np.random.SeedSequence(self._seed)
+        else:  # the next seed of the stream the last seed began, or of fresh entropy
+            if self._stream is None:
+                self._stream = np.random.SeedSequence()
+            self._seed = episode_seed(self._stream)
         cfg = self.cfg.replace(seed=self._seed)
         scenario = (options or {}).get("scenario")
         self.scenario = None if scenario is None else self._scenario(scenario)
@@ -147,6 +160,7 @@ class SoccerParallelEnv(ParallelEnv):
                     f"scenario {self.scenario.name!r} plays {cfg.robots} robots a team, this env {self.cfg.robots}"
                 )
         self.verdict: dict[str, Any] | None = None
+        self.last_outcomes: dict[str, Outcome] = {}  # the last step's, by team
         self.match = SteppedMatch(cfg, self.possible_agents, self.frame_skip, self.discrete, keep=bool(scenario))
         self.agents = list(self.possible_agents)
         self.recorded = {a: [] for a in self.agents}
@@ -166,9 +180,8 @@ class SoccerParallelEnv(ParallelEnv):
         m.advance()
         ga = m.score[0] - self._last_score[0]
         gb = m.score[1] - self._last_score[1]
-        progress, closing = 0.0, {"a": 0.0, "b": 0.0}
+        progress, closing = m.progress_a, {"a": 0.0, "b": 0.0}
         if m.ball is not None and self._last_ball is not None:
-            progress = (m.ball[0] - self._last_ball[0]) * m.attack_dir_a
             hl = m.cfg.field.length / 2
             for team, gx in (("a", hl * m.attack_dir_a), ("b", -hl * m.attack_dir_a)):
                 before = math.hypot(self._last_ball[0] - gx, self._last_ball[1])
@@ -184,9 +197,22 @@ class SoccerParallelEnv(ParallelEnv):
                 self.verdict = verdict
                 passed = verdict["passed"]
         out = {
-            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, closing["a"], passed),
-            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, closing["b"], passed),
+            team: Outcome(
+                m.tick,
+                team,
+                ga if team == "a" else gb,
+                gb if team == "a" else ga,
+                progress if team == "a" else -progress,
+                m.new_commands,
+                closing[team],
+                passed,
+                tuple(r.name for r in m.restarts if r.team == team),
+                tuple(r.name for r in m.restarts if r.team not in ("", team)),
+                sum(max(0.0, r.banked if team == "a" else -r.banked) for r in m.restarts if r.team not in ("", team)),
+            )
+            for team in ("a", "b")
         }
+        self.last_outcomes = out
         rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
         ended = bool(goal) or (decided and not over)  # a terminal state: a goal, or the scenario's verdict
         terms = {a: ended for a in self.agents}

@@ -39,13 +39,17 @@ class SoccerEnv(gymnasium.Env):
         return self.env.digests()
 
 
-def make_vector_env(n: int, asynchronous: bool = True, **options: Any) -> gymnasium.vector.VectorEnv:
+def make_vector_env(
+    n: int, asynchronous: bool = True, autoreset_mode: str = "NextStep", **options: Any
+) -> gymnasium.vector.VectorEnv:
     """`n` `SoccerEnv`s with these options, each in its own worker process (`asynchronous`: a
     `SoccerVectorEnv`, arena.learn.vector), or all in this one (Gymnasium's `SyncVectorEnv`).
 
-    `reset(seed=s)` seeds them s, s + 1, ..., s + n - 1."""
+    `autoreset_mode`: Gymnasium's `NEXT_STEP` (its default: every vector wrapper takes it) or `SAME_STEP`.
+    `reset(seed=s)`: every worker draws its episodes' seeds from its own stream (`SoccerVectorEnv`)."""
+    mode = gymnasium.vector.AutoresetMode(autoreset_mode)
     if asynchronous:
         from arena.learn.vector import SoccerVectorEnv
 
-        return SoccerVectorEnv(n, **options)
-    return gymnasium.vector.SyncVectorEnv([partial(SoccerEnv, **options) for _ in range(n)])
+        return SoccerVectorEnv(n, autoreset_mode=mode, **options)
+    return gymnasium.vector.SyncVectorEnv([partial(SoccerEnv, **options) for _ in range(n)], autoreset_mode=mode)

@@ -122,31 +122,97 @@ def test_the_vector_env_steps_its_workers_with_their_own_seeds():
     venv.close()
 
 
-def test_the_vector_env_in_worker_processes_plays_what_the_envs_play_here():
-    """Two workers through shared memory against two SoccerEnvs in this process, autoresets included."""
-    opts = dict(robot="a/1", home="AD", away="BS", half_time=0.3)
-    venv = make_vector_env(2, **opts)
-    here = [SoccerEnv(**opts) for _ in range(2)]
-    try:
-        obs, _ = venv.reset(seed=4)
+def _replayed(venv, here, mode: str, steps: int) -> int:
+    """Step the vector env and, for each worker, a SoccerEnv here on the seeds the infos report; the
+    observations, rewards, flags and episode summaries agree. The episodes that ended."""
+    obs, infos = venv.reset(seed=4)
+    for i, env in enumerate(here):
+        assert np.array_equal(obs[i], env.reset(seed=int(infos["seed"][i]))[0])
+    rng = np.random.default_rng(0)
+    ends, pending, returns = 0, [False] * len(here), [0.0] * len(here)
+    for t in range(steps):
+        act = rng.uniform(-1, 1, (len(here), 4)).astype(np.float32)
+        obs, rew, term, trunc, info = venv.step(act)
         for i, env in enumerate(here):
-            assert np.array_equal(obs[i], env.reset(seed=4 + i)[0])
-        rng = np.random.default_rng(0)
-        ends = 0
-        for t in range(70):  # 31 steps an episode: two autoresets each
-            act = rng.uniform(-1, 1, (2, 4)).astype(np.float32)
-            obs, rew, term, trunc, info = venv.step(act)
-            for i, env in enumerate(here):
-                o, r, te, tr, _ = env.step(act[i])
-                if te or tr:
-                    ends += 1
+            if pending[i]:  # NEXT_STEP: this step reset the worker
+                assert info["_seed"][i] and (rew[i], term[i], trunc[i]) == (0.0, False, False)
+                o = env.reset(seed=int(info["seed"][i]))[0]
+                pending[i], returns[i] = False, 0.0
+                assert np.array_equal(obs[i], o), f"step {t}, env {i}"
+                continue
+            o, r, te, tr, inf = env.step(act[i])
+            returns[i] += r
+            assert (rew[i], term[i], trunc[i]) == (r, te, tr), f"step {t}, env {i}"
+            if te or tr:
+                ends += 1
+                ep = {k: v[i] for k, v in info["episode"].items()}
+                assert info["_episode"][i] and ep["seed"] == inf["seed"] and ep["r"] == returns[i]
+                assert tuple(ep["score"]) == inf["score"] and ep["ticks"] == inf["tick"] and ep["scenario"] is None
+                if mode == "SameStep":
                     assert info["_final_obs"][i] and np.array_equal(info["final_obs"][i], o), f"step {t}"
-                    o, _ = env.reset()
-                assert np.array_equal(obs[i], o) and (rew[i], term[i], trunc[i]) == (r, te, tr), f"step {t}, env {i}"
-        assert ends == 4
+                    o = env.reset(seed=int(info["seed"][i]))[0]
+                    returns[i] = 0.0
+                else:
+                    pending[i] = True
+            assert np.array_equal(obs[i], o), f"step {t}, env {i}"
+    return ends
+
+
+@pytest.mark.parametrize("mode", ["NextStep", "SameStep"])
+def test_the_vector_env_in_worker_processes_plays_what_the_envs_play_here(mode):
+    """Two workers through shared memory against two SoccerEnvs in this process, autoresets included,
+    in both of Gymnasium's autoreset modes."""
+    opts = dict(robot="a/1", home="AD", away="BS", half_time=0.3)
+    venv = make_vector_env(2, autoreset_mode=mode, **opts)
+    try:
+        assert _replayed(venv, [SoccerEnv(**opts) for _ in range(2)], mode, 70) == 4  # 31 steps an episode
     finally:
         venv.close()
     assert not any(p.is_alive() for p in venv.processes)
+
+
+def test_two_workers_never_play_the_same_seed():
+    """Each worker draws its episodes' seeds from its own SeedSequence child: no seed twice over many
+    autoresets; the same root seed gives the same seeds, none gives fresh ones."""
+    venv = make_vector_env(2, robot="a/1", home="BS", away="BS", half_time=0.05, frame_skip=5)  # 2 steps an episode
+    try:
+        played = []
+        for root in (7, 7, None):
+            _, infos = venv.reset(seed=root)
+            seeds = [list(infos["seed"])]
+            for _ in range(40):
+                _, _, _, _, info = venv.step(np.zeros((2, 4), np.float32))
+                if "seed" in info:
+                    seeds.append([s for s, new in zip(info["seed"], info["_seed"]) if new])
+            played.append([s for row in seeds for s in row])
+        first, again, fresh = played
+        assert len(first) >= 30 and len(set(first)) == len(first)  # worker 0's second is not worker 1's first
+        assert first == again and not set(first) & set(fresh)
+    finally:
+        venv.close()
+
+
+def test_gymnasiums_vector_wrappers_take_the_vector_env():
+    from gymnasium.wrappers.vector import FlattenObservation, NormalizeObservation
+
+    venv = NormalizeObservation(FlattenObservation(make_vector_env(2, robot="a/1", **SHORT)))
+    try:
+        obs, _ = venv.reset(seed=1)
+        for _ in range(3):
+            obs, *_ = venv.step(np.zeros((2, 4), np.float32))
+        assert obs.shape == (2, 69) and np.isfinite(obs).all()
+    finally:
+        venv.close()
+
+
+def test_reset_without_a_seed_draws_fresh_entropy_and_says_which_seed_it_played():
+    env = SoccerEnv("a/1", **SHORT)
+    seeds = {env.reset()[1]["seed"] for _ in range(3)}
+    assert len(seeds) == 3 and not seeds & {0, 1, 2, 3}
+    env.reset(seed=5)
+    after = [env.reset()[1]["seed"] for _ in range(2)]
+    env.reset(seed=5)
+    assert [env.reset()[1]["seed"] for _ in range(2)] == after  # a seeded run is reproducible
 
 
 def test_without_the_extra_the_import_names_it_in_one_line():
@@ -341,3 +407,38 @@ def test_a_scenario_episode_ends_once_its_verdict_is_decided(tmp_path):
         plain.step({"a/1": np.zeros(4, np.float32)})
         steps += 1
     assert steps == 101  # the whole 10 s
+
+
+def _returns(tmp_path, y: float, reward) -> tuple[float, float, list]:
+    """a/1 shoots the ball from 1.5 m out, on the line y: (its return, the ball's in-play progress, restarts)."""
+    path = tmp_path / f"out-{y}.scenario.toml"
+    path.write_text(
+        SHOT.replace("y = 0.0", f"y = {y}")
+        .replace("time_limit = 3.0", "time_limit = 6.0")
+        .split("[[scenario.expect]]")[0]
+    )
+    env = SoccerParallelEnv(agents=["a/1"], robots=2, frame_skip=5, reward=reward, end_on_verdict=False)
+    env.reset(seed=2, options={"scenario": str(path)})
+    seen = []
+    total = progress = 0.0
+    while env.agents:
+        _, rew, *_ = env.step({"a/1": np.array([0.6, 0, 0, 1], np.float32)})
+        total += rew["a/1"]
+        outcome = env.last_outcomes["a"]
+        progress += outcome.ball_progress
+        seen += [("against", r) for r in outcome.restarts_against] + [("for", r) for r in outcome.restarts_for]
+    return total, progress, seen
+
+
+def test_the_default_shaping_pays_nothing_for_kicking_the_ball_out_beside_the_post(tmp_path):
+    """The ball played over the goal line beside the post gains in-play progress on its way; the goal kick
+    against charges it back, so the documented shaping GoalReward(progress=0.2) earns nothing there, and
+    a goal keeps it. The ball's placement for the goal kick is not progress."""
+    from arena.learn import GoalReward
+
+    out, gained, seen = _returns(tmp_path, 1.6, GoalReward(progress=0.2))  # the post is at y = 1.0
+    assert ("against", "GOALKICK") in seen, seen
+    assert gained > 1.0  # the ball went 1.5 m to the line and on: in-play progress it made
+    assert out <= 1e-9, out  # ... all of it charged back
+    goal, gained_goal, _ = _returns(tmp_path, 0.0, GoalReward(progress=0.2))
+    assert goal >= 1.0 + 0.2 * 1.0 and goal > out + 1.0
