@@ -205,6 +205,7 @@ class SteppedMatch:
         self.referee: Referee | None = None
         self.new_commands: list = []
         self.inplay = InPlay()
+        self.world_raw: bytes | None = None  # the latest `world` frame, as sent
         self.progress_a = 0.0  # team a's in-play ball progress [m] over the frames the last `advance` judged
         self.restarts: list[Restart] = []
         self.bus.runnable.extend(tasks)
@@ -246,6 +247,7 @@ class SteppedMatch:
             if self.keep:
                 self.worlds.append(_world(raw))
         if last is not None:
+            self.world_raw = last
             w = self.worlds[-1] if self.keep else _world(last)
             self.ball = (w.ball_x, w.ball_y)
         self.progress_a, self.restarts = self.inplay.settle(everything=self.over)
@@ -263,6 +265,10 @@ class SteppedMatch:
         node = self.robot_of[agent]
         k = min(self.tick, self.cfg.total_ticks)
         return node.sense_in.latest_by(k), node.order_in.latest_by(k)
+
+    def world(self) -> World | None:
+        """The latest ground truth (`world`), None before the first."""
+        return None if self.world_raw is None else _world(self.world_raw)
 
     def digests(self) -> dict[str, str]:
         """Every process's digest of what it has sent so far."""

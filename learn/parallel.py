@@ -41,6 +41,7 @@ from pettingzoo import ParallelEnv
 
 from arena.learn.match import SteppedMatch
 from arena.learn.rewards import GoalReward, Outcome
+from arena.learn.views import Renderer, action_mask, state, state_space
 from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 from arena.strategies import registry
 from arena.strategies.learned import DISCRETE, View, discrete_index, obs_fields, observe
@@ -61,7 +62,7 @@ def agent_name(text: str) -> str:
 
 
 class SoccerParallelEnv(ParallelEnv):
-    metadata = {"name": "soccer_arena_v0", "render_modes": [], "is_parallelizable": True}
+    metadata = {"name": "soccer_arena_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
     def __init__(
         self,
@@ -79,6 +80,7 @@ class SoccerParallelEnv(ParallelEnv):
         end_on_verdict: bool = True,
         until: str = "match",
         config: MatchConfig | None = None,
+        render_mode: str | None = None,
     ):
         base = config or MatchConfig()
         if isinstance(robots, bool) or not isinstance(robots, int) or not 1 <= robots <= 6:
@@ -100,8 +102,12 @@ class SoccerParallelEnv(ParallelEnv):
         for option, (value, allowed) in (choices | {"until": (until, ("match", "half"))}).items():
             if value not in allowed:
                 raise ValueError(f"{option} must be {' or '.join(allowed)}, got {value!r}")
-        if frame_skip < 1:
-            raise ValueError(f"frame_skip must be at least 1, got {frame_skip}")
+        if isinstance(frame_skip, bool) or not isinstance(frame_skip, int) or frame_skip < 1:
+            raise ValueError(f"frame_skip must be an integer of at least 1, got {frame_skip!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        self._renderer = Renderer()
         self.possible_agents = names
         self.agents: list[str] = []
         self.frame_skip = frame_skip
@@ -124,6 +130,8 @@ class SoccerParallelEnv(ParallelEnv):
         )
         self._obs_space = flat if obs == "flat" else dict_space
         self._act_space = spaces.Discrete(len(DISCRETE)) if self.discrete else spaces.Box(-1.0, 1.0, (4,), np.float32)
+        self.state_space = state_space(robots)
+        self._state_team = names[0][0]
         self.match: SteppedMatch | None = None
         self._seed = self.cfg.seed
         self._stream: np.random.SeedSequence | None = None
@@ -167,7 +175,8 @@ class SoccerParallelEnv(ParallelEnv):
         self.match.advance()
         self._last_score = self.match.score
         self._last_ball = self.match.ball
-        return self._observations(), {a: self._info() for a in self.agents}
+        flat = self._flat()
+        return {a: self._shape(f) for a, f in flat.items()}, {a: self._info(flat[a]) for a in self.agents}
 
     def step(self, actions: dict[str, Any]):
         m = self.match
@@ -217,8 +226,9 @@ class SoccerParallelEnv(ParallelEnv):
         ended = bool(goal) or (decided and not over)  # a terminal state: a goal, or the scenario's verdict
         terms = {a: ended for a in self.agents}
         truncs = {a: bool(over and not ended) for a in self.agents}
-        obs = self._observations()
-        infos = {a: self._info() for a in self.agents}
+        flat = self._flat()
+        obs = {a: self._shape(f) for a, f in flat.items()}
+        infos = {a: self._info(flat[a]) for a in self.agents}
         if ended or over:
             self.agents = []
         return obs, rewards, terms, truncs, infos
@@ -268,17 +278,29 @@ class SoccerParallelEnv(ParallelEnv):
     def observe(self, agent: str) -> Any:
         return self._shape(observe(*self.match.seen(agent), self._views[agent]))
 
-    def _observations(self) -> dict[str, Any]:
-        return {a: self.observe(a) for a in self.agents}
+    def _flat(self) -> dict[str, np.ndarray]:
+        return {a: observe(*self.match.seen(a), self._views[a]) for a in self.agents}
+
+    def state(self) -> np.ndarray:
+        """Ground truth for a centralised critic, in the attack frame of the first agent's team (views.state)."""
+        return state(self.match, self._state_team)
+
+    def render(self) -> np.ndarray | None:
+        """render_mode "rgb_array": the field now, as match.gif draws it (HEIGHT x WIDTH x 3, uint8)."""
+        if self.render_mode != "rgb_array":
+            return None
+        return self._renderer(self.match)
 
     def _shape(self, flat: np.ndarray) -> Any:
         if self.obs_form == "flat":
             return flat
         return {name: flat[a:b] for name, a, b in self._parts}
 
-    def _info(self) -> dict[str, Any]:
+    def _info(self, flat: np.ndarray) -> dict[str, Any]:
         m = self.match
         info: dict[str, Any] = {"tick": m.tick, "score": m.score, "seed": self._seed}
+        if self.discrete:
+            info["action_mask"] = action_mask(flat)
         if self.verdict is not None:
             info["scenario"] = self.verdict
         return info

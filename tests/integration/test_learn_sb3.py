@@ -3,6 +3,8 @@ export of docs/learning.md from the trained policy to an ONNX file that `arena m
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -37,7 +39,6 @@ def test_the_adapter_keeps_sb3s_conventions():
 
 
 @pytest.mark.slow
-@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # torch's TorchScript exporter (dynamo=False: no onnxscript)
 def test_ppo_trains_on_the_workers_and_its_export_plays_as_a_policy_file(tmp_path):
     import onnx
     import torch
@@ -60,15 +61,17 @@ def test_ppo_trains_on_the_workers_and_its_export_plays_as_a_policy_file(tmp_pat
             return torch.clamp(self.policy(obs, deterministic=True)[0], -1.0, 1.0)
 
     size = model.observation_space.shape[0]
-    torch.onnx.export(
-        Deterministic(model.policy),
-        torch.zeros(1, size),
-        str(tmp_path / "ppo.onnx"),
-        input_names=["obs"],
-        output_names=["action"],
-        opset_version=17,
-        dynamo=False,
-    )
+    with warnings.catch_warnings():  # torch's TorchScript exporter warns (deprecation, tracer) as it goes
+        warnings.simplefilter("ignore")
+        torch.onnx.export(
+            Deterministic(model.policy),
+            torch.zeros(1, size),
+            str(tmp_path / "ppo.onnx"),
+            input_names=["obs"],
+            output_names=["action"],
+            opset_version=17,
+            dynamo=False,
+        )
     path = save_policy(tmp_path / "attacker.onnx", {1: onnx.load(str(tmp_path / "ppo.onnx"))}, base="BS", frame_skip=5)
     for engine in ("inprocess", "processes"):
         got = arena_json("match", "--home", f"policy:{path}", "--away", "BS", "--half-time", "1", "--engine", engine)

@@ -442,3 +442,31 @@ def test_the_default_shaping_pays_nothing_for_kicking_the_ball_out_beside_the_po
     assert out <= 1e-9, out  # ... all of it charged back
     goal, gained_goal, _ = _returns(tmp_path, 0.0, GoalReward(progress=0.2))
     assert goal >= 1.0 + 0.2 * 1.0 and goal > out + 1.0
+
+
+def test_gymnasium_make_with_rgb_array_passes_check_env_with_its_render_check():
+    import gymnasium
+
+    env = gymnasium.make("arena/Soccer-v0", render_mode="rgb_array", **SHORT)
+    assert env.spec.max_episode_steps == 61  # 61 ticks, one decision each
+    check_env(env.unwrapped)  # the render check included: it makes the env again from its spec
+    env.reset(seed=1)
+    frame = env.render()
+    assert frame.shape == (780, 960, 3) and frame.dtype == np.uint8
+    assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 8  # the field, its lines, robots and the ball
+
+
+def test_state_is_ground_truth_in_the_attack_frame_and_the_discrete_form_masks_the_kick():
+    env = SoccerParallelEnv(agents=["b/1"], actions="discrete", **SHORT)
+    obs, infos = env.reset(seed=3)
+    mask = infos["b/1"]["action_mask"]
+    assert mask.dtype == np.int8 and list(mask) == [1] * 9 + [0]  # no ball held: no kick
+    for _ in range(10):
+        obs, _, _, _, infos = env.step({"b/1": 1})
+    s = env.state()
+    assert s.shape == env.state_space.shape and env.state_space.contains(s)
+    w = env.match.world()
+    b1 = next(r for r in w.robots if r.team == "b" and r.robot == 1)
+    half = env.cfg.field.length / 2
+    assert s[6 + 8 + 1] == pytest.approx(-b1.x / half * env.match.attack_dir_a, abs=1e-6)  # b/1, after b/0
+    assert s[0] == pytest.approx(-w.ball_x / half * env.match.attack_dir_a, abs=1e-6)  # team b attacks -x first
