@@ -106,6 +106,10 @@ def test_bad_agents_are_refused():
         ({"obs": "pixels"}, "obs must be flat or dict, got 'pixels'"),
         ({"actions": "x"}, "actions must be box or discrete, got 'x'"),
         ({"until": "goal"}, "until must be match or half, got 'goal'"),
+        ({"half_time": -1}, r"half_time must be in \(0, 3600\] seconds a half, got -1"),
+        ({"robots": 0}, "robots must be 1..6 a team, goalkeeper included, got 0"),
+        ({"frame_skip": 0}, "frame_skip must be an integer of at least 1, got 0"),
+        ({"render_mode": "human"}, "render_mode must be None or 'rgb_array', got 'human'"),
     ],
 )
 def test_a_bad_option_is_named_with_its_value(option, message):
@@ -470,3 +474,42 @@ def test_state_is_ground_truth_in_the_attack_frame_and_the_discrete_form_masks_t
     half = env.cfg.field.length / 2
     assert s[6 + 8 + 1] == pytest.approx(-b1.x / half * env.match.attack_dir_a, abs=1e-6)  # b/1, after b/0
     assert s[0] == pytest.approx(-w.ball_x / half * env.match.attack_dir_a, abs=1e-6)  # team b attacks -x first
+
+
+def test_one_agent_may_be_named_by_a_string():
+    assert SoccerParallelEnv(agents="a/1", **SHORT).possible_agents == ["a/1"]  # not "a", "/", "1"
+
+
+@pytest.mark.parametrize(
+    ("actions", "form", "message"),
+    [
+        ({}, "box", r"no action for a/1 \(step\(\) needs one for every agent"),
+        ({"a/1": np.zeros(3)}, "box", r"a/1: a box action has shape \(4,\) \(vx, vy, omega, kick\), got \(3,\)"),
+        ({"a/1": np.full(4, np.nan)}, "box", "a/1: a box action's numbers must be finite"),
+        ({"a/1": np.array([np.inf, 0, 0, 0])}, "box", "a/1: a box action's numbers must be finite"),
+        ({"a/1": np.array([1.5, 0, 0, 0])}, "box", r"a/1: a box action's numbers are in \[-1, 1\]"),
+        ({"a/1": "fast"}, "box", "a/1: a box action is 4 numbers"),
+        ({"a/1": -1}, "discrete", "a/1: a discrete action is one of 0..9, got -1"),
+        ({"a/1": 10}, "discrete", "a/1: a discrete action is one of 0..9, got 10"),
+        ({"a/1": 2.5}, "discrete", "a/1: a discrete action is one integer 0..9"),
+        ({"a/1": np.nan}, "discrete", "a/1: a discrete action is one integer 0..9"),
+    ],
+)
+def test_a_bad_action_is_refused_with_the_agent_named_and_never_played(actions, form, message):
+    """A NaN must not play as full reverse, a discrete -1 not as the kick: refused before the match moves."""
+    env = SoccerParallelEnv(agents=["a/1"], actions=form, **SHORT)
+    env.reset(seed=1)
+    tick = env.match.tick
+    with pytest.raises(ValueError, match=message):
+        env.step(actions)
+    assert env.match.tick == tick and env.recorded["a/1"] == []
+
+
+def test_a_deployed_policy_that_gives_nan_stops_its_robot_with_a_clear_error():
+    from arena.strategies.learned import View, to_cmd
+
+    view = View.of(MatchConfig(), "a")
+    with pytest.raises(ValueError, match="must be finite"):
+        to_cmd(0, np.array([np.nan, 0, 0, 0], np.float32), view)
+    with pytest.raises(ValueError, match="one of 0..9, got -1"):
+        to_cmd(0, -1, view, discrete=True)
