@@ -4,6 +4,7 @@ is one line and exit 2 before any process starts."""
 
 from __future__ import annotations
 
+import json
 import pickle
 import subprocess
 import sys
@@ -153,3 +154,36 @@ def test_a_bad_onnx_file_is_one_line_before_any_process_starts(tmp_path, name, c
     assert r.returncode == 2, r.stderr
     assert said in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "gave up" not in r.stderr and "Traceback" not in r.stderr
+
+
+def _fails_once_the_first_order_arrives(path: Path) -> Path:
+    """A model that passes the load check (its trial observation reads STOP) and gives -inf once a robot's
+    first order (KICKOFF) arrives, at tick 2 or 3: log of the STOP one-hot."""
+    from onnx import TensorProto, helper, numpy_helper
+
+    stop = 7 + 7 + 2 + 4 + 4 * 5 + 1  # the referee part's STOP, 3 robots a team
+    consts = {"s": [stop], "e": [stop + 1], "ax": [1]}
+    graph = helper.make_graph(
+        [
+            helper.make_node("Slice", ["obs", "s", "e", "ax"], ["stop"]),
+            helper.make_node("Log", ["stop"], ["l"]),
+            helper.make_node("Concat", ["l", "l", "l", "l"], ["action"], axis=1),
+        ],
+        "fails",
+        [helper.make_tensor_value_info("obs", TensorProto.FLOAT, [1, 69])],
+        [helper.make_tensor_value_info("action", TensorProto.FLOAT, [1, 4])],
+        [numpy_helper.from_array(np.array(v, np.int64), k) for k, v in consts.items()],
+    )
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 17)])
+    return save_policy(path, {1: model}, base="BS")
+
+
+def test_a_robot_whose_policy_fails_in_the_first_ticks_is_the_only_one_blamed(tmp_path):
+    """Its process dies at tick 3; a peer still at the start barrier saw its token come and go, and does
+    not wait 30 s for it and exit blaming it ("gave up waiting for robot/a/1")."""
+    path = _fails_once_the_first_order_arrives(tmp_path / "fails.onnx")
+    r = _arena("match", "--home", f"policy:{path}", "--away", "BS", "--half-time", "2", "--json")
+    assert r.returncode == 0, r.stderr
+    got = json.loads(r.stdout)
+    assert got["dead"] == ["robot/a/1"], r.stderr
+    assert "gave up" not in r.stderr and "must be finite" in r.stderr
