@@ -75,12 +75,14 @@ class InPlay:
         self.dir_a = 1
         self.last: _Ball | None = None
         self.banked = 0.0
+        self.sorted = True
 
     def referee(self, ref: Referee) -> None:
         for c in ref.commands:
             if c.name not in KEEPS_PLAY:
                 self.events.append((c.tick, 0, c))
         self.events.append((ref.tick, 1, ref))
+        self.sorted = False
         self.judged_to = max(self.judged_to, ref.tick)
 
     def world(self, raw: bytes) -> None:
@@ -89,38 +91,47 @@ class InPlay:
     def settle(self, everything: bool) -> tuple[float, list[Restart]]:
         """Team a's in-play progress [m] over the frames judged now (all of them: `everything`), and the
         set pieces called among them."""
-        events = sorted(self.events, key=lambda e: (e[0], e[1]))
-        upto = None if everything else self.judged_to
+        if not self.sorted:
+            self.events.sort(key=lambda e: (e[0], e[1]))
+            self.sorted = True
+        events, balls = self.events, self.balls
+        upto = balls[-1].tick if everything and balls else self.judged_to
         progress, restarts = 0.0, []
-        i = 0
-        n = 0
-        for b in self.balls:
-            if upto is not None and b.tick > upto:
+        i = n = 0
+        last = self.last
+        for b in balls:
+            if b.tick > upto:
                 break
             n += 1
             was = self.in_play
             while i < len(events) and events[i][0] <= b.tick:
-                tick, kind, e = events[i]
+                self._apply(events[i], restarts)
                 i += 1
-                if kind == 1:  # a referee frame: its state at its tick
-                    self.in_play = e.command == "START" and e.stage in ("FIRST_HALF", "SECOND_HALF")
-                    self.dir_a = e.attack_dir_a
-                    continue
-                if e.name in RESTARTS:  # charged once: the progress it ends is spent
-                    restarts.append(Restart(e.name, e.team, tick, self.banked))
-                    self.banked = 0.0
-                if e.name == "START":
-                    self.in_play, self.banked = True, 0.0
-                else:
-                    self.in_play = False
-            if was and self.in_play and self.last is not None:
-                d = (b.ball_x - self.last.ball_x) * self.dir_a
+            if was and self.in_play and last is not None:
+                d = (b.ball_x - last.ball_x) * self.dir_a
                 progress += d
                 self.banked += d
-            self.last = b
-        del self.balls[:n]
-        self.events = events[i:]
+            last = b
+        self.last = last
+        if n:
+            del balls[:n]
+        if i:
+            del events[:i]
         return progress, restarts
+
+    def _apply(self, event: tuple[int, int, Any], restarts: list[Restart]) -> None:
+        tick, kind, e = event
+        if kind == 1:  # a referee frame: its state at its tick
+            self.in_play = e.command == "START" and e.stage in ("FIRST_HALF", "SECOND_HALF")
+            self.dir_a = e.attack_dir_a
+        elif e.name in RESTARTS:  # charged once: the progress it ends is spent
+            restarts.append(Restart(e.name, e.team, tick, self.banked))
+            self.banked = 0.0
+            self.in_play = False
+        elif e.name == "START":
+            self.in_play, self.banked = True, 0.0
+        else:
+            self.in_play = False
 
 
 class Gate:
