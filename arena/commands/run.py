@@ -15,8 +15,8 @@ EXAMPLES = """examples:
   # a secure match (it listens on 0.0.0.0): the credentials file arena match wrote for robot/a/1
   arena run robot --match m7-1234-abcdef --connect tls/192.168.1.10:7447 --team a --robot 1 \\
       --credentials robot-a-1.json5
-  # a robot that plays a learned policy (the match: --home policy:/runs/p.pkl); its own copy of the file
-  arena run robot --match demo --connect tcp/192.168.1.10:7447 --team a --robot 1 --policy p.pkl
+  # a robot that plays a learned policy (the match: --home policy:/runs/p.onnx); its own copy of the file
+  arena run robot --match demo --connect tcp/192.168.1.10:7447 --team a --robot 1 --policy p.onnx
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
   arena run router --match demo --listen tls/0.0.0.0:7447 --credentials creds/   # secure: writes creds/*.json5
