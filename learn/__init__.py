@@ -17,19 +17,14 @@ from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.rewards import GoalReward, Outcome
 from arena.learn.single import SoccerEnv, make_vector_env
 from arena.learn.vector import SoccerVectorEnv
-from arena.strategies.learned import (
-    DISCRETE,
-    LinearPolicy,
-    RecordedActions,
-    load_policy,
-    obs_fields,
-    save_policy,
-)
+from arena.strategies.learned import DISCRETE, LinearPolicy, MLPPolicy, RecordedActions, obs_fields
+from arena.strategies.policy_file import load_policy, save_policy
 
 __all__ = [
     "DISCRETE",
     "GoalReward",
     "LinearPolicy",
+    "MLPPolicy",
     "Outcome",
     "RecordedActions",
     "SoccerEnv",

@@ -16,6 +16,7 @@ match where its strategy's would have. Digests are the distributed match's
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import msgspec
@@ -29,6 +30,106 @@ from arena.strategies.learned import LearnerBrain
 
 _referee = msgspec.msgpack.Decoder(Referee).decode
 _world = msgspec.msgpack.Decoder(World).decode
+
+
+class _Ball(msgspec.Struct, forbid_unknown_fields=False):
+    """The fields of a `world` frame the reward needs: decoded without its robots."""
+
+    tick: int
+    ball_x: float
+    ball_y: float
+
+
+_ball = msgspec.msgpack.Decoder(_Ball).decode
+# Set pieces: play stops and the named team restarts it (a kick-off is not one: it follows a goal or a half).
+RESTARTS = frozenset({"FREEKICK", "GOALKICK", "THROWIN", "CORNER", "PENALTY"})
+# The commands that leave the command in force as it is.
+KEEPS_PLAY = frozenset({"YELLOW_CARD", "RED_CARD", "DOUBLE_YELLOW", "REPAIR_OUT"})
+
+
+@dataclass(frozen=True)
+class Restart:
+    """A set piece the referee called: `name` for `team`; `banked` [m]: the ball's in-play progress towards
+    team a's opponent goal line since play last started, up to the call (team b's is its negative)."""
+
+    name: str
+    team: str
+    tick: int
+    banked: float
+
+
+class InPlay:
+    """The ball's progress while it is in play (the referee's command in force is START), tick by tick.
+
+    `world` frames come every tick, the referee's every few; a frame's movement is judged once the
+    referee's frames have come up to its tick, so a ball that a step plays over a line and the referee
+    then places elsewhere never counts its way back or its placement."""
+
+    def __init__(self):
+        self.events: list[tuple[int, int, Any]] = []  # (tick, order, command or frame state), by tick
+        self.balls: list[_Ball] = []
+        self.judged_to = -1  # the referee's frames have come up to this tick
+        self.in_play = False
+        self.dir_a = 1
+        self.last: _Ball | None = None
+        self.banked = 0.0
+        self.sorted = True
+
+    def referee(self, ref: Referee) -> None:
+        for c in ref.commands:
+            if c.name not in KEEPS_PLAY:
+                self.events.append((c.tick, 0, c))
+        self.events.append((ref.tick, 1, ref))
+        self.sorted = False
+        self.judged_to = max(self.judged_to, ref.tick)
+
+    def world(self, raw: bytes) -> None:
+        self.balls.append(_ball(raw))
+
+    def settle(self, everything: bool) -> tuple[float, list[Restart]]:
+        """Team a's in-play progress [m] over the frames judged now (all of them: `everything`), and the
+        set pieces called among them."""
+        if not self.sorted:
+            self.events.sort(key=lambda e: (e[0], e[1]))
+            self.sorted = True
+        events, balls = self.events, self.balls
+        upto = balls[-1].tick if everything and balls else self.judged_to
+        progress, restarts = 0.0, []
+        i = n = 0
+        last = self.last
+        for b in balls:
+            if b.tick > upto:
+                break
+            n += 1
+            was = self.in_play
+            while i < len(events) and events[i][0] <= b.tick:
+                self._apply(events[i], restarts)
+                i += 1
+            if was and self.in_play and last is not None:
+                d = (b.ball_x - last.ball_x) * self.dir_a
+                progress += d
+                self.banked += d
+            last = b
+        self.last = last
+        if n:
+            del balls[:n]
+        if i:
+            del events[:i]
+        return progress, restarts
+
+    def _apply(self, event: tuple[int, int, Any], restarts: list[Restart]) -> None:
+        tick, kind, e = event
+        if kind == 1:  # a referee frame: its state at its tick
+            self.in_play = e.command == "START" and e.stage in ("FIRST_HALF", "SECOND_HALF")
+            self.dir_a = e.attack_dir_a
+        elif e.name in RESTARTS:  # charged once: the progress it ends is spent
+            restarts.append(Restart(e.name, e.team, tick, self.banked))
+            self.banked = 0.0
+            self.in_play = False
+        elif e.name == "START":
+            self.in_play, self.banked = True, 0.0
+        else:
+            self.in_play = False
 
 
 class Gate:
@@ -109,6 +210,10 @@ class SteppedMatch:
         self.ball: tuple[float, float] | None = None
         self.referee: Referee | None = None
         self.new_commands: list = []
+        self.inplay = InPlay()
+        self.world_raw: bytes | None = None  # the latest `world` frame, as sent
+        self.progress_a = 0.0  # team a's in-play ball progress [m] over the frames the last `advance` judged
+        self.restarts: list[Restart] = []
         self.bus.runnable.extend(tasks)
 
     def _decider(self, agent: str):
@@ -140,14 +245,18 @@ class SteppedMatch:
             self.score = (ref.score_a, ref.score_b)
             self.attack_dir_a = ref.attack_dir_a
             self.new_commands.extend(ref.commands)
+            self.inplay.referee(ref)
         last = None
         while (raw := self.world_ch.try_recv()) is not None:
             last = raw
+            self.inplay.world(raw)
             if self.keep:
                 self.worlds.append(_world(raw))
         if last is not None:
+            self.world_raw = last
             w = self.worlds[-1] if self.keep else _world(last)
             self.ball = (w.ball_x, w.ball_y)
+        self.progress_a, self.restarts = self.inplay.settle(everything=self.over)
 
     def act(self, actions: dict[str, Any]) -> None:
         """Set the learners' actions for the tick they wait at and let them go on."""
@@ -162,6 +271,10 @@ class SteppedMatch:
         node = self.robot_of[agent]
         k = min(self.tick, self.cfg.total_ticks)
         return node.sense_in.latest_by(k), node.order_in.latest_by(k)
+
+    def world(self) -> World | None:
+        """The latest ground truth (`world`), None before the first."""
+        return None if self.world_raw is None else _world(self.world_raw)
 
     def digests(self) -> dict[str, str]:
         """Every process's digest of what it has sent so far."""

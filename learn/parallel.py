@@ -41,9 +41,16 @@ from pettingzoo import ParallelEnv
 
 from arena.learn.match import SteppedMatch
 from arena.learn.rewards import GoalReward, Outcome
-from arena.runtime.config import MatchConfig, ProcessId
+from arena.learn.views import Renderer, action_mask, state, state_space
+from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 from arena.strategies import registry
-from arena.strategies.learned import DISCRETE, RecordedActions, View, obs_fields, observe, save_policy
+from arena.strategies.learned import DISCRETE, View, discrete_index, obs_fields, observe
+from arena.strategies.policy_file import save_recorded
+
+
+def episode_seed(stream: np.random.SeedSequence) -> int:
+    """The next match seed (0 .. 2**63 - 1) of a stream: a fresh child's first 63 bits."""
+    return int(stream.spawn(1)[0].generate_state(1, np.uint64)[0] >> np.uint64(1))
 
 
 def agent_name(text: str) -> str:
@@ -55,7 +62,7 @@ def agent_name(text: str) -> str:
 
 
 class SoccerParallelEnv(ParallelEnv):
-    metadata = {"name": "soccer_arena_v0", "render_modes": [], "is_parallelizable": True}
+    metadata = {"name": "soccer_arena_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
     def __init__(
         self,
@@ -73,11 +80,18 @@ class SoccerParallelEnv(ParallelEnv):
         end_on_verdict: bool = True,
         until: str = "match",
         config: MatchConfig | None = None,
+        render_mode: str | None = None,
     ):
         base = config or MatchConfig()
+        if isinstance(robots, bool) or not isinstance(robots, int) or not 1 <= robots <= 6:
+            raise ValueError(f"robots must be 1..6 a team, goalkeeper included, got {robots!r}")
+        if isinstance(half_time, bool) or not isinstance(half_time, int | float) or not 0 < half_time <= MAX_HALF_TIME:
+            raise ValueError(f"half_time must be in (0, {MAX_HALF_TIME:g}] seconds a half, got {half_time!r}")
         self.cfg = base.replace(
             home=registry.resolve_name(home), away=registry.resolve_name(away), robots=robots, half_time=half_time
         )
+        if isinstance(agents, str):  # "a/1": one agent, not the characters of its name
+            agents = [agents]
         names = [agent_name(a) for a in agents]
         if not names or len(set(names)) != len(names):
             raise ValueError(f"agents must be distinct robots, got {list(agents)}")
@@ -88,8 +102,12 @@ class SoccerParallelEnv(ParallelEnv):
         for option, (value, allowed) in (choices | {"until": (until, ("match", "half"))}).items():
             if value not in allowed:
                 raise ValueError(f"{option} must be {' or '.join(allowed)}, got {value!r}")
-        if frame_skip < 1:
-            raise ValueError(f"frame_skip must be at least 1, got {frame_skip}")
+        if isinstance(frame_skip, bool) or not isinstance(frame_skip, int) or frame_skip < 1:
+            raise ValueError(f"frame_skip must be an integer of at least 1, got {frame_skip!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.render_mode = render_mode
+        self._renderer = Renderer()
         self.possible_agents = names
         self.agents: list[str] = []
         self.frame_skip = frame_skip
@@ -112,8 +130,11 @@ class SoccerParallelEnv(ParallelEnv):
         )
         self._obs_space = flat if obs == "flat" else dict_space
         self._act_space = spaces.Discrete(len(DISCRETE)) if self.discrete else spaces.Box(-1.0, 1.0, (4,), np.float32)
+        self.state_space = state_space(robots)
+        self._state_team = names[0][0]
         self.match: SteppedMatch | None = None
         self._seed = self.cfg.seed
+        self._stream: np.random.SeedSequence | None = None
         self.recorded: dict[str, list[Any]] = {}
         self.scenario = None
         self.verdict: dict[str, Any] | None = None
@@ -127,9 +148,16 @@ class SoccerParallelEnv(ParallelEnv):
 
     # ---------------------------------------------------------------- API
     def reset(self, seed: int | None = None, options: dict | None = None):
-        """Start the match of `seed` (the previous seed + 1 when None), or with `options={"scenario": S}`
+        """Start the match of `seed` (when None: the next of a stream of seeds that the last given seed, or
+        fresh entropy, began; the seed played is in the infos), or with `options={"scenario": S}`
         the run of scenario S (a file with one scenario, a (path, name) pair, or an `arena.scenarios.Scenario`)."""
-        self._seed = (self._seed + 1) % 2**63 if seed is None else int(seed) % 2**63
+        if seed is not None:
+            self._seed = int(seed) % 2**63
+            self._stream = np.random.SeedSequence(self._seed)
+        else:  # the next seed of the stream the last seed began, or of fresh entropy
+            if self._stream is None:
+                self._stream = np.random.SeedSequence()
+            self._seed = episode_seed(self._stream)
         cfg = self.cfg.replace(seed=self._seed)
         scenario = (options or {}).get("scenario")
         self.scenario = None if scenario is None else self._scenario(scenario)
@@ -140,27 +168,29 @@ class SoccerParallelEnv(ParallelEnv):
                     f"scenario {self.scenario.name!r} plays {cfg.robots} robots a team, this env {self.cfg.robots}"
                 )
         self.verdict: dict[str, Any] | None = None
+        self.last_outcomes: dict[str, Outcome] = {}  # the last step's, by team
         self.match = SteppedMatch(cfg, self.possible_agents, self.frame_skip, self.discrete, keep=bool(scenario))
         self.agents = list(self.possible_agents)
         self.recorded = {a: [] for a in self.agents}
         self.match.advance()
         self._last_score = self.match.score
         self._last_ball = self.match.ball
-        return self._observations(), {a: self._info() for a in self.agents}
+        flat = self._flat()
+        return {a: self._shape(f) for a, f in flat.items()}, {a: self._info(flat[a]) for a in self.agents}
 
     def step(self, actions: dict[str, Any]):
         m = self.match
         if m is None or not self.agents:
             raise RuntimeError("step() before reset(), or after the episode ended")
+        self._check(actions)
         for a in self.agents:
             self.recorded[a].append(np.array(actions[a]))  # a copy: callers may reuse one array
         m.act(actions)
         m.advance()
         ga = m.score[0] - self._last_score[0]
         gb = m.score[1] - self._last_score[1]
-        progress, closing = 0.0, {"a": 0.0, "b": 0.0}
+        progress, closing = m.progress_a, {"a": 0.0, "b": 0.0}
         if m.ball is not None and self._last_ball is not None:
-            progress = (m.ball[0] - self._last_ball[0]) * m.attack_dir_a
             hl = m.cfg.field.length / 2
             for team, gx in (("a", hl * m.attack_dir_a), ("b", -hl * m.attack_dir_a)):
                 before = math.hypot(self._last_ball[0] - gx, self._last_ball[1])
@@ -176,21 +206,71 @@ class SoccerParallelEnv(ParallelEnv):
                 self.verdict = verdict
                 passed = verdict["passed"]
         out = {
-            "a": Outcome(m.tick, "a", ga, gb, progress, m.new_commands, closing["a"], passed),
-            "b": Outcome(m.tick, "b", gb, ga, -progress, m.new_commands, closing["b"], passed),
+            team: Outcome(
+                m.tick,
+                team,
+                ga if team == "a" else gb,
+                gb if team == "a" else ga,
+                progress if team == "a" else -progress,
+                m.new_commands,
+                closing[team],
+                passed,
+                tuple(r.name for r in m.restarts if r.team == team),
+                tuple(r.name for r in m.restarts if r.team not in ("", team)),
+                sum(max(0.0, r.banked if team == "a" else -r.banked) for r in m.restarts if r.team not in ("", team)),
+            )
+            for team in ("a", "b")
         }
+        self.last_outcomes = out
         rewards = {a: float(self.reward_fn(a, out[a[0]])) for a in self.agents}
         ended = bool(goal) or (decided and not over)  # a terminal state: a goal, or the scenario's verdict
         terms = {a: ended for a in self.agents}
         truncs = {a: bool(over and not ended) for a in self.agents}
-        obs = self._observations()
-        infos = {a: self._info() for a in self.agents}
+        flat = self._flat()
+        obs = {a: self._shape(f) for a, f in flat.items()}
+        infos = {a: self._info(flat[a]) for a in self.agents}
         if ended or over:
             self.agents = []
         return obs, rewards, terms, truncs, infos
 
     def close(self) -> None:
         self.match = None
+
+    @staticmethod
+    def _refuse_box(a: str, act: Any) -> None:
+        try:
+            v = np.asarray(act, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{a}: a box action is 4 numbers in [-1, 1], got {act!r:.80}") from None
+        if v.shape != (4,):
+            raise ValueError(f"{a}: a box action has shape (4,) (vx, vy, omega, kick), got {v.shape}")
+        if not np.isfinite(v).all():
+            raise ValueError(f"{a}: a box action's numbers must be finite, got {v.tolist()}")
+        raise ValueError(f"{a}: a box action's numbers are in [-1, 1], got {v.tolist()}")
+
+    def _check(self, actions: dict[str, Any]) -> None:
+        """ValueError, naming the agent, for an action that is missing, of the wrong shape, not finite or
+        out of range (a NaN would play as full reverse, a discrete -1 as the last move)."""
+        if not isinstance(actions, dict):
+            raise ValueError(f"step() takes a dict of actions by agent, got {type(actions).__name__}")
+        missing = [a for a in self.agents if a not in actions]
+        if missing:
+            raise ValueError(f"no action for {', '.join(missing)} (step() needs one for every agent: {self.agents})")
+        for a in self.agents:
+            act = actions[a]
+            if self.discrete:
+                try:
+                    discrete_index(act)
+                except ValueError as exc:
+                    raise ValueError(f"{a}: {exc}") from None
+                continue
+            v = act.tolist() if isinstance(act, np.ndarray) else act
+            try:
+                if len(v) == 4 and all(-1.0 <= x <= 1.0 for x in v):  # False for NaN: the one test a step pays
+                    continue
+            except TypeError:
+                pass
+            self._refuse_box(a, act)
 
     # -------------------------------------------------------------- extras
     def digests(self) -> dict[str, str]:
@@ -200,24 +280,36 @@ class SoccerParallelEnv(ParallelEnv):
     def save_actions(self, team: str, path) -> str:
         """A policy file that replays this episode's actions of `team`'s learners, the rest of the team
         by its strategy: `arena match --home policy:PATH` (team a) plays this episode again."""
-        mine = {int(a.split("/")[1]): RecordedActions(self.recorded[a]) for a in self.recorded if a[0] == team}
+        mine = {int(a.split("/")[1]): self.recorded[a] for a in self.recorded if a[0] == team}
         cfg = self.match.cfg if self.match is not None else self.cfg  # a scenario names its own strategies
-        return str(save_policy(path, mine, cfg.strategy_of(team), self.frame_skip, self.discrete, cfg.robots))
+        return str(save_recorded(path, mine, cfg.strategy_of(team), self.frame_skip, self.discrete, cfg.robots))
 
     def observe(self, agent: str) -> Any:
         return self._shape(observe(*self.match.seen(agent), self._views[agent]))
 
-    def _observations(self) -> dict[str, Any]:
-        return {a: self.observe(a) for a in self.agents}
+    def _flat(self) -> dict[str, np.ndarray]:
+        return {a: observe(*self.match.seen(a), self._views[a]) for a in self.agents}
+
+    def state(self) -> np.ndarray:
+        """Ground truth for a centralised critic, in the attack frame of the first agent's team (views.state)."""
+        return state(self.match, self._state_team)
+
+    def render(self) -> np.ndarray | None:
+        """render_mode "rgb_array": the field now, as match.gif draws it (HEIGHT x WIDTH x 3, uint8)."""
+        if self.render_mode != "rgb_array":
+            return None
+        return self._renderer(self.match)
 
     def _shape(self, flat: np.ndarray) -> Any:
         if self.obs_form == "flat":
             return flat
         return {name: flat[a:b] for name, a, b in self._parts}
 
-    def _info(self) -> dict[str, Any]:
+    def _info(self, flat: np.ndarray) -> dict[str, Any]:
         m = self.match
         info: dict[str, Any] = {"tick": m.tick, "score": m.score, "seed": self._seed}
+        if self.discrete:
+            info["action_mask"] = action_mask(flat)
         if self.verdict is not None:
             info["scenario"] = self.verdict
         return info

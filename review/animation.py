@@ -48,37 +48,53 @@ def frames_of(worlds: list[World], dt: float, half_tick: int | None = None) -> l
 
 def animate(worlds: list[World], cfg, path: Path, refs: list[Referee], draw_field) -> str:
     """Write the GIF to `path`; `draw_field(ax, cfg, grass=False)` draws the lines and goals."""
-    from PIL import Image, ImageDraw
+    from PIL import Image
 
     frames = frames_of(worlds, cfg.timing.dt, cfg.half_ticks)
     tl = timeline([], refs, cfg.timing.dt)  # marks and scores only
-    background, to_px, strip = _background(cfg, tl, draw_field)
-    fonts = _fonts()
-    palette = _palette(background)
+    painter = Painter(cfg, tl, draw_field)
+    palette = _palette(painter.background)
     images = []
     for w in frames:
-        img = background.copy()
+        m = last_mark(tl, w.tick, within=round(3.0 / cfg.timing.dt))
+        banner = None if m is None else f"{m['kind'].replace('_', ' ')} {m['team']}".strip()
+        img = painter.paint(w, score_at(tl, w.tick), banner)
+        images.append(img.quantize(palette=palette, dither=Image.Dither.NONE))
+    images[0].save(path, save_all=True, append_images=images[1:], duration=FRAME_MS, loop=0)
+    return str(path)
+
+
+class Painter:
+    """One frame of match.gif at a time: the still background drawn once (`tl`'s marks on its strip),
+    then every `paint` draws a world's robots, ball, score, clock and banner onto a copy (RGB)."""
+
+    def __init__(self, cfg, tl: dict, draw_field):
+        self.cfg = cfg
+        self.background, self.to_px, self.strip = _background(cfg, tl, draw_field)
+        self.fonts = _fonts()
+
+    def paint(self, w: World, score: tuple[int, int], banner: str | None = None):
+        from PIL import ImageDraw
+
+        cfg, to_px, fonts = self.cfg, self.to_px, self.fonts
+        img = self.background.copy()
         draw = ImageDraw.Draw(img)
         for r in sorted(w.robots, key=lambda r: (r.team, r.robot)):
             _robot(draw, to_px(r.x, r.y), r.team, r.robot, fonts["number"])
         bx, by = to_px(w.ball_x, w.ball_y)
         rb = 6 * (1 + 2 * max(0.0, w.ball_z))  # [px] a lob looks larger
         draw.ellipse((bx - rb, by - rb, bx + rb, by + rb), fill=BALL, outline="black", width=1)
-        a, b = score_at(tl, w.tick)
+        a, b = score
         head = f"{cfg.home} (a)  {a} : {b}  (b) {cfg.away}      {w.t:5.1f} s"
         draw.text((WIDTH / 2, 22), head, fill="white", font=fonts["head"], anchor="mm")
-        m = last_mark(tl, w.tick, within=round(3.0 / cfg.timing.dt))
-        if m is not None:
-            banner = f"{m['kind'].replace('_', ' ')} {m['team']}".strip()
+        if banner:
             draw.text(
                 (WIDTH / 2, 80), banner, fill=HALF, font=fonts["mark"], anchor="mm", stroke_width=2, stroke_fill="black"
             )
-        x0, x1, y0, y1 = strip
+        x0, x1, y0, y1 = self.strip
         cx = x0 + (x1 - x0) * min(1.0, w.tick / max(1, cfg.total_ticks))
         draw.line((cx, y0, cx, y1), fill=NOW, width=3)
-        images.append(img.quantize(palette=palette, dither=Image.Dither.NONE))
-    images[0].save(path, save_all=True, append_images=images[1:], duration=FRAME_MS, loop=0)
-    return str(path)
+        return img
 
 
 def _robot(draw, xy: tuple[float, float], team: str, number: int, font) -> None:

@@ -190,14 +190,16 @@ class Peer:
         deadline = start + self.cfg.timing.startup_timeout
         told: list[str] | None = None
         with self._alive_cond:
-            while not expected <= self._alive:
-                missing_now = sorted(expected - self._alive)
+            # A peer whose token came and went is no one to wait for: it started and died (a robot whose
+            # policy failed at tick 0); the loop treats it as dead. Waiting would blame this process.
+            while not expected <= self._alive | self.gone:
+                missing_now = sorted(expected - self._alive - self.gone)
                 if self.on_waiting is not None and missing_now != told and clock.monotonic() - start > 1.0:
                     told = missing_now
                     self.on_waiting(missing_now)
                 left = deadline - clock.monotonic()
                 if left <= 0:
-                    missing = ", ".join(sorted(expected - self._alive))
+                    missing = ", ".join(sorted(expected - self._alive - self.gone))
                     raise StartupError(
                         f"{self.name}: gave up after {self.cfg.timing.startup_timeout:g} s waiting for: {missing}"
                     )

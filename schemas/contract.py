@@ -36,6 +36,7 @@ from arena.schemas.keys import (
     WAITING,
     KeySpec,
 )
+from arena.schemas.policy_contract import POLICY
 
 README = Path(__file__).with_name("README.md")
 
@@ -530,6 +531,7 @@ def render() -> str:
             text = description + (f" ({cons})" if cons else "")
             lines.append(f"| `{f.name}` | {_type_name(t)} | {text} | {_default(f)} |")
     lines.append(CLIENT.rstrip("\n"))
+    lines.append(POLICY.rstrip("\n"))
     lines.append(SECURITY.rstrip("\n"))
     lines.append("")
     return "\n".join(lines)

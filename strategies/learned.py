@@ -10,10 +10,8 @@ so that a policy trained in one process plays unchanged as a robot process:
   in [-1, 1] or an index into `DISCRETE`, as the robot's `Cmd`;
 * `LearnerBrain`: a `RobotBrain` that asks a `decide(tick, sense, order)` for an
   action every `frame_skip` ticks and holds it in between;
-* a policy file (`save_policy`, `load_policy`): a pickle of the policy per robot
-  number, the strategy that plays the rest of the team, and the action form. The
-  strategy name `policy:PATH` (`policy_strategy`) plays it in `arena match`,
-  `arena tournament` and `arena run robot`.
+* the numpy policies `LinearPolicy` and `MLPPolicy`, which export to ONNX without
+  torch, and `RecordedActions`. Policy files (ONNX) are strategies/policy_file.py.
 
 Every coordinate is in the robot's attack frame: the opponent goal is at +x
 whichever side the team plays on, so one policy serves both halves and teams.
@@ -22,19 +20,16 @@ whichever side the team plays on, so one policy serves both halves and teams.
 from __future__ import annotations
 
 import math
-import pickle
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from functools import cache
-from pathlib import Path
 from typing import Any, get_args
 
 import numpy as np
 
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Report, Sense
 from arena.schemas.vocabulary import RefCommandName
-from arena.strategies.base import RobotContext, Strategy, TeamContext, report_of
+from arena.strategies.base import RobotContext, report_of
 
 PREFIX = "policy:"
 COMMANDS: tuple[str, ...] = get_args(RefCommandName)
@@ -218,9 +213,15 @@ DISCRETE: tuple[tuple[str, tuple[float, float, float, float]], ...] = (
 def to_cmd(tick: int, action: Any, v: View, discrete: bool = False) -> Cmd:
     """The `Cmd` for an action: vx, vy [m/s] = a0, a1 x max_speed (body frame), omega = a2 x max_omega,
     kick_speed = max(0, a3) x kick_max_speed; each clipped to [-1, 1] first. The dribbler is always on."""
-    a = DISCRETE[int(action)][1] if discrete else action
-    if isinstance(a, np.ndarray):
-        a = a.tolist()  # Python floats, exactly the array's values (float32 widens without rounding)
+    if discrete:
+        a = DISCRETE[discrete_index(action)][1]
+    else:
+        a = action.tolist() if isinstance(action, np.ndarray) else action  # float32 widens without rounding
+        if len(a) != 4:
+            raise ValueError(f"a box action is 4 numbers (vx, vy, omega, kick), got {len(a)}: {a!r:.80}")
+        for x in a:
+            if not math.isfinite(x):  # NaN would clip to -1: full reverse
+                raise ValueError(f"a box action's numbers must be finite, got {a!r:.80}")
     vx = min(1.0, max(-1.0, float(a[0])))
     vy = min(1.0, max(-1.0, float(a[1])))
     om = min(1.0, max(-1.0, float(a[2])))
@@ -233,6 +234,21 @@ def to_cmd(tick: int, action: Any, v: View, discrete: bool = False) -> Cmd:
         dribbler=True,
         kick_speed=max(0.0, kick) * v.kick_max_speed,
     )
+
+
+def discrete_index(action: Any) -> int:
+    """The move a discrete action names; ValueError unless it is one integer 0..9 (-1 must not play the last)."""
+    a = np.asarray(action)
+    v = a.reshape(-1)[0] if a.size == 1 else None
+    whole = v is not None and (
+        np.issubdtype(a.dtype, np.integer) or (np.issubdtype(a.dtype, np.floating) and math.isfinite(v) and v == int(v))
+    )
+    if not whole:
+        raise ValueError(f"a discrete action is one integer 0..{len(DISCRETE) - 1}, got {action!r:.80}")
+    i = int(v)
+    if not 0 <= i < len(DISCRETE):
+        raise ValueError(f"a discrete action is one of 0..{len(DISCRETE) - 1}, got {i}")
+    return i
 
 
 Decide = Callable[[int, "Sense | None", "Order | None"], Any]
@@ -262,15 +278,40 @@ class LearnerBrain:
 
 
 # ------------------------------------------------------------------ policies
-class LinearPolicy:
-    """action = tanh(W obs + b): a Box action from a flat observation."""
+class MLPPolicy:
+    """A multilayer perceptron: h = tanh(W_i h + b_i) through every layer, the last one included (so
+    its output, 4 numbers, is a Box action in [-1, 1]; 10 numbers: scores of the discrete moves).
+    float32 throughout, as its ONNX export computes (`save_policy` writes it without torch)."""
 
-    def __init__(self, weights: np.ndarray, bias: np.ndarray):
-        self.weights = np.asarray(weights, dtype=np.float64)
-        self.bias = np.asarray(bias, dtype=np.float64)
+    def __init__(self, weights: Sequence[np.ndarray], biases: Sequence[np.ndarray]):
+        self.weights = [np.asarray(w, dtype=np.float32) for w in weights]
+        self.biases = [np.asarray(b, dtype=np.float32) for b in biases]
+        if not self.weights or len(self.weights) != len(self.biases):
+            raise ValueError("an MLPPolicy needs one bias per weight matrix, at least one layer")
+        for i, (w, b) in enumerate(zip(self.weights, self.biases)):
+            if w.ndim != 2 or b.shape != (w.shape[0],):
+                raise ValueError(f"layer {i}: weights {w.shape} and bias {b.shape} do not fit (out x in, out)")
+            if i and w.shape[1] != self.weights[i - 1].shape[0]:
+                raise ValueError(
+                    f"layer {i} takes {w.shape[1]} numbers, layer {i - 1} gives {self.weights[i - 1].shape[0]}"
+                )
+
+    @property
+    def obs_size(self) -> int:
+        return self.weights[0].shape[1]
 
     def __call__(self, obs: np.ndarray) -> np.ndarray:
-        return np.tanh(self.weights @ obs + self.bias).astype(np.float32)
+        h = np.asarray(obs, dtype=np.float32)
+        for w, b in zip(self.weights, self.biases):
+            h = np.tanh(w @ h + b)
+        return h
+
+
+class LinearPolicy(MLPPolicy):
+    """action = tanh(W obs + b): a Box action from a flat observation (an `MLPPolicy` of one layer)."""
+
+    def __init__(self, weights: np.ndarray, bias: np.ndarray):
+        super().__init__([weights], [bias])
 
 
 class RecordedActions:
@@ -284,75 +325,3 @@ class RecordedActions:
         a = self.actions[self.i] if self.i < len(self.actions) else np.zeros_like(self.actions[0])
         self.i += 1
         return a
-
-
-@dataclass
-class PolicyFile:
-    """What a policy file holds: a policy (obs -> action) per robot number, and how it plays."""
-
-    base: str  # the strategy of the team brain and of every robot without a policy
-    policies: dict[int, Callable[[np.ndarray], Any]]
-    frame_skip: int = 1
-    discrete: bool = False
-    robots: int = 0  # the team size it was trained with: its observations have that many robot slots (0: any)
-
-
-def save_policy(
-    path: str | Path,
-    policies: dict[int, Callable[[np.ndarray], Any]],
-    base: str,
-    frame_skip: int = 1,
-    discrete: bool = False,
-    robots: int = 0,
-) -> Path:
-    """Write a policy file: `policies` maps robot numbers to picklable callables obs -> action.
-
-    `robots`: the team size it was trained with, so that a match of another size still gives it
-    observations of the size it knows (the nearest robots fill the slots)."""
-    p = Path(path)
-    p.write_bytes(pickle.dumps(PolicyFile(base, dict(policies), frame_skip, discrete, robots)))
-    return p
-
-
-def load_policy(path: str | Path) -> PolicyFile:
-    """Read a policy file; ConfigError (one line) if it cannot be."""
-    try:
-        data = pickle.loads(Path(path).read_bytes())
-    except FileNotFoundError:
-        raise ConfigError(f"policy file {path} not found") from None
-    except IsADirectoryError:
-        raise ConfigError(f"policy file {path} is a directory: give the file save_policy wrote") from None
-    except Exception as exc:  # anything a file that is not a pickle of ours makes pickle raise
-        raise ConfigError(f"policy file {path} cannot be read: {type(exc).__name__}: {exc}") from None
-    if not isinstance(data, PolicyFile):
-        raise ConfigError(f"policy file {path} is not an arena policy (write it with arena.learn.save_policy)")
-    return data
-
-
-@cache
-def policy_strategy(name: str) -> Strategy:
-    """The strategy `policy:PATH`: the file's policies play their robots, its `base` the rest."""
-    from arena.strategies import registry
-
-    path = name[len(PREFIX) :]
-    pf = load_policy(path)
-    base = registry.get(pf.base)
-
-    def make_robot(ctx: RobotContext):
-        if ctx.n not in pf.policies:
-            return base.make_robot(ctx)
-        policy = load_policy(path).policies[ctx.n]  # a fresh copy per robot: policies may keep state
-        view = View.of(ctx.cfg, ctx.team, pf.robots)
-        return LearnerBrain(
-            ctx, lambda _k, sense, order: policy(observe(sense, order, view)), pf.frame_skip, pf.discrete
-        )
-
-    def make_team(ctx: TeamContext):
-        return base.make_team(ctx)
-
-    return Strategy(
-        name=name,
-        make_team=make_team,
-        make_robot=make_robot,
-        description=f"learned policy for robots {sorted(pf.policies)}, the rest by {base.name}",
-    )

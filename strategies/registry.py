@@ -6,7 +6,7 @@ from functools import cache
 from pathlib import Path
 
 from arena.runtime.config import ConfigError
-from arena.strategies import learned
+from arena.strategies import learned, policy_file
 from arena.strategies.base import Strategy
 
 GROUP = "soccer_arena.strategies"
@@ -98,7 +98,7 @@ def resolve_name(name: str) -> str:
     if name.startswith(learned.PREFIX):  # a policy file: its absolute path, as every process opens it
         if not name[len(learned.PREFIX) :].strip():  # Path("") is the working directory
             raise ConfigError(f"{name!r} names no file: policy:PATH, a file written by arena.learn.save_policy")
-        return learned.policy_strategy(learned.PREFIX + str(Path(name[len(learned.PREFIX) :]).resolve())).name
+        return policy_file.policy_strategy(learned.PREFIX + str(Path(name[len(learned.PREFIX) :]).resolve())).name
     wanted = name.strip().lower()
     found = _find(builtin_strategies(), wanted) or _find(all_strategies(), wanted)
     if found is not None:
@@ -113,6 +113,6 @@ def resolve_name(name: str) -> str:
 
 def get(name: str) -> Strategy:
     if name.startswith(learned.PREFIX):
-        return learned.policy_strategy(name)
+        return policy_file.policy_strategy(name)
     canonical = resolve_name(name)
     return builtin_strategies().get(canonical) or all_strategies()[canonical]

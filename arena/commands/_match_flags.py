@@ -82,6 +82,28 @@ def add_match_flags(
     )
 
 
+class _AllowPickle(argparse.Action):
+    """`--allow-pickle`: from the moment it is parsed, this process and every process it starts load
+    pickle policy files (ARENA_ALLOW_PICKLE=1)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from arena.strategies.policy_file import allow_pickle
+
+        allow_pickle()
+        setattr(namespace, self.dest, True)
+
+
+def allow_pickle_flag(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--allow-pickle",
+        action=_AllowPickle,
+        nargs=0,
+        default=False,
+        help="load pickle policy files (policy:FILE.pkl): loading a pickle RUNS ANY CODE IT HOLDS, so only for "
+        "files you trust; an ONNX policy file needs no flag (docs/learning.md)",
+    )
+
+
 def match_config(
     args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None, seed: bool = True
 ) -> MatchConfig:

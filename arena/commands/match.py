@@ -8,7 +8,7 @@ import sys
 
 from arena.commands._common import ENGINE_FLAG, add_command, emit_match, one_line, seconds
 from arena.commands._live import add_live_flags, full_config
-from arena.commands._match_flags import add_match_flags
+from arena.commands._match_flags import add_match_flags, allow_pickle_flag
 from arena.commands._refbox_flags import add_refbox_flags, warn_unreachable_refbox
 from arena.runtime.config import ConfigError, MatchConfig
 
@@ -42,6 +42,7 @@ EXAMPLES = """examples:
 def add_parser(sub) -> None:
     m = add_command(sub, "match", "play one match, every process its own OS process, and print the score", EXAMPLES)
     add_match_flags(m, config=True)
+    allow_pickle_flag(m)
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
     m.add_argument(
         "--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand"

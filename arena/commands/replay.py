@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from arena.commands._common import add_command
+from arena.commands._match_flags import allow_pickle_flag
 
 EXAMPLES = """examples:
   arena replay match.mcap --process robot/a/1          # re-run one process against its recorded inputs
@@ -23,6 +24,7 @@ def add_parser(sub) -> None:
         help="robot/a/1 (or a/1), basestation/b, engine, referee, or all (repeatable)",
     )
     y.add_argument("--json", action="store_true", help="print JSON instead of text")
+    allow_pickle_flag(y)  # a recording whose match played a pickle policy file
 
 
 def run(args: argparse.Namespace) -> int:

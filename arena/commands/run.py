@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from arena.commands._common import add_command, seconds
-from arena.commands._match_flags import add_match_flags, match_config
+from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
 from arena.runtime.config import KINDS, ConfigError
 
 EXAMPLES = """examples:
@@ -15,8 +15,8 @@ EXAMPLES = """examples:
   # a secure match (it listens on 0.0.0.0): the credentials file arena match wrote for robot/a/1
   arena run robot --match m7-1234-abcdef --connect tls/192.168.1.10:7447 --team a --robot 1 \\
       --credentials robot-a-1.json5
-  # a robot that plays a learned policy (the match: --home policy:/runs/p.pkl); its own copy of the file
-  arena run robot --match demo --connect tcp/192.168.1.10:7447 --team a --robot 1 --policy p.pkl
+  # a robot that plays a learned policy (the match: --home policy:/runs/p.onnx); its own copy of the file
+  arena run robot --match demo --connect tcp/192.168.1.10:7447 --team a --robot 1 --policy p.onnx
   arena run engine --match demo --listen tcp/127.0.0.1:7448 --home BS --away AD --seed 3
   arena run router --match demo --listen tcp/0.0.0.0:7447
   arena run router --match demo --listen tls/0.0.0.0:7447 --credentials creds/   # secure: writes creds/*.json5
@@ -46,6 +46,7 @@ def add_parser(sub) -> None:
         help="robot, basestation: this computer's copy of the policy file the team plays (its strategy is "
         "policy:PATH, a path on the computer that started the match; docs/learning.md)",
     )
+    allow_pickle_flag(r)
     r.add_argument("--mode", choices=["peer", "client"], default="peer", help="zenoh mode (peer)")
     r.add_argument(
         "--credentials",

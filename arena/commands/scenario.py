@@ -15,6 +15,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 from pathlib import Path
 
+from arena.commands._match_flags import allow_pickle_flag
+
 EXAMPLES = """\
 examples:
   arena scenario run corner.scenario.toml                      # each scenario once, seed 0
@@ -61,6 +63,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="one JSON object: every scenario, run and verdict")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report, one test case per scenario")
     p.add_argument("--record", metavar="PATH", help="with one scenario and one seed: write the run's MCAP here")
+    allow_pickle_flag(p)
     p.add_argument(
         "--records", metavar="DIR", default="scenario-runs", help="MCAP files of failed runs (scenario-runs)"
     )

@@ -7,7 +7,7 @@ import json
 import sys
 
 from arena.commands._common import ENGINE_FLAG, add_command, positive_int
-from arena.commands._match_flags import add_match_flags, match_config
+from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
@@ -50,6 +50,7 @@ def add_parser(sub) -> None:
     )
     t.add_argument("--json", action="store_true", help="print one JSON object")
     t.add_argument("--engine", **ENGINE_FLAG)
+    allow_pickle_flag(t)
 
 
 def run(args: argparse.Namespace) -> int:

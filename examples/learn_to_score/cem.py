@@ -9,8 +9,8 @@ position in its body frame, whether it sees and holds the ball), 28 parameters. 
 method (Rubinstein 1999; de Boer et al. 2005, Alg. 2) samples a population of parameter vectors from
 a Gaussian, plays each on the same seeds, and refits the Gaussian to the best fifth.
 
-It writes into --out: learning-curve.png, policy.pkl (a policy file: `arena match --home
-policy:OUT/policy.pkl --away BS` plays it), and results.json with the trained and the untrained
+It writes into --out: learning-curve.png, policy.onnx (a policy file: `arena match --home
+policy:OUT/policy.onnx --away BS` plays it), and results.json with the trained and the untrained
 policy's goals over 50 seeds no training episode used.
 """
 
@@ -121,10 +121,10 @@ def main() -> None:
         result[name] = {"mean_return": round(ret, 4), "goals": goals}
         print(f"{name}: {goals} goals in {args.eval_seeds} seeds, mean return {ret:.3f}", flush=True)
     result["curve"] = curve
-    save_policy(out / "policy.pkl", {1: trained}, base="basic-static", frame_skip=FRAME_SKIP, robots=ROBOTS)
+    save_policy(out / "policy.onnx", {1: trained}, base="basic-static", frame_skip=FRAME_SKIP, robots=ROBOTS)
     (out / "results.json").write_text(json.dumps(result, indent=2))
     plot(curve, result, out / "learning-curve.png")
-    print(f"wrote {out}/learning-curve.png, {out}/policy.pkl, {out}/results.json")
+    print(f"wrote {out}/learning-curve.png, {out}/policy.onnx, {out}/results.json")
 
 
 def plot(curve, result, path: Path) -> None:

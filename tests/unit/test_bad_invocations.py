@@ -189,7 +189,7 @@ BAD = [
     (["match", "--config", "{tmp}"], "is a directory: give a file"),
     (["match", "--config", "{deep}"], "nests arrays or tables too deep"),  # was RecursionError
     (["config", "--check", "{huge}"], "robot.mass must be at most 1000 kg, got 1e+308"),  # was accepted
-    (["match", "--home", "policy:{file}", "--away", "BS"], "cannot be read"),
+    (["match", "--home", "policy:{file}", "--away", "BS"], "is not a valid ONNX model"),
     (["match", "--home", "policy:/nonexistent.pkl", "--away", "BS"], "policy file /nonexistent.pkl not found"),
     (["match", "--home", "policy:", "--away", "BS"], "'policy:' names no file: policy:PATH"),  # was the cwd, read
     (["match", "--home", "policy:{tmp}", "--away", "BS"], "is a directory: give the file save_policy wrote"),
