@@ -51,7 +51,7 @@ from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.keys import MAX_BATCH, MAX_FRAME_BYTES
 from arena.schemas.messages import Base
-from arena.schemas.validate import nonfinite, safe_default
+from arena.schemas.validate import nonfinite, safe_default, suspect
 
 M = TypeVar("M", bound=Base)
 
@@ -348,7 +348,6 @@ class Inbound(Generic[M]):
         self.woken = False  # reactive mode: a WAKE came (a peer's token vanished)
         self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
         self.latest: M | None = None  # the last delivered message
-        self._last_raw: bytes = b""  # payload of the last accepted frame (conflict detection)
         self._recent: dict[int, bytes] = {}  # tick -> payload of the last RECENT accepted frames (conflicts)
         self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
         self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
@@ -367,7 +366,7 @@ class Inbound(Generic[M]):
         if len(raw) > MAX_FRAME_BYTES:  # not even decoded: 60,000 robots in a sense took the decoder ~40 ms
             self._rej.reject(self.key, "too-large", f"{len(raw)} bytes, at most {MAX_FRAME_BYTES}")
             return False
-        if raw[:1] and raw[0] in BATCH_HEADS:
+        if raw and raw[0] in BATCH_HEADS:
             try:
                 frames = decode_batch(raw)
             except (msgspec.DecodeError, msgspec.ValidationError) as exc:
@@ -376,35 +375,39 @@ class Inbound(Generic[M]):
             if not frames or len(frames) > MAX_BATCH:
                 self._rej.reject(self.key, "malformed", f"a batch of {len(frames)} frames (1 to {MAX_BATCH})")
                 return False
+            # A frame's bytes lie whole in its batch's: a batch without the byte pair of a
+            # non-finite float (schemas/validate.py `suspect`) has no frame with it.
+            clean = not suspect(raw)
             got = False
             for frame in frames:
-                got = self._accept_one(frame, now_tick) or got
+                got = self._accept_one(frame, now_tick, clean) or got
             return got
         return self._accept_one(raw, now_tick)
 
-    def _accept_one(self, raw: bytes, now_tick: int | None) -> bool:
-        """One frame's bytes: decode, check the sequence, emulate the link."""
+    def _accept_one(self, raw: bytes, now_tick: int | None, clean: bool = False) -> bool:
+        """One frame's bytes: decode, check the sequence, emulate the link; `clean`: known to hold no
+        non-finite float (its batch was scanned)."""
         try:
             msg = self._decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
             self._rej.reject(self.key, "malformed", str(exc)[:120])
             return False
         tick = msg.tick
+        last_seen = self.last_seen
         if self.strict:  # lockstep: exactly the next scheduled tick
-            expected = self.last_seen + 1 if self._every_tick else self.schedule.first_after(self.last_seen)
+            expected = last_seen + 1 if self._every_tick else self.schedule.first_after(last_seen)
             if tick != expected:
-                if tick <= self.last_seen and self._recent.get(tick, raw) != raw:
+                if tick <= last_seen and self._recent.get(tick, raw) != raw:
                     self._conflict(raw, msg)
                 else:
                     self._rej.reject(self.key, "out-of-sequence", f"tick {tick}, expected {expected}")
                 return False
-        elif tick <= self.last_seen:
+        elif tick <= last_seen:
             if self._recent.get(tick, raw) != raw:
                 self._conflict(raw, msg)
             else:
-                self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {self.last_seen}")
+                self._rej.reject(self.key, "out-of-sequence", f"tick {tick} after {last_seen}")
             return False
-        self._last_raw = raw
         recent = self._recent
         recent[tick] = raw
         if len(recent) > RECENT:
@@ -413,7 +416,7 @@ class Inbound(Generic[M]):
         # In sequence: the link advances whatever the content. A frame that fails
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
-        problem = nonfinite(raw, msg)
+        problem = None if clean else nonfinite(raw, msg)
         if problem is None and self._check is not None:
             problem = self._check(msg)
         if problem:
