@@ -176,9 +176,10 @@ def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Ve
     n = len(track)
     if n < 3:
         return 0.0, 0.0
-    mt = sum(t for t, _, _ in track) / n
-    mx = sum(x for _, x, _ in track) / n
-    my = sum(y for _, _, y in track) / n
+    ts, xs, ys = zip(*track)  # the same sums as over generators, without one frame per element
+    mt = sum(ts) / n
+    mx = sum(xs) / n
+    my = sum(ys) / n
     stt = sxt = syt = 0.0
     for t, x, y in track:
         d = t - mt
