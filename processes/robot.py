@@ -23,6 +23,7 @@ class RobotNode(Node):
         cfg = self.cfg
         team, n = self.pid.team, self.pid.robot
         self.report_schedule = self.schedule("report")
+        self._report_phase, self._report_period = self.report_schedule.phase, self.report_schedule.period
         # The perception latency L: at tick k the robot sees the sense of tick k - L.
         self.sense_in = self.inp("sense", team, n, lag=cfg.timing.perception_latency)
         self.order_in = self.inp("order", team, n)
@@ -38,15 +39,20 @@ class RobotNode(Node):
         sense = self.sense_in.latest_by(k)
         order = self.order_in.latest_by(k)
         self.cmd_out.send(self.brain.step(k, sense, order))
-        if self.report_schedule.due(k):
+        if k >= self._report_phase and (k - self._report_phase) % self._report_period == 0:  # report_schedule.due(k)
             self.report_out.send(self.brain.report(k, sense))
         self.last_tick = k
         self.timed(t0)
 
     def lockstep(self) -> Waits:
+        sense_in, order_in, skip_below = self.sense_in, self.order_in, self.skip_below
         for k in range(self.cfg.total_ticks + 1):
-            yield self.sense_in, k
-            yield self.order_in, k
+            sense_in.waited = k  # a wait not yielded (`Node.skip_below`)
+            if k >= skip_below or not sense_in.ready(k):
+                yield sense_in, k
+            order_in.waited = k
+            if k >= skip_below or not order_in.ready(k):
+                yield order_in, k
             self.act(k)
 
     def loop_realtime(self) -> None:
