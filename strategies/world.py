@@ -171,15 +171,37 @@ class TeamModel:
         return t.xy
 
 
+def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
+    """For n consecutive ticks t0 .. t0 + n - 1: each t - mean(t), and the sum of their squares, in the
+    order `_regression_velocity` adds them. The mean is t0 + (n - 1) / 2, a multiple of 1/2 and exact,
+    so each t - mean is i - (n - 1) / 2 whatever t0 is: the same floats as the general loop gives."""
+    mt = sum(range(n)) / n
+    ds = tuple(t - mt for t in range(n))
+    stt = 0.0
+    for d in ds:
+        stt += d * d
+    return ds, stt
+
+
+_CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
+
+
 def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Vec:
     """[m/s] The least-squares slope of x and y over the track's ticks; (0, 0) with fewer than 3 points."""
     n = len(track)
     if n < 3:
         return 0.0, 0.0
     ts, xs, ys = zip(*track)  # the same sums as over generators, without one frame per element
-    mt = sum(ts) / n
     mx = sum(xs) / n
     my = sum(ys) / n
+    if ts[-1] - ts[0] == n - 1 and n in _CONSECUTIVE:  # a detection every tick (ticks rise: `_track`)
+        ds, stt = _CONSECUTIVE[n]
+        sxt = syt = 0.0
+        for d, x, y in zip(ds, xs, ys):
+            sxt += d * (x - mx)
+            syt += d * (y - my)
+        return sxt / (stt * dt), syt / (stt * dt)
+    mt = sum(ts) / n
     stt = sxt = syt = 0.0
     for t, x, y in track:
         d = t - mt
