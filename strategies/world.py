@@ -83,7 +83,10 @@ class BallFilter:
 
     def observe(self, tick: int, x: float, y: float) -> None:
         t = self.track
-        if t is not None and tick > t.tick:
+        if t is None:
+            self.track = Track(x, y, tick)
+            return
+        if tick > t.tick:
             gap = tick - t.tick  # [ticks]
             span = gap * self.dt
             vx, vy = (x - t.x) / span, (y - t.y) / span
@@ -92,7 +95,7 @@ class BallFilter:
                 self.vel = (w * vx + keep * vel[0], w * vy + keep * vel[1])
             else:
                 self.vel = (0.0, 0.0)
-        self.track = Track(x, y, tick)
+        t.x, t.y, t.tick = x, y, tick  # the track is read, never kept, by this module's callers
 
     def age(self, tick: int) -> int:
         return tick - self.track.tick if self.track is not None else 1 << 30
