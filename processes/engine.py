@@ -193,9 +193,10 @@ class EngineNode(Node):
         ph, sp = self.physics, self.cfg.sensor
         for out, z in zip(self.sense_out.values(), sense_every(ph, k, self.sense_plan, sp)):
             out.send(z)
-        if self.world_schedule.due(k):
+        ws, es = self.world_schedule, self.events_schedule
+        if k >= ws.phase and (k - ws.phase) % ws.period == 0:  # world_schedule.due(k), inlined
             self.world_out.send(ph.world(k))
-        if self.events_schedule.due(k):
+        if k >= es.phase and (k - es.phase) % es.period == 0:
             self.pending_events.extend(self.stuck.check(ph))
             self.events_out.send(EngineEvents(tick=k, events=self.pending_events))
             self.pending_events = []
