@@ -360,8 +360,9 @@ class Node(Peer):
         # A lockstep loop may skip yielding a wait at tick k < skip_below whose link is
         # `ready(k)` already, noting `waited` itself: every driver's `advance` goes straight
         # on from such a wait, so only the resumes are saved (a dozen a tick in process).
-        # At and past a scenario's `kill` tick every wait is yielded, for `until` to see.
-        self.skip_below = 1 << 62
+        # 0 here: whoever drives `lockstep()` itself sees every wait (learn/match.py gates a
+        # learner's loop on them); `loop` sets it, up to a scenario's `kill` tick, for `until`.
+        self.skip_below = 0
 
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
