@@ -17,7 +17,14 @@ figure is derived, not measured, as the smaller of two bounds:
   measured match to 600 simulated seconds.
 The in-process engine's match is one thread (its CPU ~ its wall), so its two
 bounds agree; the distributed engine's eleven processes share the cores, so
-the CPU bound is the one that holds for it."""
+the CPU bound is the one that holds for it.
+
+Also printed: ticks per CPU-second of each engine's whole command (start-up
+included; the figure the engines' cost is compared by), the processes engine's
+rtf over the in-process engine's, pair by pair, and, where the learn extra is
+installed, the learning env's steps per CPU-second beside the in-process
+match's ticks per CPU-second, both measured in this process over the same match
+(`arena bench learn` has more)."""
 
 from __future__ import annotations
 
@@ -36,6 +43,10 @@ if TYPE_CHECKING:
     from arena.runtime.config import MatchConfig
 
 ENGINES = ("processes", "inprocess")
+RSOCCER = (
+    "not measured by this command: rSoccer's VSS-v0 needs Python 3.10 (rc-robosim, rsoccer-gym); "
+    "docs/performance.md has the side-by-side figures and how they were taken"
+)
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
 LAUNCH_DEFINITIONS = {
     "command": "the `arena match` command started (Python's start and every import included) "
@@ -67,6 +78,7 @@ def play(engine: str, cfg: MatchConfig) -> dict:
         "digest": r["digest"],
         "rtf": r["rtf"],
         "sim_seconds": r["sim_seconds"],
+        "ticks": r["ticks"],
         "command_wall_s": round(wall, 3),
         "command_cpu_s": round(cpu, 3),
         "launch_to_first_tick_s": round(started - t0, 3),
@@ -81,6 +93,7 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
     med = {k: statistics.median(r[k] or 0.0 for r in runs) for k in keys}
     overhead = statistics.median(r["overhead_s"] for r in runs)
     cpu_per_sim = statistics.median(r["command_cpu_s"] / r["sim_seconds"] for r in runs)
+    ticks_per_cpu = statistics.median((r.get("ticks") or 0) / max(1e-9, r["command_cpu_s"]) for r in runs)
     per_match_wall = TOURNAMENT_MATCH_S / med["rtf"] + overhead
     wall_bound = jobs * 3600.0 / per_match_wall
     cpu_bound = cores * 3600.0 / (cpu_per_sim * TOURNAMENT_MATCH_S)
@@ -92,10 +105,29 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
         "launch": sorted({r["launch"] or "" for r in runs}),
         "command_wall_s": round(med["command_wall_s"], 3),
         "cpu_s_per_sim_s": round(cpu_per_sim, 4),
+        "ticks_per_cpu_s": round(ticks_per_cpu, 1),
         "matches_per_hour": round(min(wall_bound, cpu_bound), 1),
         "matches_per_hour_wall_bound": round(wall_bound, 1),
         "matches_per_hour_cpu_bound": round(cpu_bound, 1),
     }
+
+
+def learn_rates(base: MatchConfig, runs: int, strategy: str, say) -> dict | None:
+    """The learning env's steps and the in-process match's ticks per CPU-second of this process, over
+    the same 3v3 match (one controlled robot), interleaved; None without the learn extra."""
+    try:
+        from arena.learn.bench import env_rate, match_rate
+    except ImportError:
+        return None
+    match: list[float] = []
+    env: list[float] = []
+    for i in range(runs):
+        cfg = base.replace(seed=1 + i, home=strategy, away=strategy, robots=3, link="ideal")
+        say(f"learn env run {i + 1}/{runs}: in-process match, then one env episode (robot a/1) ...")
+        match.append(match_rate(cfg))
+        env.append(env_rate(cfg, ["a/1"]))
+    m, e = statistics.median(match), statistics.median(env)
+    return {"match_ticks_per_cpu_s": round(m, 1), "env_steps_per_cpu_s": round(e, 1), "env_over_match": round(e / m, 3)}
 
 
 def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool) -> int:
@@ -114,6 +146,8 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
     per = {e: summarise(played[e], jobs, cores) for e in ENGINES}
     same = all(a["digest"] == b["digest"] for a, b in zip(played["processes"], played["inprocess"]))
     ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
+    back = statistics.median(a["rtf"] / b["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
+    learn = learn_rates(base, runs, strategy, console.print)
     out = {
         "runs": runs,
         "match": f"{strategy} v {strategy}, {base.robots}v{base.robots}, 2 x {base.half_time:g} s, link {base.link}",
@@ -121,6 +155,9 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
         "jobs": jobs,
         "engines": per,
         "rtf_ratio_inprocess_over_processes": round(ratio, 2),
+        "rtf_ratio_processes_over_inprocess": round(back, 3),
+        "learn": learn,  # None: the learn extra is not installed
+        "rsoccer": RSOCCER,
         "digests_equal": same,
         "throughput_how": "matches/hour of 2 x 300 s = min(jobs x 3600 / (600 / rtf + start-up and teardown), "
         "cores x 3600 / (CPU s per simulated s x 600)), from the medians above",
@@ -153,6 +190,12 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
         f"{q['play_match_to_first_tick_s'] / max(1e-9, p['play_match_to_first_tick_s']):.2f}x",
     )
     t.add_row(escape("whole command [s]"), f"{p['command_wall_s']:.2f}", f"{q['command_wall_s']:.2f}", "")
+    t.add_row(
+        "ticks per CPU-second (whole command)",
+        f"{p['ticks_per_cpu_s']:.0f}",
+        f"{q['ticks_per_cpu_s']:.0f}",
+        f"{q['ticks_per_cpu_s'] / max(1e-9, p['ticks_per_cpu_s']):.2f}x",
+    )
     t.add_row("CPU s per simulated s", f"{p['cpu_s_per_sim_s']:.4f}", f"{q['cpu_s_per_sim_s']:.4f}", "")
     t.add_row(
         f"tournament matches/hour (2 x 300 s, --jobs {jobs})",
@@ -162,6 +205,16 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
     )
     make_console().print(t)
     console.print(f"digests equal in every pair: {'yes' if same else 'NO'}")
+    console.print(f"processes rtf / in-process rtf, median of the pairs: {back:.3f}")
+    if learn is None:
+        console.print("learning env: not measured (install the learn extra)")
+    else:
+        console.print(
+            f"learning env: {learn['env_steps_per_cpu_s']:.0f} steps per CPU-second against the in-process "
+            f"match's {learn['match_ticks_per_cpu_s']:.0f} ticks per CPU-second (this process): "
+            f"{learn['env_over_match']:.2f} x"
+        )
+    console.print(f"rSoccer VSS-v0: {RSOCCER}")
     console.print("throughput derived: " + out["throughput_how"])
     console.print(f"(1) {LAUNCH_DEFINITIONS['command']}")
     console.print(f"(2) {LAUNCH_DEFINITIONS['play_match']}")
