@@ -42,7 +42,7 @@ class RobotNode(Node):
         if k >= self._report_phase and (k - self._report_phase) % self._report_period == 0:  # report_schedule.due(k)
             self.report_out.send(self.brain.report(k, sense))
         self.last_tick = k
-        self.timed(t0)
+        self._work_s.append(time.perf_counter() - t0)  # `timed(t0)`, one call less a tick
 
     def lockstep(self) -> Waits:
         sense_in, order_in, skip_below = self.sense_in, self.order_in, self.skip_below

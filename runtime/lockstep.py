@@ -503,7 +503,8 @@ class Inbound(Generic[M]):
         """Lockstep, never blocking: take in whatever has arrived on the channel (the cooperative driver)."""
         ch = self.channel
         while (raw := ch.try_recv()) is not None:  # type: ignore[union-attr]
-            self._accept(raw, None)
+            if raw != WAKE:  # `_accept`, one call less a message
+                self._accept_frame(raw, None)
 
     def sender_gone(self) -> bool:
         """Its sender's liveliness token has vanished."""
