@@ -34,6 +34,7 @@ import resource
 import statistics
 import subprocess
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from arena.tools.console import console as make_console
@@ -112,26 +113,15 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
     }
 
 
-def learn_rates(base: MatchConfig, runs: int, strategy: str, say) -> dict | None:
-    """The learning env's steps and the in-process match's ticks per CPU-second of this process, over
-    the same 3v3 match (one controlled robot), interleaved; None without the learn extra."""
-    try:
-        from arena.learn.bench import env_rate, match_rate
-    except ImportError:
-        return None
-    match: list[float] = []
-    env: list[float] = []
-    for i in range(runs):
-        cfg = base.replace(seed=1 + i, home=strategy, away=strategy, robots=3, link="ideal")
-        say(f"learn env run {i + 1}/{runs}: in-process match, then one env episode (robot a/1) ...")
-        match.append(match_rate(cfg))
-        env.append(env_rate(cfg, ["a/1"]))
-    m, e = statistics.median(match), statistics.median(env)
-    return {"match_ticks_per_cpu_s": round(m, 1), "env_steps_per_cpu_s": round(e, 1), "env_over_match": round(e / m, 3)}
-
-
-def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool) -> int:
-    """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved."""
+def bench_throughput(
+    base: MatchConfig,
+    runs: int,
+    strategy: str,
+    as_json: bool,
+    learn_rates: Callable[[MatchConfig, int, str, Callable[[str], None]], dict] | None = None,
+) -> int:
+    """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved;
+    `learn_rates`: the learning env's figures (arena/learn/bench.py), None without the learn extra."""
     console = make_console(stderr=True)
     cores = os.cpu_count() or 1
     jobs = default_jobs()
@@ -147,7 +137,7 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
     same = all(a["digest"] == b["digest"] for a, b in zip(played["processes"], played["inprocess"]))
     ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
     back = statistics.median(a["rtf"] / b["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
-    learn = learn_rates(base, runs, strategy, console.print)
+    learn = learn_rates(base, runs, strategy, console.print) if learn_rates is not None else None
     out = {
         "runs": runs,
         "match": f"{strategy} v {strategy}, {base.robots}v{base.robots}, 2 x {base.half_time:g} s, link {base.link}",
