@@ -18,7 +18,14 @@ figure is derived, not measured, as the smaller of two bounds:
   measured match to 600 simulated seconds.
 The in-process engine's match is one thread (its CPU ~ its wall), so its two
 bounds agree; the distributed engine's eleven processes share the cores, so
-the CPU bound is the one that holds for it."""
+the CPU bound is the one that holds for it.
+
+Also printed: ticks per CPU-second of each engine's whole command (start-up
+included; the figure the engines' cost is compared by), the processes engine's
+rtf over the in-process engine's, pair by pair, and, where the learn extra is
+installed, the learning env's steps per CPU-second beside the in-process
+match's ticks per CPU-second, both measured in this process over the same match
+(`arena bench learn` has more)."""
 
 from __future__ import annotations
 
@@ -28,6 +35,7 @@ import resource
 import statistics
 import subprocess
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from msgspec import UNSET
@@ -40,6 +48,10 @@ if TYPE_CHECKING:
     from arena.runtime.config import MatchConfig
 
 ENGINES = ("processes", "inprocess")
+RSOCCER = (
+    "not measured by this command: rSoccer's VSS-v0 needs Python 3.10 (rc-robosim, rsoccer-gym); "
+    "docs/performance.md has the side-by-side figures and how they were taken"
+)
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
 LAUNCH_DEFINITIONS = {
     "command": "the match's command started (`python -m arena.match`; Python's start and every import included) "
@@ -72,6 +84,7 @@ def play(engine: str, cfg: MatchConfig) -> dict:
         "digest": r.digest,
         "rtf": r.rtf,
         "sim_seconds": r.sim_seconds,
+        "ticks": r.ticks,
         "command_wall_s": round(wall, 3),
         "command_cpu_s": round(cpu, 3),
         "launch_to_first_tick_s": round(started - t0, 3),
@@ -86,6 +99,7 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
     med = {k: statistics.median(r[k] or 0.0 for r in runs) for k in keys}
     overhead = statistics.median(r["overhead_s"] for r in runs)
     cpu_per_sim = statistics.median(r["command_cpu_s"] / r["sim_seconds"] for r in runs)
+    ticks_per_cpu = statistics.median((r.get("ticks") or 0) / max(1e-9, r["command_cpu_s"]) for r in runs)
     per_match_wall = TOURNAMENT_MATCH_S / med["rtf"] + overhead
     wall_bound = jobs * 3600.0 / per_match_wall
     cpu_bound = cores * 3600.0 / (cpu_per_sim * TOURNAMENT_MATCH_S)
@@ -97,14 +111,22 @@ def summarise(runs: list[dict], jobs: int, cores: int) -> dict:
         "launch": sorted({r["launch"] or "" for r in runs}),
         "command_wall_s": round(med["command_wall_s"], 3),
         "cpu_s_per_sim_s": round(cpu_per_sim, 4),
+        "ticks_per_cpu_s": round(ticks_per_cpu, 1),
         "matches_per_hour": round(min(wall_bound, cpu_bound), 1),
         "matches_per_hour_wall_bound": round(wall_bound, 1),
         "matches_per_hour_cpu_bound": round(cpu_bound, 1),
     }
 
 
-def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool) -> int:
-    """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved."""
+def bench_throughput(
+    base: MatchConfig,
+    runs: int,
+    strategy: str,
+    as_json: bool,
+    learn_rates: Callable[[MatchConfig, int, str, Callable[[str], None]], dict] | None = None,
+) -> int:
+    """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved;
+    `learn_rates`: the learning env's figures (arena/learn/bench.py), None without the learn extra."""
     console = make_console(stderr=True)
     cores = os.cpu_count() or 1
     jobs = default_jobs()
@@ -119,6 +141,8 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
     per = {e: summarise(played[e], jobs, cores) for e in ENGINES}
     same = all(a["digest"] == b["digest"] for a, b in zip(played["processes"], played["inprocess"]))
     ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
+    back = statistics.median(a["rtf"] / b["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
+    learn = learn_rates(base, runs, strategy, console.print) if learn_rates is not None else None
     out = {
         "runs": runs,
         "match": f"{strategy} v {strategy}, {base.robots}v{base.robots}, 2 x {base.half_time:g} s, link {base.link}",
@@ -126,6 +150,9 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
         "jobs": jobs,
         "engines": per,
         "rtf_ratio_inprocess_over_processes": round(ratio, 2),
+        "rtf_ratio_processes_over_inprocess": round(back, 3),
+        "learn": learn,  # None: the learn extra is not installed
+        "rsoccer": RSOCCER,
         "digests_equal": same,
         "throughput_how": "matches/hour of 2 x 300 s = min(jobs x 3600 / (600 / rtf + start-up and teardown), "
         "cores x 3600 / (CPU s per simulated s x 600)), from the medians above",
@@ -158,6 +185,12 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
         f"{q['play_match_to_first_tick_s'] / max(1e-9, p['play_match_to_first_tick_s']):.2f}x",
     )
     t.add_row(escape("whole command [s]"), f"{p['command_wall_s']:.2f}", f"{q['command_wall_s']:.2f}", "")
+    t.add_row(
+        "ticks per CPU-second (whole command)",
+        f"{p['ticks_per_cpu_s']:.0f}",
+        f"{q['ticks_per_cpu_s']:.0f}",
+        f"{q['ticks_per_cpu_s'] / max(1e-9, p['ticks_per_cpu_s']):.2f}x",
+    )
     t.add_row("CPU s per simulated s", f"{p['cpu_s_per_sim_s']:.4f}", f"{q['cpu_s_per_sim_s']:.4f}", "")
     t.add_row(
         f"tournament matches/hour (2 x 300 s, --jobs {jobs})",
@@ -167,6 +200,16 @@ def bench_throughput(base: MatchConfig, runs: int, strategy: str, as_json: bool)
     )
     make_console().print(t)
     console.print(f"digests equal in every pair: {'yes' if same else 'NO'}")
+    console.print(f"processes rtf / in-process rtf, median of the pairs: {back:.3f}")
+    if learn is None:
+        console.print("learning env: not measured (install the learn extra)")
+    else:
+        console.print(
+            f"learning env: {learn['env_steps_per_cpu_s']:.0f} steps per CPU-second against the in-process "
+            f"match's {learn['match_ticks_per_cpu_s']:.0f} ticks per CPU-second (this process): "
+            f"{learn['env_over_match']:.2f} x"
+        )
+    console.print(f"rSoccer VSS-v0: {RSOCCER}")
     console.print("throughput derived: " + out["throughput_how"])
     console.print(f"(1) {LAUNCH_DEFINITIONS['command']}")
     console.print(f"(2) {LAUNCH_DEFINITIONS['play_match']}")

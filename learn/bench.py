@@ -63,6 +63,20 @@ def env_rate(cfg: MatchConfig, agents: list[str], frame_skip: int = 1) -> float:
     return n / (time.process_time() - t0)
 
 
+def learn_rates(base: MatchConfig, runs: int, strategy: str, say) -> dict:
+    """The env's steps and the in-process match's ticks per CPU-second of this process, over the same
+    3v3 match (one controlled robot), interleaved: `arena bench throughput`'s learning row."""
+    match: list[float] = []
+    env: list[float] = []
+    for i in range(runs):
+        cfg = base.replace(seed=1 + i, home=strategy, away=strategy, robots=3, link="ideal")
+        say(f"learn env run {i + 1}/{runs}: in-process match, then one env episode (robot a/1) ...")
+        match.append(match_rate(cfg))
+        env.append(env_rate(cfg, ["a/1"]))
+    m, e = statistics.median(match), statistics.median(env)
+    return {"match_ticks_per_cpu_s": round(m, 1), "env_steps_per_cpu_s": round(e, 1), "env_over_match": round(e / m, 3)}
+
+
 def vector_rate(workers: int, steps: int, half_time: float, strategy: str, frame_skip: int = 1, gym: bool = False):
     """`workers` SoccerEnvs in their own processes, `steps` vector steps after 20 to warm up.
 

@@ -199,6 +199,8 @@ class SteppedMatch:
                 self.gates[agent] = gate = Gate(agent)
                 self.robot_of[agent] = node
                 steps = _gated(node, gate, frame_skip)
+            else:  # no gate on its waits: it may skip those already ready (`Node.skip_below`)
+                node.skip_below = 1 << 62
             task = node.driver  # its `Task`; the gated loop is driven, not `Node.playing`
             task.steps, task.flush = steps, node.batch_flusher()
             tasks.append(task)

@@ -202,9 +202,10 @@ class EngineNode(Node):
         ph, sp = self.physics, self.cfg.sensor
         for out, z in zip(self.sense_out.values(), sense_every(ph, k, self.sense_plan, sp)):
             out.send(z)
-        if self.world_schedule.due(k):
+        ws, es = self.world_schedule, self.events_schedule
+        if k >= ws.phase and (k - ws.phase) % ws.period == 0:  # world_schedule.due(k), inlined
             self.world_out.send(ph.world(k))
-        if self.events_schedule.due(k):
+        if k >= es.phase and (k - es.phase) % es.period == 0:
             self.pending_events.extend(self.stuck.check(ph))
             self.events_out.send(EngineEvents(tick=k, events=self.pending_events))
             self.pending_events = []
@@ -247,11 +248,14 @@ class EngineNode(Node):
         self.field_out.send(self.field_spec())
         last = self.cfg.total_ticks
         ph = self.physics
-        pacer = self.pacer
+        pacer, ref_in, skip_below = self.pacer, self.ref_in, self.skip_below
         for k in range(last + 1):
             if pacer is not None:
                 yield pacer, k  # type: ignore[misc] - duck-types an Inbound: it only ever waits
-            yield self.ref_in, k
+            skip = k < skip_below
+            ref_in.waited = k  # a wait not yielded (`Node.skip_below`)
+            if not (skip and ref_in.ready(k)):
+                yield ref_in, k
             t0 = time.perf_counter()
             self.apply_referee(self.ref_in.take(k), k)
             self.publish(k)
@@ -263,7 +267,9 @@ class EngineNode(Node):
                 break
             work = time.perf_counter() - t0
             for r, ib in self.cmd_in.items():
-                yield ib, k
+                ib.waited = k  # a wait not yielded (`Node.skip_below`)
+                if not (skip and ib.ready(k)):
+                    yield ib, k
                 frames = ib.take(k)
                 if frames:
                     ph.set_command(r[0], r[1], frames[-1])

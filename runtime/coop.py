@@ -113,8 +113,9 @@ class Task:
         self.summary: Summary | None = None  # what `play` played to its end returned
 
     def drive(self, steps: Waits, before_wait: Callable[[], None] | None) -> Waits:
+        # The loop itself, not a generator round it: one level less for each of its resumes.
         self.flush = before_wait
-        yield from steps
+        return steps
 
     def before_wait(self) -> None:
         # Looked up at each park: `drive` sets it once the node's loop starts.

@@ -131,7 +131,7 @@ def parse_overrides(texts) -> dict[str, dict[str, float]]:
 class LinkEmulator:
     """Decides, frame by frame and in send order, whether a frame is dropped and how late it is."""
 
-    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "_ideal", "_changes")
+    __slots__ = ("model", "_rng", "_bad", "frames", "dropped", "delays_ms", "_ideal", "_changes", "on_time")
 
     def __init__(self, model: LinkModel, rng: random.Random, changes: tuple[tuple[int, LinkModel], ...] = ()):
         """`changes`: (tick, model) in tick order: a scenario's link steps (`scheduled`), for frames sent from then on."""
@@ -140,6 +140,9 @@ class LinkEmulator:
         self._rng = rng
         self._bad = False
         self._ideal = model.is_ideal()
+        # Ideal now and for good: `decide` only counts the frame and says 0.0 (its receiver
+        # does that itself, without the call: runtime/lockstep.py `Inbound._accept_one`).
+        self.on_time = self._ideal and not self._changes
         self.frames = 0
         self.dropped = 0
         self.delays_ms: list[float] = []  # drawn delays of delivered frames (non-ideal links)
@@ -149,6 +152,7 @@ class LinkEmulator:
         if self._changes and tick >= self._changes[0][0]:
             self.model = self._changes.pop(0)[1]
             self._ideal = self.model.is_ideal()
+            self.on_time = self._ideal and not self._changes
         self.frames += 1
         if self._ideal:
             return 0.0  # no delay statistics to keep: every delay is 0

@@ -371,6 +371,12 @@ class Node(Peer):
             self.tap = Tap(self.name, self._tap_handoff or put)
         if isinstance(self.driver, Reactor):  # its main thread looks ten times a second
             self.driver.on_idle = self.announce_spoofing
+        # A lockstep loop may skip yielding a wait at tick k < skip_below whose link is
+        # `ready(k)` already, noting `waited` itself: every driver's `advance` goes straight
+        # on from such a wait, so only the resumes are saved (a dozen a tick in process).
+        # 0 here: whoever drives `lockstep()` itself sees every wait (learn/match.py gates a
+        # learner's loop on them); `loop` sets it, up to a scenario's `kill` tick, for `until`.
+        self.skip_below = 0
 
     # ----------------------------------------------------------------- wiring
     def out(self, name: str, team: str = "", n: int | None = None, viewers_only: bool = False) -> Outbound[Any]:
@@ -446,8 +452,9 @@ class Node(Peer):
         if self.cfg.realtime and not self.cooperative:
             self.loop_realtime()
             return
-        steps = self.lockstep()
         stop = killed_at(self.cfg, self.name)
+        self.skip_below = stop if stop >= 0 else 1 << 62  # see `Node.skip_below`
+        steps = self.lockstep()
         if stop >= 0:  # a scenario's `kill` step: the loop ends before acting at that tick
             steps = until(steps, stop)
         yield from self.driver.drive(steps, self.batch_flusher())

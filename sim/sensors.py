@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from arena.navigation.frames import wrap_angle
+from arena.navigation.frames import TAU
 from arena.runtime.config import SensorParams
 from arena.schemas.messages import BallSeen, Pose, RobotSeen, Sense
 from arena.sim.physics import Physics
@@ -111,10 +111,11 @@ def _sense(
     """Robot `me` (one of `states`) at `tick`, with its normals `z` (3 + 2 per robot of `states`)."""
     team, n, x, y, theta, vx, vy, omega = me
     c, s = math.cos(theta), math.sin(theta)
+    heading = math.remainder(theta + p.heading_sigma * z[2], TAU)  # wrap_angle, inlined
     pose = Pose(
         x=x + p.pose_sigma * z[0],
         y=y + p.pose_sigma * z[1],
-        theta=wrap_angle(theta + p.heading_sigma * z[2]),
+        theta=math.pi if heading == -math.pi else heading,
     )
     hypot, det, per_m = math.hypot, p.det_sigma, p.det_sigma_per_m
     bx, by = ball_state[0], ball_state[1]

@@ -83,7 +83,10 @@ class BallFilter:
 
     def observe(self, tick: int, x: float, y: float) -> None:
         t = self.track
-        if t is not None and tick > t.tick:
+        if t is None:
+            self.track = Track(x, y, tick)
+            return
+        if tick > t.tick:
             gap = tick - t.tick  # [ticks]
             span = gap * self.dt
             vx, vy = (x - t.x) / span, (y - t.y) / span
@@ -92,7 +95,7 @@ class BallFilter:
                 self.vel = (w * vx + keep * vel[0], w * vy + keep * vel[1])
             else:
                 self.vel = (0.0, 0.0)
-        self.track = Track(x, y, tick)
+        t.x, t.y, t.tick = x, y, tick  # the track is read, never kept, by this module's callers
 
     def age(self, tick: int) -> int:
         return tick - self.track.tick if self.track is not None else 1 << 30
@@ -171,14 +174,37 @@ class TeamModel:
         return t.xy
 
 
+def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
+    """For n consecutive ticks t0 .. t0 + n - 1: each t - mean(t), and the sum of their squares, in the
+    order `_regression_velocity` adds them. The mean is t0 + (n - 1) / 2, a multiple of 1/2 and exact,
+    so each t - mean is i - (n - 1) / 2 whatever t0 is: the same floats as the general loop gives."""
+    mt = sum(range(n)) / n
+    ds = tuple(t - mt for t in range(n))
+    stt = 0.0
+    for d in ds:
+        stt += d * d
+    return ds, stt
+
+
+_CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
+
+
 def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Vec:
     """[m/s] The least-squares slope of x and y over the track's ticks; (0, 0) with fewer than 3 points."""
     n = len(track)
     if n < 3:
         return 0.0, 0.0
-    mt = sum(t for t, _, _ in track) / n
-    mx = sum(x for _, x, _ in track) / n
-    my = sum(y for _, _, y in track) / n
+    ts, xs, ys = zip(*track)  # the same sums as over generators, without one frame per element
+    mx = sum(xs) / n
+    my = sum(ys) / n
+    if ts[-1] - ts[0] == n - 1 and n in _CONSECUTIVE:  # a detection every tick (ticks rise: `_track`)
+        ds, stt = _CONSECUTIVE[n]
+        sxt = syt = 0.0
+        for d, x, y in zip(ds, xs, ys):
+            sxt += d * (x - mx)
+            syt += d * (y - my)
+        return sxt / (stt * dt), syt / (stt * dt)
+    mt = sum(ts) / n
     stt = sxt = syt = 0.0
     for t, x, y in track:
         d = t - mt

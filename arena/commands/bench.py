@@ -125,7 +125,11 @@ def run(args: argparse.Namespace) -> int:
     if args.what == "throughput":
         from arena.experiments import throughput
 
-        return throughput.bench_throughput(base, args.runs, strategy, args.json)
+        try:  # the learning env's row, with the learn extra
+            from arena.learn.bench import learn_rates
+        except ImportError:
+            learn_rates = None  # type: ignore[assignment]
+        return throughput.bench_throughput(base, args.runs, strategy, args.json, learn_rates)
     if args.what == "nav":
         from arena.experiments import navbench
 
