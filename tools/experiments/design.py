@@ -122,10 +122,11 @@ def read_toml(path: str, what: str) -> dict:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError as exc:
         raise ConfigError(f"cannot read {what} {path}: {exc.strerror}") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise ConfigError(f"{what} {path} is not a regular file")
     with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fh.fileno())
-        if not stat.S_ISREG(st.st_mode):
-            raise ConfigError(f"{what} {path} is not a regular file")
         if st.st_size > MAX_FILE_BYTES:
             raise ConfigError(f"{what} {path} is {st.st_size} bytes; at most {MAX_FILE_BYTES} are read")
         raw = fh.read(MAX_FILE_BYTES + 1)
@@ -248,12 +249,15 @@ def _base(value: Any, path: str) -> MatchConfig:
     """`base`: an inline match configuration, or the path of a match configuration file."""
     if isinstance(value, str):
         where = str(Path(path).parent / value)
-        return matchfile.from_data(matchfile.to_dict(read_toml(where, "base"), where), where)
-    if not isinstance(value, dict):
+        data = read_toml(where, "base")
+    elif isinstance(value, dict):
+        where, data = f"{path}: base", value
+    else:
         raise ConfigError(f"{path}: base must be a table of match configuration keys or a file's path")
-    if "seed" in value:
-        raise ConfigError(f"{path}: base.seed: the seeds are the experiment's (seeds, first_seed)")
-    return matchfile.from_data(matchfile.to_dict(value, f"{path}: base"), f"{path}: base")
+    if "seed" in data:
+        raise ConfigError(f"{where}: seed: the seeds are the experiment's (seeds, first_seed)")
+    cfg = matchfile.from_data(matchfile.to_dict(data, where), where)
+    return cfg.replace(home=_strategy(cfg.home, "home", where), away=_strategy(cfg.away, "away", where))
 
 
 # ------------------------------------------------------------------- factors

@@ -159,9 +159,7 @@ def _lines(ax, cells: list[dict], x: str, group: str | None, resp: str) -> None:
         members.sort(key=lambda c: c[x] if _numeric([c[x]]) else str(c[x]))
         xs = [c[x] for c in members]
         pos = xs if _numeric(xs) else list(range(len(xs)))
-        mean = [c[resp]["mean"] for c in members]
-        lo = [c[resp]["low"] for c in members]
-        hi = [c[resp]["high"] for c in members]
+        mean, lo, hi = ([_nan(c[resp][k]) for c in members] for k in ("mean", "low", "high"))
         ax.plot(pos, mean, marker="o", label=_short(name) if group else None)
         ax.fill_between(pos, lo, hi, alpha=0.2)
         if not _numeric(xs):
@@ -178,7 +176,7 @@ def _heatmap(fig, ax, cells: list[dict], x: str, y: str, resp: str) -> None:
     ys = sorted({c[y] for c in cells}, key=lambda v: (not _numeric([v]), v if _numeric([v]) else str(v)))
     grid = np.full((len(ys), len(xs)), np.nan)
     for c in cells:
-        grid[ys.index(c[y]), xs.index(c[x])] = c[resp]["mean"] if c[resp]["mean"] is not None else np.nan
+        grid[ys.index(c[y]), xs.index(c[x])] = _nan(c[resp]["mean"])
     im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
     ax.set_xticks(range(len(xs)), [_short(v) for v in xs])
     ax.set_yticks(range(len(ys)), [_short(v) for v in ys])
@@ -189,6 +187,10 @@ def _heatmap(fig, ax, cells: list[dict], x: str, y: str, resp: str) -> None:
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     fig.colorbar(im, ax=ax, label=resp)
+
+
+def _nan(x: float | None) -> float:
+    return float("nan") if x is None else x
 
 
 def _short(v) -> str:
