@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from arena.runtime.config import ConfigError, MatchConfig
+from arena.tools.experiments.experiment import team_view
 from arena.tools.experiments.sprt import Sprt, normalized_elo
 
 EXIT = {"accepted": 0, "rejected": 1, "": 3}
@@ -105,12 +106,12 @@ def run(base: MatchConfig, opts: CompareOptions, progress: bool = True, log_dir:
             while not test.state and counted < opts.max_pairs:
                 while next_pair < opts.max_pairs and ex.pending + 2 <= max(ex.capacity, 2):
                     for key, cfg, team in matches_of_pair(base, opts, next_pair):
-                        ex.submit(key, (cfg, "inprocess", team, False))
+                        ex.submit((key, team), (cfg, "inprocess", False))
                     next_pair += 1
-                for key, row, reason in ex.wait():
-                    if row is None:
+                for (key, team), played, reason in ex.wait():
+                    if played is None:
                         raise RuntimeError(f"pair {key[0]} ({key[1]}, team {key[2]}): {reason}")
-                    got[key] = row
+                    got[key] = team_view(played, team)
                 while counted < next_pair and all(k in got for k, _, _ in matches_of_pair(base, opts, counted)):
                     games = games_of_pair(opts, got, counted)
                     wins += games.count(1.0)

@@ -2,7 +2,7 @@
 processes (`--jobs N`, one match per worker at a time, each importing once), or as Ray
 tasks (`--ray [ADDRESS]`, tools/experiments/cluster.py's connection and version check).
 
-Every task is `play_one(cfg, engine, team, facts)` (tools/experiments/experiment.py); a
+Every task is `play_one(cfg, engine, facts)` (tools/experiments/experiment.py); a
 task that fails comes back as its reason, never as an exception, so the caller decides
 whether to play it again.
 """

@@ -72,17 +72,28 @@ def _play_processes(cfg: MatchConfig) -> dict:
     return json.loads(proc.stdout)
 
 
-def play_one(cfg: MatchConfig, engine: str, team: str, facts: bool) -> dict:
-    """One match as the responses of `team`'s strategy, its digest and CPU time; a worker's task."""
+def play_one(cfg: MatchConfig, engine: str, facts: bool) -> dict:
+    """One match: its score, metres per robot, digest, CPU time and, with `facts`, the `arena facts`
+    measures of both teams; a worker's task. `team_view` turns it into one team's responses."""
     cpu0 = time.process_time()
     m, frames = _play(cfg, engine, ("world", "referee") if facts else ())
     if reason := void_reason(m):
         raise RuntimeError(reason)
-    out = responses(m, team)
+    out = {"score": m["score"], "robots": m["robots"], "distance_m": m["distance_m"], "digest": m["digest"]}
     if facts:
-        out.update(facts_of(cfg, m, frames, team))
-    out["digest"] = m["digest"]
+        out["facts"] = facts_of(cfg, m, frames)
     out["cpu_s"] = round(time.process_time() - cpu0, 4)
+    return out
+
+
+def team_view(got: dict, team: str, share: int = 1) -> dict:
+    """The responses of `team` in a match `play_one` played; `share`: rows that show this one match
+    (its CPU time is split among them, so the rows' CPU adds up to what was played)."""
+    out = responses(got, team)
+    if "facts" in got:
+        out.update(got["facts"][team])
+    out["digest"] = got["digest"]
+    out["cpu_s"] = round(got["cpu_s"] / share, 4)
     return out
 
 
@@ -103,8 +114,8 @@ def responses(m: dict, team: str) -> dict:
     return out
 
 
-def facts_of(cfg: MatchConfig, m: dict, frames: dict, team: str) -> dict:
-    """The `arena facts` measures of `team` (recording/analysis/facts.py over the watched frames)."""
+def facts_of(cfg: MatchConfig, m: dict, frames: dict) -> dict:
+    """The `arena facts` measures of each team (recording/analysis/facts.py over the watched frames)."""
     import msgspec
 
     from arena.recording.analysis.facts import measure
@@ -114,8 +125,10 @@ def facts_of(cfg: MatchConfig, m: dict, frames: dict, team: str) -> dict:
     referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in frames["referee"])}
     extra = {"log": m["referee_log"], "score": m["score"], "events": m["events"]}  # the referee's summary
     f = measure(cfg, worlds, referee, extra, m["distance_m"])
-    t = f.teams[0 if team == "a" else 1]
-    return {"shots": t.shots, "on_target": t.on_target, "saves": t.saves, "blocks": t.blocks}
+    return {
+        team: {"shots": t.shots, "on_target": t.on_target, "saves": t.saves, "blocks": t.blocks}
+        for team, t in zip("ab", f.teams)
+    }
 
 
 # ------------------------------------------------------------------ the run
@@ -157,46 +170,53 @@ class Run:
         cfg = self.exp.match_config(m)
         row = {"match": m["id"], "cell": f"c{m['cell']:03d}", **cell}
         row |= {"strategy": self.exp.configs[m["cell"]].home, "opponent": m["opponent"], "seed": m["seed"]}
-        row |= {"team": m["team"], "home": cfg.home, "away": cfg.away, "status": "ok" if got else "failed"}
+        row |= {"team": m["team"], "team_a": cfg.home, "team_b": cfg.away, "status": "ok" if got else "failed"}
         row |= got or {"reason": reason}
         row["attempts"] = attempts
         write_atomic(self.out / "matches" / f"{m['id']}.json", json.dumps(row))
         return row
 
-    def todo(self) -> list[dict]:
-        return [m for m in self.matches if m["id"] not in self.rows]
+    def todo(self) -> list[list[dict]]:
+        """The matches still to play, grouped by configuration: in a round robin of cells, AD's match
+        against AS with AD as team a is AS's against AD with AS as team b, played once for both rows."""
+        groups: dict[str, list[dict]] = {}
+        for m in self.matches:
+            groups.setdefault(repr(self.exp.match_config(m)), []).append(m)
+        return [g for g in groups.values() if any(m["id"] not in self.rows for m in g)]
 
     def play(self) -> bool:
         """Play what is missing; True if interrupted (Ctrl-C), with what was finished kept."""
         from arena.tools.experiments.executor import Executor
 
         todo = self.todo()
-        bar = Bar(len(self.matches), len(self.matches) - len(todo), self.opts.progress)
+        left = sum(len(g) for g in todo)
+        bar = Bar(len(self.matches), len(self.matches) - left, self.opts.progress)
         if not todo:
             return False
         queue = list(reversed(todo))
         try:
             with bar, Executor(self.opts.jobs, self.opts.ray, self.out) as ex:
                 while queue and ex.pending < ex.capacity:
-                    m = queue.pop()
-                    ex.submit((m["id"], 1), self._task(m))
+                    group = queue.pop()
+                    ex.submit((group, 1), self._task(group[0]))
                 while ex.pending:
-                    for (mid, attempt), got, reason in ex.wait():
-                        m = self.by_id[mid]
+                    for (group, attempt), got, reason in ex.wait():
                         if got is None and attempt < ATTEMPTS:
-                            ex.submit((mid, attempt + 1), self._task(m))
+                            ex.submit((group, attempt + 1), self._task(group[0]))
                             continue
-                        self.rows[mid] = row = self.row(m, got, reason, attempt)
-                        bar.advance(row)
+                        for m in group:
+                            view = team_view(got, m["team"], len(group)) if got else None
+                            self.rows[m["id"]] = row = self.row(m, view, reason, attempt)
+                            bar.advance(row)
                         if queue:
-                            m = queue.pop()
-                            ex.submit((m["id"], 1), self._task(m))
+                            group = queue.pop()
+                            ex.submit((group, 1), self._task(group[0]))
         except KeyboardInterrupt:
             return True
         return False
 
     def _task(self, m: dict) -> tuple:
-        return (self.exp.match_config(m), self.exp.engine, m["team"], self.exp.needs_facts)
+        return (self.exp.match_config(m), self.exp.engine, self.exp.needs_facts)
 
 
 def ray_task(task: tuple, driver: dict) -> dict:
