@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from arena.commands._common import add_command, positive_int, seconds
-from arena.commands._match_flags import match_config
+from arena.commands._common import add_command, positive_int
+from arena.commands._match_flags import add_match_flags, match_config
 from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
@@ -25,23 +25,24 @@ EXAMPLES = """examples:
   arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
 
 
+# The match flags (arena match's, `add_match_flags`; None or [] when not given) and bench's own defaults.
+MATCH = ("config_file", "half_time", "robots", "link", "link_param", "perception_latency", "batch")
+MATCH_DEFAULTS = {"half_time": 60.0}
 # The flags each benchmark reads (besides --json); any other one given is refused, not ignored.
 USES = {
-    "match": {"runs", "half_time", "robots", "link"},
-    "record": {"runs", "half_time", "robots", "link"},
-    "throughput": {"runs", "half_time", "robots", "link", "strategy"},
+    "match": {"runs", *MATCH},
+    "record": {"runs", *MATCH},
+    "throughput": {"runs", *MATCH, "strategy"},
     "robot": {"strategy"},
     "learn": {"runs", "half_time", "strategy"},
     "scenario": {"runs"},
-    "experiment": {"runs", "half_time", "robots", "strategy"},
+    "experiment": {"runs", *MATCH, "strategy"},
     "nav": {"trials", "seed", "scenarios", "only", "plots"},
 }
 DEFAULTS = {
     "strategy": "advance-dynamic",
     "runs": 3,
-    "half_time": 60.0,
-    "robots": 3,
-    "link": "ideal",
+    **{k: [] if k == "link_param" else None for k in MATCH},
     "trials": 10,
     "seed": 0,
     "scenarios": None,
@@ -69,11 +70,8 @@ def add_parser(sub) -> None:
         help="robot, throughput, learn: strategy (both teams); experiment: team a's, against BS (AD)",
     )
     b.add_argument("--runs", type=positive_int, default=DEFAULTS["runs"], metavar="N", help="runs (3)")
-    b.add_argument(
-        "--half-time", type=seconds, default=DEFAULTS["half_time"], metavar="SECONDS", help="half length [s] (60)"
-    )
-    b.add_argument("--robots", type=int, default=DEFAULTS["robots"], metavar="N", help="match, record, throughput (3)")
-    b.add_argument("--link", default=DEFAULTS["link"], metavar="PRESET", help="match, record, throughput (ideal)")
+    # match, record, throughput: the match they play (learn: --half-time only)
+    add_match_flags(b, seed=False, teams=False, config=True, defaults=MATCH_DEFAULTS)
     b.add_argument("--json", action="store_true")
     b.add_argument(
         "--trials",
@@ -115,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
             from arena.learn.bench import bench_learn
         except ImportError as exc:
             raise ConfigError(str(exc)) from None
-        return bench_learn(args.runs, args.half_time, args.strategy, args.json)
+        return bench_learn(args.runs, args.half_time or MATCH_DEFAULTS["half_time"], args.strategy, args.json)
     if args.what == "experiment":
         from arena.tools.experiments.experiment_bench import bench_experiment
 

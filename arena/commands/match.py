@@ -41,14 +41,7 @@ EXAMPLES = """examples:
 
 def add_parser(sub) -> None:
     m = add_command(sub, "match", "play one match, every process its own OS process, and print the score", EXAMPLES)
-    add_match_flags(m, required=False)
-    m.add_argument(
-        "--config",
-        dest="config_file",
-        metavar="FILE.toml",
-        help="the match's configuration: field, robot, rules, timing, links (arena config --print writes one); "
-        "flags given here win",
-    )
+    add_match_flags(m, config=True)
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
     m.add_argument(
         "--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand"
@@ -95,8 +88,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.launch import launcher
-    from arena.tools.launch.children import JoinError, MatchError
+    from arena.match import JoinError, MatchError, Processes, play
 
     cfg, record = full_config(args)
     if args.engine == "inprocess":
@@ -104,20 +96,19 @@ def run(args: argparse.Namespace) -> int:
     if cfg.refbox.follow:
         warn_unreachable_refbox(cfg.refbox.follow)
     show = not args.json and sys.stderr.isatty()
+    engine = Processes(
+        match=args.match,
+        listen=args.listen,
+        progress=show,
+        log_dir=args.logs,
+        announce=lambda text: print(text, file=sys.stderr, flush=True),
+        strict=args.strict,
+        live_host=args.live_host,
+        secure=args.secure,
+        credentials=args.credentials,
+    )
     try:
-        result = launcher.play_match(
-            cfg,
-            match=args.match,
-            listen=args.listen,
-            progress=show,
-            log_dir=args.logs,
-            announce=lambda text: print(text, file=sys.stderr, flush=True),
-            strict=args.strict,
-            live_host=args.live_host,
-            secure=args.secure,
-            credentials=args.credentials,
-            record=record,
-        )
+        result = play(cfg, engine=engine, record=record)
     except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 2 if isinstance(exc, JoinError) else 1
@@ -126,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
 
 def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = "") -> int:
     """`arena match --engine inprocess`: flags that need separate processes are refused."""
-    from arena.tools.launch import inprocess
+    from arena.match import MatchError, play
 
     for flag, given in (
         ("--realtime", args.realtime),
@@ -141,8 +132,8 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = ""
         if given:
             raise ConfigError(f"{flag} needs --engine processes (inprocess plays lockstep in one process)")
     try:
-        result = inprocess.play_match(cfg, record=record)
-    except inprocess.InprocessError as exc:
+        result = play(cfg, engine="inprocess", record=record)
+    except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 1
     return emit_match(result, args.json)

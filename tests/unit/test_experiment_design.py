@@ -89,7 +89,6 @@ def test_an_open_dict_field_takes_new_keys(monkeypatch):
         ('[design]\nkind = "sobol"\n', "design.kind must be one of"),
         ('responses = ["elo"]\n', "unknown response 'elo'"),
         ('opponents = ["BS"]\n[base]\nhome = "BS"\n', "no match to play"),
-        ('engine = "processes"\nresponses = ["shots"]\n', "need engine"),
     ],
 )
 def test_bad_files_are_one_line_errors(tmp_path, text, error):

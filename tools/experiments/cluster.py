@@ -1,10 +1,11 @@
 """`arena tournament --ray [ADDRESS]`: every fixture one Ray task, the tables on the driver.
 
-Ray is imported only here, and only when `--ray` is given. Each task runs on a
-worker node the same `arena match ... --json` command that a local job runs,
-in its own process group with its own zenoh router (a unix socket in a private
+Ray is imported only here, and only when `--ray` is given. Each task gets the
+fixture's `MatchConfig` itself and plays it on a worker node as a local job
+does: on the processes engine a `python -m arena.match` process group
+(match/child.py) with its own zenoh router (a unix socket in a private
 temp dir), so matches never hear each other, on one node or many. The task
-returns the match's JSON; the driver writes the result atomically to
+returns the match's `MatchResult`; the driver writes the result atomically to
 `<out>/matches/<id>.json` as it arrives (so `--resume` works), feeds the
 progress bar from `ray.wait`, and on Ctrl-C or SIGTERM ends the Ray job
 (Ray kills the job's workers, and each match dies with its worker by
@@ -31,7 +32,6 @@ import json
 import signal
 import socket
 import subprocess
-import sys
 import threading
 import time
 from dataclasses import asdict
@@ -183,10 +183,10 @@ def _die_with_parent() -> None:
 def play_on_worker(job: dict, driver: dict) -> dict:
     """Body of the Ray task: check the version, play one match, return what the driver needs.
 
-    `job` is {"argv": [...], "timeout": s} for the distributed engine (the
-    `arena match` command a local job runs, under this worker's interpreter)
-    or {"config": MatchConfig} for the in-process engine, which plays in this
-    worker process itself: Ray reuses its workers, so it imports once.
+    `job` is {"config": MatchConfig, "engine": name, "timeout": s}. The distributed engine plays
+    in a process group of its own (`python -m arena.match` under this worker's interpreter, handed
+    the configuration); the in-process engine plays in this worker process itself: Ray reuses its
+    workers, so it imports once.
     """
     import ray
 
@@ -200,37 +200,34 @@ def play_on_worker(job: dict, driver: dict) -> dict:
             f"the driver has {describe(driver)}; install the same soccer-arena on every node or use a runtime_env",
         }
     t0 = time.monotonic()
-    if "config" in job:
-        from arena.tools.launch.inprocess import play_match
+    if job["engine"] == "inprocess":
+        from arena.match import play
 
         try:
-            m = play_match(job["config"]).to_dict()
+            m = play(job["config"])
         except Exception as exc:  # a failed match is a result for the driver, never a crashed task
             return {"rc": 1, "node": node, "reason": f"{type(exc).__name__}: {exc}".splitlines()[0]}
+        m.summaries = {}  # the driver reads the result's own fields
         return {"rc": 0, "match": m, "wall": time.monotonic() - t0, "node": node}
-    proc = subprocess.Popen(
-        [sys.executable, *job["argv"]],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-        preexec_fn=_die_with_parent,
+    from arena.match import child
+
+    proc, given = child.start(
+        job["config"], job["engine"], stderr=subprocess.PIPE, start_new_session=True, preexec_fn=_die_with_parent
     )
     reason = ""
     try:
-        out, err = proc.communicate(timeout=job["timeout"])
+        out, err = proc.communicate(input=given, timeout=job["timeout"])
     except subprocess.TimeoutExpired:
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate()
         reason = f"timed out after {job['timeout']:g} s"
-    return {
-        "rc": proc.returncode,
-        "out": out,
-        "err": err,
-        "reason": reason,
-        "wall": time.monotonic() - t0,
-        "node": node,
-    }
+    got = {"rc": proc.returncode, "err": err, "reason": reason, "wall": time.monotonic() - t0, "node": node}
+    if proc.returncode == 0 and not reason:
+        try:
+            got["match"] = child.decode(out)
+        except ValueError as exc:
+            got["reason"] = str(exc)
+    return got
 
 
 # ------------------------------------------------------------------ driver
@@ -300,17 +297,14 @@ def _play(opts: TournamentOptions, runner, todo: list, on_result):
     try:
         remote = ray.remote(play_on_worker).options(num_cpus=cpus, max_retries=SYSTEM_RETRIES, retry_exceptions=False)
         driver = fingerprint()
-        timeout = 120.0 + 2.0 * opts.half_time
+        timeout = 120.0 + 2.0 * opts.base.half_time
         # An existing cluster decides how many run at once; --jobs caps it if given.
         cap = jobs if address is None or opts.jobs else len(todo)
         queue = list(todo)
         inflight: dict = {}  # ref -> (fixture, attempt)
 
         def submit(fx, attempt: int) -> None:
-            if runner.engine == "inprocess":
-                job = {"config": runner.match_config(fx)}
-            else:
-                job = {"argv": runner.command(fx)[1:], "timeout": timeout}  # the worker's own interpreter
+            job = {"config": runner.match_config(fx), "engine": runner.engine, "timeout": timeout}
             inflight[remote.remote(job, driver)] = (fx, attempt)
 
         try:
@@ -353,14 +347,10 @@ def finish(runner, fx, attempt: int, got: dict):
     where = f"[cluster] attempt {attempt} played on node {got['node']}\n" if "node" in got else ""
     write_atomic(log, (got.get("err") or "") + (f"{reason}\n" if reason else "") + where)
     if got["rc"] == 0 and not reason:
-        try:
-            m = got["match"] if "match" in got else json.loads(got["out"])
-        except json.JSONDecodeError:
-            reason = "the match printed no JSON"
-        else:
-            reason = void_reason(m)
+        m = got["match"]
+        reason = void_reason(m)
         if not reason:
-            r = Result.played(fx, m, attempt, got["wall"], m.get("engine", "processes"))
+            r = Result.played(fx, m, attempt, got["wall"], m.engine)
             write_atomic(runner.matches_dir / f"{fx.id}.json", json.dumps(asdict(r)))
             return r
     if not reason:

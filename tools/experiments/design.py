@@ -187,8 +187,6 @@ def load(path: str) -> Experiment:
         responses=_responses(data, path, base.robots),
         engine=engine,
     )
-    if exp.engine == "processes" and exp.needs_facts:
-        raise ConfigError(f'{path}: responses {", ".join(FACTS_RESPONSES)} need engine = "inprocess"')
     exp.cells = cells(exp)
     exp.configs = [cell_config(base, cell, f"{path}: cell {i}") for i, cell in enumerate(exp.cells)]
     total = len(exp.matches())

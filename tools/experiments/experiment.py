@@ -15,17 +15,19 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import subprocess
 import sys
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from arena.runtime import matchfile
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.tools.experiments.design import COVERAGE, Experiment
-from arena.tools.experiments.fixtures import void_reason, write_atomic
+from arena.tools.experiments.fixtures import write_atomic
+
+if TYPE_CHECKING:
+    from arena.match import MatchResult
 
 ATTEMPTS = 2  # a match that fails is played once more, then recorded as failed
 
@@ -40,48 +42,24 @@ class RunOptions:
 
 
 # ------------------------------------------------------------------ one match
-def _play(cfg: MatchConfig, engine: str, watch: tuple[str, ...] = ()) -> tuple[dict, dict]:
-    """Play one match on `engine`: (the `arena match --json` object, {key: [payload, ...]} of `watch`)."""
-    if engine == "processes":
-        return _play_processes(cfg), {}
-    if not watch:
-        from arena.tools.launch.inprocess import play_match
+def _play(cfg: MatchConfig, engine: str, watch: tuple[str, ...] = ()) -> MatchResult:
+    """Play one match on `engine` (arena.match: the one way to play a match); `watch`: keys whose
+    payloads the result keeps (`frames`)."""
+    from arena.match import play
 
-        return play_match(cfg).to_dict(), {}
-    from arena.tools.launch.inprocess import play_in_process
-    from arena.tools.launch.result import Collected, assemble
-
-    t0 = time.monotonic()
-    summaries, frames = play_in_process(cfg, watch=watch)
-    result = assemble(cfg, Collected(summaries=summaries), time.monotonic() - t0)
-    result.engine = "inprocess"
-    return result.to_dict(), frames
-
-
-def _play_processes(cfg: MatchConfig) -> dict:
-    """`arena match --config FILE --json` of `cfg` as its own process group (every field in the file)."""
-    with tempfile.TemporaryDirectory(prefix="arena-exp-") as tmp:
-        path = Path(tmp) / "match.toml"
-        path.write_text(matchfile.dump(cfg))
-        argv = [sys.executable, "-m", "arena", "match", "--config", str(path), "--engine", "processes", "--json"]
-        timeout = 120.0 + 2.0 * cfg.half_time
-        proc = subprocess.run(argv, capture_output=True, text=True, timeout=timeout, start_new_session=True)
-    if proc.returncode != 0:
-        tail = proc.stderr.strip().splitlines()
-        raise RuntimeError(tail[-1] if tail else f"arena match exited {proc.returncode}")
-    return json.loads(proc.stdout)
+    return play(cfg, engine=engine, watch=watch)
 
 
 def play_one(cfg: MatchConfig, engine: str, facts: bool) -> dict:
     """One match: its score, metres per robot, digest, CPU time and, with `facts`, the `arena facts`
     measures of both teams; a worker's task. `team_view` turns it into one team's responses."""
     cpu0 = time.process_time()
-    m, frames = _play(cfg, engine, ("world", "referee") if facts else ())
-    if reason := void_reason(m):
-        raise RuntimeError(reason)
-    out = {"score": m["score"], "robots": m["robots"], "distance_m": m["distance_m"], "digest": m["digest"]}
+    m = _play(cfg, engine, ("world", "referee") if facts else ())
+    if m.void:  # a void match is no result (tools/launch/faults.py)
+        raise RuntimeError("void: " + "; ".join(m.outcome_reasons or ["no reason given"]))
+    out = {"score": list(m.score), "robots": m.robots, "distance_m": dict(m.distance_m), "digest": m.digest}
     if facts:
-        out["facts"] = facts_of(cfg, m, frames)
+        out["facts"] = facts_of(cfg, m)
     out["cpu_s"] = round(time.process_time() - cpu0, 4)
     return out
 
@@ -114,17 +92,17 @@ def responses(m: dict, team: str) -> dict:
     return out
 
 
-def facts_of(cfg: MatchConfig, m: dict, frames: dict) -> dict:
+def facts_of(cfg: MatchConfig, m: MatchResult) -> dict:
     """The `arena facts` measures of each team (recording/analysis/facts.py over the watched frames)."""
     import msgspec
 
     from arena.recording.analysis.facts import measure
     from arena.schemas.messages import Referee, World
 
-    worlds = [msgspec.msgpack.decode(raw, type=World) for raw in frames["world"]]
-    referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in frames["referee"])}
-    extra = {"log": m["referee_log"], "score": m["score"], "events": m["events"]}  # the referee's summary
-    f = measure(cfg, worlds, referee, extra, m["distance_m"])
+    worlds = [msgspec.msgpack.decode(raw, type=World) for raw in m.frames["world"]]
+    referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in m.frames["referee"])}
+    extra = {"log": m.referee_log, "score": m.score, "events": m.events}  # the referee's summary
+    f = measure(cfg, worlds, referee, extra, m.distance_m)
     return {
         team: {"shots": t.shots, "on_target": t.on_target, "saves": t.saves, "blocks": t.blocks}
         for team, t in zip("ab", f.teams)

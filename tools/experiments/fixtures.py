@@ -8,8 +8,12 @@ import os
 from dataclasses import dataclass, field
 from itertools import combinations
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from arena.runtime import seeds
+
+if TYPE_CHECKING:
+    from arena.match import MatchResult
 
 ABBREV = {"advance-dynamic": "AD", "advance-static": "AS", "basic-dynamic": "BD", "basic-static": "BS"}
 
@@ -86,19 +90,19 @@ class Result:
     )  # a team's crashed process: the match counts (tools/launch/faults.py)
 
     @classmethod
-    def played(cls, fx: Fixture, m: dict, attempts: int, wall_seconds: float, engine: str) -> Result:
-        """Fixture `fx`'s result from its match JSON `m` (one that `void_reason` accepted)."""
+    def played(cls, fx: Fixture, m: MatchResult, attempts: int, wall_seconds: float, engine: str) -> Result:
+        """Fixture `fx`'s result from its match's `m` (one that `void_reason` accepted)."""
         return cls(
             id=fx.id,
             status="ok",
-            score=m["score"],
-            distance_m=m["distance_m"],
+            score=list(m.score),
+            distance_m=dict(m.distance_m),
             attempts=attempts,
             wall_seconds=round(wall_seconds, 2),
-            rtf=m["rtf"],
-            digest=m["digest"],
+            rtf=m.rtf,
+            digest=m.digest,
             engine=engine,
-            faults=m.get("faults", []),
+            faults=list(m.faults),
             **fixture_fields(fx),
         )
 
@@ -135,8 +139,8 @@ def load_results(directory: Path) -> dict[str, Result]:
     return out
 
 
-def void_reason(m: dict) -> str:
-    """Why a match's JSON is no result ("" if it is one): a void match never counts (tools/launch/faults.py)."""
-    if m.get("outcome") == "void" or m.get("void"):
-        return "void: " + "; ".join(m.get("outcome_reasons") or ["no reason given"])
+def void_reason(m: MatchResult) -> str:
+    """Why a match is no result ("" if it is one): a void match never counts (tools/launch/faults.py)."""
+    if m.outcome == "void" or m.void:
+        return "void: " + "; ".join(m.outcome_reasons or ["no reason given"])
     return ""

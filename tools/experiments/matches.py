@@ -1,6 +1,7 @@
-"""Playing a tournament's fixtures on this machine: each an `arena match` process
-group, or with `--engine inprocess` a match on a worker process of a pool; one
-retry, a failure recorded with its reason; Ctrl-C stops what runs."""
+"""Playing a tournament's fixtures on this machine: each a match process group
+(`python -m arena.match`, handed its whole configuration: match/child.py),
+or with `--engine inprocess` a match on a worker process of a pool; one retry, a
+failure recorded with its reason; Ctrl-C stops what runs."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
@@ -16,16 +16,18 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from arena.match import child
 from arena.tools.experiments import pools
 from arena.tools.experiments.fixtures import Fixture, Result, void_reason, write_atomic
 
 if TYPE_CHECKING:
+    from arena.match import MatchResult
     from arena.runtime.config import MatchConfig
     from arena.tools.experiments.tournament import TournamentOptions
 
 
 class Runner:
-    """Plays fixtures as `arena match` subprocesses; stoppable from the main thread."""
+    """Plays fixtures as match subprocesses (or on a pool's workers); stoppable from the main thread."""
 
     def __init__(self, opts: TournamentOptions, out: Path):
         self.opts = opts
@@ -50,21 +52,9 @@ class Runner:
                 initializer=_worker_init,
             )
 
-    def match_config(self, fx: Fixture):
-        from arena.runtime.config import MatchConfig, TimingParams
-
-        cfg = MatchConfig(
-            seed=fx.seed,
-            home=fx.home,
-            away=fx.away,
-            robots=self.opts.robots,
-            half_time=self.opts.half_time,
-            link=self.opts.link,
-            link_overrides=self.opts.link_overrides(),
-            timing=TimingParams(perception_latency=self.opts.latency()),
-        )
-        cfg.validate()
-        return cfg
+    def match_config(self, fx: Fixture) -> MatchConfig:
+        """The fixture's match: the tournament's base configuration with its seed and teams."""
+        return self.opts.match_config(fx.seed, fx.home, fx.away)
 
     def play_inprocess(self, fx: Fixture) -> Result | None:
         """`play` on a worker process of the pool (--engine inprocess)."""
@@ -96,27 +86,23 @@ class Runner:
         if self.pool is not None:
             pools.stop(self.pool, now=self.stopping)
 
-    def command(self, fx: Fixture) -> list[str]:
-        return match_argv(self.match_config(fx), self.engine)
-
     def play(self, fx: Fixture) -> Result | None:
         """Play one fixture (one retry on failure). None if stopped by Ctrl-C."""
         if self.pool is not None:
             return self.play_inprocess(fx)
         reason = ""
-        timeout = 120.0 + 2.0 * self.opts.half_time  # generous: rtf >= 1 plus start-up
+        cfg = self.match_config(fx)
+        timeout = 120.0 + 2.0 * cfg.half_time  # generous: rtf >= 1 plus start-up
         for attempt in (1, 2):
             if self.stopping:
                 return None
             t0 = time.monotonic()
             log = open(self.logs_dir / f"{fx.id}.log", "w")
-            proc = subprocess.Popen(
-                self.command(fx), stdout=subprocess.PIPE, stderr=log, text=True, start_new_session=True
-            )
+            proc, given = child.start(cfg, self.engine, stderr=log, start_new_session=True)
             with self._lock:
                 self._running.add(proc)
             try:
-                out, _ = proc.communicate(timeout=timeout)
+                out, _ = proc.communicate(input=given, timeout=timeout)
             except subprocess.TimeoutExpired:
                 proc.send_signal(signal.SIGINT)
                 out, _ = proc.communicate()
@@ -129,9 +115,9 @@ class Runner:
                 return None
             if proc.returncode == 0:
                 try:
-                    m = json.loads(out)
-                except json.JSONDecodeError:
-                    reason = "the match printed no JSON"
+                    m = child.decode(out)
+                except ValueError as exc:
+                    reason = str(exc)
                     continue
                 if void := void_reason(m):
                     reason = void
@@ -153,7 +139,7 @@ class Runner:
             running = list(self._running)
         for p in running:
             if p.poll() is None:
-                p.send_signal(signal.SIGINT)  # arena match stops its whole process group
+                p.send_signal(signal.SIGINT)  # the match stops its whole process group
 
 
 def _worker_init() -> None:
@@ -165,26 +151,17 @@ def _worker_init() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except OSError:
         pass
+    import arena.match
     import arena.processes.engine
     import arena.tools.launch.inprocess  # noqa: F401
 
 
-def _play_inprocess(cfg) -> dict:
-    from arena.tools.launch.inprocess import play_match
+def _play_inprocess(cfg: MatchConfig) -> MatchResult:
+    from arena.match import play
 
-    return play_match(cfg).to_dict()
-
-
-def match_argv(cfg: MatchConfig, engine: str) -> list[str]:
-    """The `arena match ... --json` command that plays `cfg` (strategies, size, half, seed, link and its
-    overrides, perception latency) on `engine`, as a user would type it."""
-    argv = [sys.executable, "-m", "arena", "match", "--home", cfg.home, "--away", cfg.away]
-    argv += ["--robots", str(cfg.robots), "--half-time", str(cfg.half_time), "--seed", str(cfg.seed)]
-    argv += ["--link", cfg.link, "--perception-latency", str(cfg.timing.perception_latency)]
-    argv += ["--engine", engine, "--json"]
-    for cls, params in cfg.link_overrides.items():
-        argv += [x for p, v in params.items() for x in ("--link-param", f"{cls}.{p}={v!r}")]
-    return argv
+    result = play(cfg)
+    result.summaries = {}  # what the tournament reads is the result's own fields: not pickled back
+    return result
 
 
 def default_jobs() -> int:

@@ -1,7 +1,8 @@
 """`arena bench throughput`: the two engines side by side on the same host.
 
 Each run plays the same match (same seed) once with `--engine processes` and
-once with `--engine inprocess`, each as its own `arena match --json` command,
+once with `--engine inprocess`, each as its own command (`python -m arena.match`,
+handed the configuration: match/child.py),
 the order alternating from run to run (interleaved A/B), and every figure is
 the median over the runs. Whole-process figures: the command's wall time and
 its CPU (itself and every child it waited for, `RUSAGE_CHILDREN`).
@@ -29,8 +30,11 @@ import subprocess
 import time
 from typing import TYPE_CHECKING
 
+from msgspec import UNSET
+
+from arena.match import child
 from arena.tools.console import console as make_console
-from arena.tools.experiments.matches import default_jobs, match_argv
+from arena.tools.experiments.matches import default_jobs
 
 if TYPE_CHECKING:
     from arena.runtime.config import MatchConfig
@@ -38,9 +42,9 @@ if TYPE_CHECKING:
 ENGINES = ("processes", "inprocess")
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
 LAUNCH_DEFINITIONS = {
-    "command": "the `arena match` command started (Python's start and every import included) "
+    "command": "the match's command started (`python -m arena.match`; Python's start and every import included) "
     "to the engine's first tick, clocked by this benchmark",
-    "play_match": "the match's launcher called (`play_match`, in a process that has imported the CLI) "
+    "play_match": "the match's launcher called (`play_match`, in a process that has imported the engine) "
     "to the engine's first tick, as the command reports it (`startup_seconds`)",
 }
 TOURNAMENT_MATCH_S = 600.0  # [s] simulated: the paper's 2 x 300 s
@@ -52,27 +56,28 @@ def _children_cpu() -> float:
 
 
 def play(engine: str, cfg: MatchConfig) -> dict:
-    """`cfg` played by an `arena match` command on `engine`: what the command took, and what it says."""
+    """`cfg` played by a match's command on `engine`: what the command took, and what it says."""
     cpu0, t0 = _children_cpu(), time.time()
-    proc = subprocess.run(match_argv(cfg, engine), capture_output=True, text=True, timeout=600 + 10 * cfg.half_time)
+    proc, given = child.start(cfg, engine, stderr=subprocess.PIPE)
+    out, err = proc.communicate(input=given, timeout=600 + 10 * cfg.half_time)
     wall, cpu = time.time() - t0, _children_cpu() - cpu0
     if proc.returncode != 0:
-        tail = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
-        raise RuntimeError(f"arena match --engine {engine} failed: {tail}")
-    r = json.loads(proc.stdout)
-    started = r.get("play_started_unix") or t0
+        tail = (err.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
+        raise RuntimeError(f"the match on --engine {engine} failed: {tail}")
+    r = child.decode(out)
+    started = r.play_started_unix or t0
     return {
         "engine": engine,
         "seed": cfg.seed,
-        "digest": r["digest"],
-        "rtf": r["rtf"],
-        "sim_seconds": r["sim_seconds"],
+        "digest": r.digest,
+        "rtf": r.rtf,
+        "sim_seconds": r.sim_seconds,
         "command_wall_s": round(wall, 3),
         "command_cpu_s": round(cpu, 3),
         "launch_to_first_tick_s": round(started - t0, 3),
-        "play_match_to_first_tick_s": r.get("startup_seconds"),
-        "launch": r.get("launch"),
-        "overhead_s": round(wall - r["play_wall_seconds"], 3),  # start-up and teardown of one match
+        "play_match_to_first_tick_s": None if r.startup_seconds is UNSET else r.startup_seconds,
+        "launch": None if r.launch is UNSET else r.launch,
+        "overhead_s": round(wall - r.play_wall_seconds, 3),  # start-up and teardown of one match
     }
 
 

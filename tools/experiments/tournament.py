@@ -21,31 +21,39 @@ import signal
 import sys
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
+from arena.runtime.config import MatchConfig
 from arena.tools.experiments.fixtures import Result, load_results, schedule, short, write_atomic
 from arena.tools.experiments.matches import Runner, play_local
 from arena.tools.experiments.tournament_report import report, show_value
 
 # Settings that decide what a match is: --resume refuses to mix results played with other values.
-BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "perception_latency", "seed")
+BINDING = (
+    "strategies",
+    "legs",
+    "half_time",
+    "robots",
+    "link",
+    "link_overrides",
+    "perception_latency",
+    "config",
+    "seed",
+)
 # What a settings.json written before a binding setting existed was played with.
-LEGACY = {"perception_latency": 0}
+LEGACY = {"perception_latency": 0, "config": {}}
 
 
 @dataclass(frozen=True)
 class TournamentOptions:
-    """What `arena tournament` plays and how: its flags, typed (arena/commands/tournament.py builds one from argv)."""
+    """What `arena tournament` plays and how (arena/commands/tournament.py builds one from its flags):
+    `base` is every match's configuration, each fixture setting its seed, home and away (`match_config`)."""
 
     strategies: tuple[str, ...]  # resolved names, in the order given
+    base: MatchConfig = field(default_factory=MatchConfig)
     legs: int = 10
-    half_time: float = 300.0  # [s] simulated, per half
-    robots: int = 3
-    link: str = "ideal"
-    link_param: tuple[str, ...] = ()  # CLASS.PARAM=V, as given to --link-param
-    perception_latency: int | None = None  # [ticks] None: the default (runtime/config.py DEFAULT_PERCEPTION_LATENCY)
-    seed: int = 0
+    seed: int = 0  # the tournament's: the matches' seeds derive from it
     jobs: int = 0  # 0: one per core
     out: Path = Path("tournament")
     resume: bool = False
@@ -54,30 +62,50 @@ class TournamentOptions:
     ray: str | None = None  # None: no Ray; "": a local instance; else auto or HOST:PORT
     ray_runtime_env: str | None = None  # JSON text
 
-    def latency(self) -> int:
-        """The perception latency the matches are played with [ticks]."""
-        from arena.runtime.config import DEFAULT_PERCEPTION_LATENCY
+    def match_config(self, seed: int, home: str, away: str) -> MatchConfig:
+        """One fixture's match: the base configuration with its seed and teams."""
+        return self.base.replace(seed=seed, home=home, away=away)
 
-        return DEFAULT_PERCEPTION_LATENCY if self.perception_latency is None else self.perception_latency
 
-    def link_overrides(self) -> dict[str, dict[str, float]]:
-        from arena.runtime.links import parse_overrides
+# Set per fixture, or recorded by settings() on their own: not part of its "config".
+PER_MATCH = {"seed", "home", "away", "robots", "half_time", "link", "link_overrides"}
+TRANSPORT = {"perception_latency", "batch"}  # timing keys recorded on their own, or no part of the digests
 
-        return parse_overrides(self.link_param)
+
+def config_changes(base: MatchConfig) -> dict:
+    """What the base configuration sets apart from the defaults, beyond the settings recorded on
+    their own: {section: {key: value}} of field, robot, ball, sensor, rules, timing, ...
+    ({} for a tournament of defaults)."""
+    now, default = base.to_dict(), MatchConfig().to_dict()
+    out = {}
+    for key, value in now.items():
+        if key in PER_MATCH or value == default[key]:
+            continue
+        if isinstance(value, dict) and isinstance(default[key], dict):
+            changed = {k: v for k, v in value.items() if v != default[key].get(k)}
+            if key == "timing":
+                changed = {k: v for k, v in changed.items() if k not in TRANSPORT}
+            if changed:
+                out[key] = changed
+        else:
+            out[key] = value
+    return out
 
 
 def settings(opts: TournamentOptions) -> dict:
     """Everything needed to play the tournament again (tournament.json, report.md, --resume's check)."""
     from arena.runtime.version import package_version
 
+    base = opts.base
     return {
         "strategies": list(opts.strategies),
         "legs": opts.legs,
-        "half_time": float(opts.half_time),
-        "robots": opts.robots,
-        "link": opts.link,
-        "link_overrides": opts.link_overrides(),
-        "perception_latency": opts.latency(),
+        "half_time": float(base.half_time),
+        "robots": base.robots,
+        "link": base.link,
+        "link_overrides": base.link_overrides,
+        "perception_latency": base.timing.perception_latency,
+        "config": config_changes(base),
         "seed": opts.seed,
         "engine": opts.engine,
         "version": package_version(),
