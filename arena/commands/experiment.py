@@ -11,11 +11,11 @@ from arena.commands._common import add_command
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
-  arena experiment run examples/studies/wifi.toml --out runs/wifi           # every cell, every seed, both ends
+  arena experiment run examples/studies/wifi-latency.toml --out runs/wifi   # every cell, seed and end
   arena experiment run sweep.toml --jobs 2 --out runs/sweep --resume        # continue after Ctrl-C or a crash
   arena experiment run sweep.toml --ray --out runs/sweep                    # every match a task on a local Ray
   arena experiment run sweep.toml --ray auto --json                         # join this node's Ray cluster
-  arena experiment compare --candidate AD --baseline BS --half-time 30      # SPRT: is AD better than BS?
+  arena experiment compare --candidate AD --baseline BS --half-time 30 --elo1 50   # SPRT: is AD better?
   arena experiment compare --candidate AD --baseline AS --opponents BD,BS --elo0 0 --elo1 10 --max-pairs 200
 (docs/experiments.md: the experiment file key by key, and what compare prints)"""
 
