@@ -160,7 +160,8 @@ class Run:
         groups: dict[str, list[dict]] = {}
         for m in self.matches:
             groups.setdefault(repr(self.exp.match_config(m)), []).append(m)
-        return [g for g in groups.values() if any(m["id"] not in self.rows for m in g)]
+        todo = [g for g in groups.values() if any(m["id"] not in self.rows for m in g)]
+        return sorted(todo, key=lambda g: g[0]["seed"])  # seed by seed: a run stopped early has every cell
 
     def play(self) -> bool:
         """Play what is missing; True if interrupted (Ctrl-C), with what was finished kept."""
