@@ -5,8 +5,11 @@ rows.json), per cell the mean of each response with its 95 % bootstrap interval
 The interval is over seeds: a seed's value is its matches' mean (both ends, every
 opponent), and the seeds are resampled with replacement (a percentile bootstrap, 2000
 resamples from a fixed seed, so a rerun writes the same numbers). Every cell plays the same
-seeds (common random numbers), so a cell's difference to the first cell is resampled by
-seed too, the pair kept together (`diff` in summary.json and the report).
+seeds (common random numbers), so a cell's difference to its reference cell is resampled by
+seed too, the pair kept together (`diff` in summary.json and the report). A cell's reference
+is the first cell with the same values of every factor but the last one in the file: over
+one factor the first cell, over latency per strategy (`home`, then the latency) the same
+strategy at the first latency.
 """
 
 from __future__ import annotations
@@ -43,18 +46,28 @@ def bootstrap(values: np.ndarray, idx: np.ndarray) -> tuple[float, float, float]
     return float(values.mean()), float(lo), float(hi)
 
 
+def reference(exp: Experiment, c: int) -> int:
+    """The cell `c` is compared with: the first with the same values of every factor but the last."""
+    keep = [f.path for f in exp.factors[:-1]]
+    mine = exp.cells[c]
+    return next(j for j, other in enumerate(exp.cells) if all(other[k] == mine[k] for k in keep))
+
+
 def summarise(exp: Experiment, rows: list[dict]) -> dict:
-    """Per cell and response: mean, 95 % interval, and the seed-paired difference to cell c000."""
+    """Per cell and response: mean, 95 % interval, and the seed-paired difference to its reference cell."""
     rng = np.random.default_rng(BOOT_SEED)
     seeds = exp.seeds
     idx = rng.integers(0, len(seeds), size=(RESAMPLES, len(seeds)))  # the same resamples in every cell: paired
     cells = []
-    first: dict[str, np.ndarray] = {}
+    full_values: dict[tuple[int, str], np.ndarray] = {}  # (cell, response) -> per seed, when every seed played
     for c, cell in enumerate(exp.cells):
         name = f"c{c:03d}"
+        ref = reference(exp, c)
         out = {"cell": name, **cell, "strategy": exp.configs[c].home, "matches": 0, "failed": 0}
         out["matches"] = sum(1 for r in rows if r["cell"] == name and r["status"] == "ok")
         out["failed"] = sum(1 for r in rows if r["cell"] == name and r["status"] != "ok")
+        if ref != c:
+            out["reference"] = f"c{ref:03d}"
         for resp in exp.responses:
             by_seed = per_seed(exp, rows, name, resp)
             full = len(by_seed) == len(seeds)
@@ -62,10 +75,10 @@ def summarise(exp: Experiment, rows: list[dict]) -> dict:
             own_idx = idx if full else rng.integers(0, max(1, len(v)), size=(RESAMPLES, max(1, len(v))))
             mean, lo, hi = bootstrap(v, own_idx)
             out[resp] = {"mean": _r(mean), "low": _r(lo), "high": _r(hi), "seeds": len(v)}
-            if c == 0 and full:
-                first[resp] = v
-            elif full and resp in first:
-                d_mean, d_lo, d_hi = bootstrap(v - first[resp], idx)
+            if full:
+                full_values[(c, resp)] = v
+            if ref != c and full and (ref, resp) in full_values:
+                d_mean, d_lo, d_hi = bootstrap(v - full_values[(ref, resp)], idx)
                 out[resp]["diff"] = {"mean": _r(d_mean), "low": _r(d_lo), "high": _r(d_hi)}
         cells.append(out)
     return {
@@ -212,7 +225,8 @@ def report(exp: Experiment, summary: dict, plots: list[Path]) -> str:
         lines.append(f"Opponents: {', '.join(exp.opponents)} (each cell's strategy against each of the others).")
     lines += [
         "",
-        "Mean per cell with its 95 % bootstrap interval over seeds; Δ: the difference to c000, paired by seed.",
+        "Mean per cell with its 95 % bootstrap interval over seeds; Δ: the difference to the reference cell "
+        "(the first with the same values of every factor but the last), paired by seed.",
         "",
     ]
     head = ["cell", *[f.path for f in exp.factors], "strategy", "matches", *exp.responses]
