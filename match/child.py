@@ -70,8 +70,7 @@ def main(args: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("arena.match: interrupted; every process of the match was stopped", file=sys.stderr)
         return 130
-    printed = result.to_dict()
-    for line in faults.warnings(printed):
+    for line in faults.warnings(result):
         print(f"arena.match: warning: {line}", file=sys.stderr)
-    print(json.dumps(printed))
+    print(json.dumps(result.to_dict()))
     return 0

@@ -123,7 +123,7 @@ class EngineNode(Node):
         """A live lockstep match (`--live`): the viewer's pace, pause and steps (runtime/pace.py)."""
         if self.cfg.live < 0 or self.cfg.realtime:
             return None
-        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log)
+        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log, self.clock)
         key = self.keys.control()
         # Unpaced, the viewer draws at most 30 frames a second of wall time: only every
         # Nth world frame goes on the wire, and the held one whenever the pacer holds
@@ -269,7 +269,8 @@ class EngineNode(Node):
         last_cmd = {r: 0 for r in self.robots}
         ph = self.physics
         self.field_out.send(self.field_spec())
-        start = time.monotonic()
+        clock = self.clock  # the wall clock it keeps pace with (runtime/clock.py)
+        start = clock.monotonic()
         for k in range(last + 1):
             t0 = time.perf_counter()
             self.ref_in.poll(k)
@@ -292,9 +293,9 @@ class EngineNode(Node):
                         self.park(r, k)
             self.pending_events.extend(ph.step())
             self.timed(t0)
-            delay = start + (k + 1) * dt - time.monotonic()
+            delay = start + (k + 1) * dt - clock.monotonic()
             if delay > 0:
-                time.sleep(delay)
+                clock.sleep(delay)
 
     def close(self) -> None:
         super().close()

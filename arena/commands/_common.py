@@ -107,15 +107,15 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
     from arena.tools.launch import faults
     from arena.tools.review import report
 
-    result = match.to_dict()
     if as_json:
-        result.pop("referee_log", None)
-        print(json.dumps(result, indent=2))
+        printed = match.to_dict()
+        printed.pop("referee_log", None)
+        print(json.dumps(printed, indent=2))
     else:
-        report.print_match(result)
-    for line in faults.warnings(result):
+        report.print_match(match)
+    for line in faults.warnings(match):
         print(f"{prog}: warning: {line}", file=sys.stderr)
-    if result.get("outcome") == "void":
-        print(f"{prog}: void: {'; '.join(result['outcome_reasons'])}", file=sys.stderr)
+    if match.outcome == "void":
+        print(f"{prog}: void: {'; '.join(match.outcome_reasons)}", file=sys.stderr)
         return 1
     return 0

@@ -32,34 +32,34 @@ def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
     for i in range(runs):
         cfg = base.replace(seed=1000 + i)
         console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, {robots}v{robots}, link {link} ...")
-        r = play(cfg, engine="processes").to_dict()
+        r = play(cfg, engine="processes")
         results.append(r)
         console.print(
-            f"  rtf {r['rtf']:.1f}x, {1000 * r['play_wall_seconds'] / max(1, r['ticks']):.3f} ms/tick, "
-            f"first tick {r['startup_seconds']}s after play_match ({r['launch']})"
+            f"  rtf {r.rtf:.1f}x, {1000 * r.play_wall_seconds / max(1, r.ticks):.3f} ms/tick, "
+            f"first tick {r.startup_seconds}s after play_match ({r.launch})"
         )
-    rtf = statistics.median(r["rtf"] for r in results)
-    ms_tick = statistics.median(1000 * r["play_wall_seconds"] / max(1, r["ticks"]) for r in results)
-    startup = statistics.median(r["wall_seconds"] - r["play_wall_seconds"] for r in results)
+    rtf = statistics.median(r.rtf for r in results)
+    ms_tick = statistics.median(1000 * r.play_wall_seconds / max(1, r.ticks) for r in results)
+    startup = statistics.median(r.wall_seconds - r.play_wall_seconds for r in results)
     per_kind: dict[str, list[float]] = {}
     for r in results:
-        for p in r["processes"]:
-            if p["tick_us_median"] is not None:
-                per_kind.setdefault(p["kind"], []).append(p["tick_us_median"])
+        for p in r.processes:
+            if p.tick_us_median is not None:
+                per_kind.setdefault(p.kind, []).append(p.tick_us_median)
     out = {
         "runs": runs,
         "half_time": half_time,
         "robots": robots,
         "link": link,
         "rtf_median": rtf,
-        "rtf_all": [r["rtf"] for r in results],
+        "rtf_all": [r.rtf for r in results],
         "ms_per_tick_median": round(ms_tick, 4),
         "ticks_per_second": round(1000.0 / ms_tick, 1),
         "startup_seconds_median": round(startup, 2),
         # play_match called (everything imported) to the engine's first tick; how the processes started
-        "launch_to_first_tick_median": statistics.median(r["startup_seconds"] or 0.0 for r in results),
-        "launch_to_first_tick_all": [r["startup_seconds"] for r in results],
-        "launch": [r["launch"] for r in results],
+        "launch_to_first_tick_median": statistics.median(r.startup_seconds or 0.0 for r in results),
+        "launch_to_first_tick_all": [r.startup_seconds for r in results],
+        "launch": [r.launch for r in results],
         "work_us_per_tick_median": {k: round(statistics.median(v), 1) for k, v in per_kind.items()},
     }
     rows = [
@@ -105,14 +105,14 @@ def bench_record(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int
             # Alternate which goes first, so that drift in the machine's load favours neither.
             order = [(False, ""), (True, str(path))]
             for rec, record in order if i % 2 == 0 else reversed(order):
-                r = play(cfg, engine="processes", record=record).to_dict()
+                r = play(cfg, engine="processes", record=record)
                 (recorded if rec else plain).append(r)
-                console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
+                console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r.rtf:.1f}x")
             sizes.append(path.stat().st_size)
-    rtf_plain = statistics.median(r["rtf"] for r in plain)
-    rtf_rec = statistics.median(r["rtf"] for r in recorded)
-    wall_plain = statistics.median(r["wall_seconds"] for r in plain)
-    wall_rec = statistics.median(r["wall_seconds"] for r in recorded)
+    rtf_plain = statistics.median(r.rtf for r in plain)
+    rtf_rec = statistics.median(r.rtf for r in recorded)
+    wall_plain = statistics.median(r.wall_seconds for r in plain)
+    wall_rec = statistics.median(r.wall_seconds for r in recorded)
     out = {
         "runs": runs,
         "half_time": half_time,
@@ -122,12 +122,12 @@ def bench_record(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int
         "rtf_median_recorded": rtf_rec,
         "rtf_ratio": round(rtf_rec / rtf_plain, 3),
         "cost_percent": round(100.0 * (1.0 - rtf_rec / rtf_plain), 1),
-        "rtf_all_plain": [r["rtf"] for r in plain],
-        "rtf_all_recorded": [r["rtf"] for r in recorded],
+        "rtf_all_plain": [r.rtf for r in plain],
+        "rtf_all_recorded": [r.rtf for r in recorded],
         "wall_seconds_median_plain": wall_plain,
         "wall_seconds_median_recorded": wall_rec,
         "recorder_cpu_s_median": statistics.median(
-            p["cpu_s"] for r in recorded for p in r["processes"] if p["kind"] == "recorder" and p["cpu_s"] is not None
+            p.cpu_s for r in recorded for p in r.processes if p.kind == "recorder" and p.cpu_s is not None
         ),
         "file_mb_median": round(statistics.median(sizes) / 1e6, 2),
     }

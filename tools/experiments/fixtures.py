@@ -10,6 +10,8 @@ from itertools import combinations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import msgspec
+
 from arena.runtime import seeds
 
 if TYPE_CHECKING:
@@ -102,7 +104,7 @@ class Result:
             rtf=m.rtf,
             digest=m.digest,
             engine=engine,
-            faults=list(m.faults),
+            faults=msgspec.to_builtins(m.faults),  # as a match's JSON says them (a Result is JSON)
             **fixture_fields(fx),
         )
 

@@ -30,12 +30,41 @@ The outcome:
 from __future__ import annotations
 
 import signal
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import msgspec
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Summary
 
+if TYPE_CHECKING:
+    from arena.tools.launch.result import MatchResult
+
 # A failure of one of these makes the match void: without them there is no game.
 VOIDING = ("engine", "referee")
+
+
+class Fault(msgspec.Struct):
+    """One failed process of a match: `faults` of `arena match --json`."""
+
+    process: str  # e.g. "robot/b/1"
+    tick: int | None  # when it was given up on (the engine's tick), None if nobody did
+    reason: str  # "exited with code -9 (SIGKILL)", "stopped responding: ...", ...
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What `outcome` finds: the match result's `outcome`, `void`, `outcome_reasons`, `dead`,
+    `faults`, `conflicts` and `forged`."""
+
+    outcome: str
+    void: bool
+    outcome_reasons: list[str]
+    dead: list[str]
+    faults: list[Fault]
+    conflicts: dict[str, int]
+    forged: dict[str, int]
 
 
 def exit_reason(code: int) -> str:
@@ -118,8 +147,8 @@ def outcome(
     lost: dict[str, str],
     missing: dict[str, str],
     void: str = "",
-) -> dict:
-    """The `outcome`, `void`, `outcome_reasons`, `dead`, `faults`, `conflicts` and `forged` of the match JSON."""
+) -> Verdict:
+    """Who failed, and whether the match counts (`Verdict`)."""
     dead = blame(summaries, set(lost))
     order = [str(p) for p in cfg.processes()]
     faults = []
@@ -130,16 +159,16 @@ def outcome(
             why = "stopped responding: its peers gave up waiting for it" if claimed else "lost contact with its peers"
         if why is None:
             continue
-        faults.append({"process": name, "tick": dead.get(name), "reason": why})
+        faults.append(Fault(process=name, tick=dead.get(name), reason=why))
     reasons = []
     if void:
         reasons.append(void)
     for kind in VOIDING:
-        f = next((f for f in faults if f["process"] == kind), None)
+        f = next((f for f in faults if f.process == kind), None)
         if kind not in summaries and not void:
-            reasons.append(f"{kind}: {f['reason']}" if f else f"{kind}: no summary")
+            reasons.append(f"{kind}: {f.reason}" if f else f"{kind}: no summary")
         elif f is not None and not (void and void.startswith(kind)):
-            reasons.append(f"{kind}: {f['reason']}")  # it failed, even if its summary came later
+            reasons.append(f"{kind}: {f.reason}")  # it failed, even if its summary came later
     referee = summaries.get("referee")
     follow = referee.extra.get("refbox_follow") if referee is not None else None
     if follow and not follow.get("connected"):
@@ -153,7 +182,7 @@ def outcome(
         result = "void"
     elif faults:
         result = "completed_with_faults"
-        reasons = [f"{f['process']}: {f['reason']}" for f in faults]
+        reasons = [f"{f.process}: {f.reason}" for f in faults]
     else:
         result = "completed"
     conflicts: dict[str, int] = {}
@@ -163,25 +192,25 @@ def outcome(
             conflicts[key] = conflicts.get(key, 0) + n
         for key, n in s.forged.items():
             forged[key] = forged.get(key, 0) + n
-    return {
-        "outcome": result,
-        "void": result == "void",
-        "outcome_reasons": reasons,
-        "dead": sorted(dead),
-        "faults": faults,
-        "conflicts": dict(sorted(conflicts.items())),
-        "forged": dict(sorted(forged.items())),
-    }
+    return Verdict(
+        outcome=result,
+        void=result == "void",
+        outcome_reasons=reasons,
+        dead=sorted(dead),
+        faults=faults,
+        conflicts=dict(sorted(conflicts.items())),
+        forged=dict(sorted(forged.items())),
+    )
 
 
-def warnings(result: dict) -> list[str]:
+def warnings(result: MatchResult) -> list[str]:
     """One line per fault and per key with forged or conflicting frames, for the terminal."""
     lines = []
-    conflicts, forged = result.get("conflicts", {}), result.get("forged", {})
+    conflicts, forged = result.conflicts, result.forged
     for key in sorted({*conflicts, *forged}):
         counts = [f"{n} {what}" for n, what in ((forged.get(key, 0), "forged"), (conflicts.get(key, 0), "conflicting"))]
         lines.append(f"possible spoofing on {key} ({', '.join(c for c in counts if not c.startswith('0 '))} frames)")
-    for f in result.get("faults", []):
-        at = f" at tick {f['tick']}" if f.get("tick") is not None else ""
-        lines.append(f"fault: {f['process']}{at}: {f['reason']}")
+    for f in result.faults:
+        at = f" at tick {f.tick}" if f.tick is not None else ""
+        lines.append(f"fault: {f.process}{at}: {f.reason}")
     return lines

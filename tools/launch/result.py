@@ -18,6 +18,7 @@ from msgspec import UNSET, UnsetType
 from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.stats import percentile
 from arena.schemas.messages import Referee, Summary
+from arena.tools.launch.faults import Fault
 from arena.tools.launch.faults import outcome as match_outcome
 
 # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
@@ -63,10 +64,51 @@ class Collected:
     last_referee: Referee | None = None  # the newest referee frame the launcher saw (a void match's ticks, score)
 
 
+class ProcessRow(msgspec.Struct):
+    """One process of the match: `processes` of `arena match --json`."""
+
+    kind: str
+    team: str | None
+    robot: int | None
+    pid: int | None
+    external: bool
+    tick_us_median: float | None  # its own work per tick [us]
+    tick_us_p95: float | None
+    cpu_s: float | None
+
+
+class LinkStats(msgspec.Struct):
+    """One link class of the match, over every process's links of it: `links` of `arena match --json`."""
+
+    sent: int
+    dropped: int
+    drop_rate: float
+    delay_ms_mean: float
+    delay_ms_p95: float
+
+
+class Parked(msgspec.Struct):
+    """A dead robot taken off the field (processes/engine.py): `parked` of `arena match --json`."""
+
+    tick: int
+    x: float
+    y: float
+
+
+class SentOff(msgspec.Struct):
+    """A robot sent off by a card or REPAIR_OUT (docs/rules.md): `sent_off` of `arena match --json`."""
+
+    tick: int
+    robot: str  # "b/1"
+    command: str  # RED_CARD, DOUBLE_YELLOW, REPAIR_OUT
+
+
 class MatchResult(msgspec.Struct, kw_only=True):
     """One match's result. Its fields, in order, are the keys of `arena match --json`
     (README.md, "What a match prints"); those after `referee_log` are set by the
-    engine that played it, and a field left UNSET is not printed."""
+    engine that played it, and a field left UNSET is not printed. `recording`, `refbox`,
+    `refbox_follow` and `referee_log` are what the recorder, the RefBox bridge and the referee
+    report of themselves (their Summary's `extra`), as they report it."""
 
     outcome: str  # completed | void (tools/launch/faults.py)
     void: bool
@@ -87,16 +129,16 @@ class MatchResult(msgspec.Struct, kw_only=True):
     rtf: float
     digest: str
     process_digests: dict[str, str]
-    processes: list[dict[str, Any]]
-    links: dict[str, dict[str, Any]]
+    processes: list[ProcessRow]
+    links: dict[str, LinkStats]
     events: dict[str, int]
-    distance_m: dict[str, Any]
-    parked: dict[str, Any]
-    sent_off: list[Any]
+    distance_m: dict[str, float]  # "a/1" -> metres driven
+    parked: dict[str, Parked]  # "b/1" -> where and when
+    sent_off: list[SentOff]
     rejected: int
     rejected_reasons: dict[str, int]
     dead: list[str]
-    faults: list[dict[str, Any]]
+    faults: list[Fault]
     conflicts: dict[str, int]
     forged: dict[str, int]
     liveliness_lapses: list[str]
@@ -114,15 +156,19 @@ class MatchResult(msgspec.Struct, kw_only=True):
     launch: str | UnsetType = UNSET  # processes: exec | fork | zygote; inprocess
     play_started_unix: float | None | UnsetType = UNSET  # processes, inprocess
     pid: int | UnsetType = UNSET  # inprocess
-    deadlocks: list[Any] | UnsetType = UNSET  # inprocess
+    deadlocks: list[str] | UnsetType = UNSET  # inprocess
     logs: str | UnsetType = UNSET  # processes: where a failed match's logs are kept
     # Never printed (`NOT_PRINTED`): what a caller in this process reads further.
     summaries: dict[str, Summary] = {}  # every process's own Summary, by name
     frames: dict[str, list[bytes]] = {}  # the payloads on each key `play(..., watch=...)` named, in order
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object of `arena match --json` (values as they are; UNSET fields left out)."""
-        return {f: v for f in self.__struct_fields__ if f not in NOT_PRINTED and (v := getattr(self, f)) is not UNSET}
+        """The JSON object of `arena match --json` (typed parts as plain dicts; UNSET fields left out)."""
+        return {
+            f: msgspec.to_builtins(v)
+            for f in self.__struct_fields__
+            if f not in NOT_PRINTED and (v := getattr(self, f)) is not UNSET
+        }
 
 
 NOT_PRINTED = frozenset(("summaries", "frames"))
@@ -136,21 +182,26 @@ def assemble(
     sums = got.summaries
     referee = sums.get("referee")
     engine = sums.get("engine")
-    links: dict[str, dict] = {}
+    totals: dict[str, list] = {}  # class -> [sent, dropped, delays]
     for name in order:
         s = sums.get(name)
         if s is None:
             continue
         for cls, agg in s.links.items():
-            acc = links.setdefault(cls, {"sent": 0, "dropped": 0, "_delays": []})
-            acc["sent"] += int(agg["frames"])
-            acc["dropped"] += int(agg["dropped"])
-            acc["_delays"].extend(s.delays_ms.get(cls, []))
-    for acc in links.values():
-        d = sorted(acc.pop("_delays"))
-        acc["drop_rate"] = round(acc["dropped"] / acc["sent"], 5) if acc["sent"] else 0.0
-        acc["delay_ms_mean"] = round(sum(d) / len(d), 3) if d else 0.0
-        acc["delay_ms_p95"] = round(percentile(d, 95), 3)
+            acc = totals.setdefault(cls, [0, 0, []])
+            acc[0] += int(agg["frames"])
+            acc[1] += int(agg["dropped"])
+            acc[2].extend(s.delays_ms.get(cls, []))
+    links = {}
+    for cls, (sent, dropped, delays) in totals.items():
+        d = sorted(delays)
+        links[cls] = LinkStats(
+            sent=sent,
+            dropped=dropped,
+            drop_rate=round(dropped / sent, 5) if sent else 0.0,
+            delay_ms_mean=round(sum(d) / len(d), 3) if d else 0.0,
+            delay_ms_p95=round(percentile(d, 95), 3),
+        )
     rejected = Counter()
     for s in sums.values():
         rejected.update(s.rejected_reasons)
@@ -162,16 +213,16 @@ def assemble(
         name = str(p)
         s = sums.get(name)
         processes.append(
-            {
-                "kind": p.kind,
-                "team": p.team or None,
-                "robot": p.robot if p.kind == "robot" else None,
-                "pid": s.pid if s is not None else pid_of.get(name),
-                "external": p.short in cfg.external or name in cfg.external,
-                "tick_us_median": round(s.tick_us[0], 1) if s and s.tick_us else None,
-                "tick_us_p95": round(s.tick_us[1], 1) if s and s.tick_us else None,
-                "cpu_s": round(sum(s.cpu_s), 3) if s and s.cpu_s else None,
-            }
+            ProcessRow(
+                kind=p.kind,
+                team=p.team or None,
+                robot=p.robot if p.kind == "robot" else None,
+                pid=s.pid if s is not None else pid_of.get(name),
+                external=p.short in cfg.external or name in cfg.external,
+                tick_us_median=round(s.tick_us[0], 1) if s and s.tick_us else None,
+                tick_us_p95=round(s.tick_us[1], 1) if s and s.tick_us else None,
+                cpu_s=round(sum(s.cpu_s), 3) if s and s.cpu_s else None,
+            )
         )
     last = got.last_referee
     if referee is not None:
@@ -193,12 +244,12 @@ def assemble(
     honest = match_outcome(cfg, sums, got.crashed, got.lost, got.missing, got.void)
     recording = recorder.extra if recorder else None
     if cfg.tap and recorder is None:
-        why = next((f["reason"] for f in honest["faults"] if f["process"] == "recorder"), "no summary")
+        why = next((f.reason for f in honest.faults if f.process == "recorder"), "no summary")
         recording = {"path": record, "complete": False, "error": f"the recorder failed: {why}"}
     return MatchResult(
-        outcome=honest["outcome"],
-        void=honest["void"],
-        outcome_reasons=honest["outcome_reasons"],
+        outcome=honest.outcome,
+        void=honest.void,
+        outcome_reasons=honest.outcome_reasons,
         home=cfg.home,
         away=cfg.away,
         score=score,
@@ -219,14 +270,14 @@ def assemble(
         links=links,
         events=dict(sorted(referee.extra.get("events", {}).items())) if referee else {},
         distance_m=engine.extra.get("distance_m", {}) if engine else {},
-        parked=engine.extra.get("parked", {}) if engine else {},
-        sent_off=engine.extra.get("sent_off", []) if engine else [],  # cards and REPAIR_OUT (docs/rules.md)
+        parked={k: Parked(**v) for k, v in engine.extra.get("parked", {}).items()} if engine else {},
+        sent_off=[SentOff(**s) for s in engine.extra.get("sent_off", [])] if engine else [],
         rejected=sum(rejected.values()),
         rejected_reasons=dict(rejected),
-        dead=honest["dead"],
-        faults=honest["faults"],
-        conflicts=honest["conflicts"],
-        forged=honest["forged"],
+        dead=honest.dead,
+        faults=honest.faults,
+        conflicts=honest.conflicts,
+        forged=honest.forged,
         liveliness_lapses=sorted(got.lapsed),
         forged_summaries=dict(sorted(got.forged.items())),
         sent_by_key=dict(sorted(sent_by_key.items())),
