@@ -185,18 +185,21 @@ def _lines(ax, cells: list[dict], x: str, group: str | None, resp: str) -> None:
 
 
 def _heatmap(fig, ax, cells: list[dict], x: str, y: str, resp: str) -> None:
-    xs = sorted({c[x] for c in cells}, key=lambda v: (not _numeric([v]), v if _numeric([v]) else str(v)))
-    ys = sorted({c[y] for c in cells}, key=lambda v: (not _numeric([v]), v if _numeric([v]) else str(v)))
+    """The mean per cell in colour, written in each cell with its interval."""
+    order = lambda v: (not _numeric([v]), v if _numeric([v]) else str(v))
+    xs, ys = sorted({c[x] for c in cells}, key=order), sorted({c[y] for c in cells}, key=order)
     grid = np.full((len(ys), len(xs)), np.nan)
+    text = {}
     for c in cells:
-        grid[ys.index(c[y]), xs.index(c[x])] = _nan(c[resp]["mean"])
+        i, j = ys.index(c[y]), xs.index(c[x])
+        grid[i, j] = _nan(c[resp]["mean"])
+        if c[resp]["mean"] is not None:
+            text[i, j] = f"{c[resp]['mean']:.2f}\n[{c[resp]['low']:.2f}, {c[resp]['high']:.2f}]"
     im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
     ax.set_xticks(range(len(xs)), [_short(v) for v in xs])
     ax.set_yticks(range(len(ys)), [_short(v) for v in ys])
-    for i in range(len(ys)):
-        for j in range(len(xs)):
-            if grid[i, j] == grid[i, j]:
-                ax.text(j, i, f"{grid[i, j]:.2f}", ha="center", va="center", color="w", fontsize=8)
+    for (i, j), label in text.items():  # dark text on the light end of the colour map
+        ax.text(j, i, label, ha="center", va="center", fontsize=7, color="k" if im.norm(grid[i, j]) > 0.6 else "w")
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     fig.colorbar(im, ax=ax, label=resp)
