@@ -20,8 +20,8 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from arena.match.result import MatchResult
     from arena.runtime.config import MatchConfig
-    from arena.tools.launch.result import MatchResult
 
 
 def argv(engine: str) -> list[str]:
@@ -40,7 +40,7 @@ def decode(out: str) -> MatchResult:
     """The `MatchResult` the match printed; ValueError if it printed none (one line)."""
     import msgspec
 
-    from arena.tools.launch.result import MatchResult
+    from arena.match.result import MatchResult
 
     try:
         return msgspec.json.decode(out, type=MatchResult)
@@ -49,10 +49,9 @@ def decode(out: str) -> MatchResult:
 
 
 def main(args: list[str] | None = None) -> int:
-    from arena.match import MatchError, play
+    from arena.match import MatchError, faults, play
     from arena.match.engines import ENGINES
     from arena.runtime.config import ConfigError, MatchConfig
-    from arena.tools.launch import faults
 
     p = argparse.ArgumentParser(prog="python -m arena.match", description=__doc__.splitlines()[0])
     p.add_argument("--engine", choices=ENGINES, default="processes")

@@ -492,7 +492,7 @@ class RecorderNode(Observer):
         if self.interrupted:
             raise SystemExit(128 + signal.Signals[self.interrupted].value)
 
-    # A cooperative match (tools/launch/inprocess.py) calls these two instead of `observe`.
+    # A cooperative match (match/inprocess.py) calls these two instead of `observe`.
     def pump(self) -> None:
         """Take in the tap batches and summaries that are there; write what every watermark passed."""
         self._drain()

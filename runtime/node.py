@@ -333,7 +333,7 @@ class Node(Peer):
     """A process in the lockstep: its links, its lockstep loop, and the `Driver` that runs it.
 
     `driver`: `Pull` (blocking on this thread) unless given; a zenoh match in lockstep
-    gives a `Reactor` (tools/launch/run.py), a cooperative match a `coop.Task`.
+    gives a `Reactor` (match/run.py), a cooperative match a `coop.Task`.
     """
 
     def __init__(

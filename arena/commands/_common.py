@@ -10,7 +10,7 @@ import sys
 from typing import TYPE_CHECKING, NoReturn
 
 if TYPE_CHECKING:
-    from arena.tools.launch.result import MatchResult
+    from arena.match.result import MatchResult
 
 
 class Parser(argparse.ArgumentParser):
@@ -102,10 +102,10 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
     """Print a match result (arena match, arena up): one JSON object, or the tables.
 
     Faults and keys with two senders are also printed on stderr, one line
-    each. A void match (tools/launch/faults.py) exits 1 with one line naming the cause.
+    each. A void match (match/faults.py) exits 1 with one line naming the cause.
     """
-    from arena.tools.launch import faults
-    from arena.tools.review import report
+    from arena.match import faults
+    from arena.review import report
 
     if as_json:
         printed = match.to_dict()

@@ -22,7 +22,7 @@ EXAMPLES = """examples:
   arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
-  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see experiments/navbench/navbench.toml)"""
 
 
 # The match flags (arena match's, `add_match_flags`; None or [] when not given) and bench's own defaults.
@@ -84,15 +84,15 @@ def add_parser(sub) -> None:
     b.add_argument(
         "--scenarios",
         metavar="FILE",
-        help="nav: scenario file (default: the built-in tools/experiments/navbench/navbench.toml)",
+        help="nav: scenario file (default: the built-in experiments/navbench/navbench.toml)",
     )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
 
 
 def run(args: argparse.Namespace) -> int:
+    from arena.experiments import bench
     from arena.strategies import registry
-    from arena.tools.experiments import bench
 
     unused = [k for k, v in DEFAULTS.items() if k not in USES[args.what] and getattr(args, k) != v]
     if unused:  # learn and scenario played 3v3 on ideal links whatever --robots and --link said
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"{flag} does not apply to arena bench {args.what} (it takes {takes} and --json)")
     if args.what in ("match", "record", "throughput", "experiment"):  # checked before the first run says it starts
         base = match_config(args, seed=False)  # --seed is nav's
-        if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
+        if args.what == "throughput":  # its matches are processes of their own: a bad name would fail in each
             strategy = registry.resolve_name(args.strategy)
     if args.what == "record":
         return bench.bench_record(base, args.runs, args.json)
@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(str(exc)) from None
         return bench_learn(args.runs, args.half_time or MATCH_DEFAULTS["half_time"], args.strategy, args.json)
     if args.what == "experiment":
-        from arena.tools.experiments.experiment_bench import bench_experiment
+        from arena.experiments.experiment_bench import bench_experiment
 
         name = registry.resolve_name(args.strategy)
         return bench_experiment(base.replace(home=name, away="basic-static"), args.runs, args.json)
@@ -124,11 +124,11 @@ def run(args: argparse.Namespace) -> int:
 
         return bench_scenario(args.runs, args.json)
     if args.what == "throughput":
-        from arena.tools.experiments import throughput
+        from arena.experiments import throughput
 
         return throughput.bench_throughput(base, args.runs, strategy, args.json)
     if args.what == "nav":
-        from arena.tools.experiments import navbench
+        from arena.experiments import navbench
 
         return navbench.main(
             scenarios=args.scenarios,

@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
-        from arena.tools.experiments.cluster import parse_address
+        from arena.experiments.cluster import parse_address
 
         parse_address(args.ray)
     if args.experiment == "compare":
@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from arena.tools.experiments import design, experiment
+    from arena.experiments import design, experiment
 
     exp = design.load(args.file)
     source = Path(args.file).read_text()
@@ -126,8 +126,8 @@ def _run(args: argparse.Namespace) -> int:
 
 def _compare(args: argparse.Namespace) -> int:
     from arena.commands._match_flags import match_config
+    from arena.experiments import compare
     from arena.strategies import registry
-    from arena.tools.experiments import compare
 
     if args.half_time is not None and not 0 < args.half_time <= 3600:
         raise ConfigError(f"--half-time must be in (0, 3600] s, got {args.half_time}")

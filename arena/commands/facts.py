@@ -39,7 +39,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.experiments import facts
+    from arena.experiments import facts
 
     if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
         raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")

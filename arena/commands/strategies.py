@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.markup import escape
     from rich.table import Table
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     t = Table(title="strategies (arena match --home NAME --away ALIAS)")
     for col in ("name", "alias", "from", "conformance"):

@@ -55,9 +55,9 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from arena.experiments import tournament
+    from arena.experiments.tournament_report import print_summary
     from arena.strategies import registry
-    from arena.tools.experiments import tournament
-    from arena.tools.experiments.tournament_report import print_summary
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ConfigError(f"--out {args.out} exists and is not a directory")
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
-        from arena.tools.experiments.cluster import parse_address, parse_runtime_env
+        from arena.experiments.cluster import parse_address, parse_runtime_env
 
         parse_address(args.ray)
         parse_runtime_env(args.ray_runtime_env)

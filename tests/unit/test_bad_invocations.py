@@ -363,9 +363,9 @@ def test_a_jobs_of_0_is_said_to_mean_the_default(capfd):
 
 def test_a_malformed_listen_is_said_before_a_process_is_forked(monkeypatch):
     """`arena match --listen foo` forked the match's ten processes, then refused the endpoint."""
+    from arena.match import forkstart, launcher
     from arena.runtime.config import MatchConfig
     from arena.runtime.session import EndpointError
-    from arena.tools.launch import forkstart, launcher
 
     monkeypatch.setattr(forkstart, "starter", lambda *args: pytest.fail("forked before the endpoint was checked"))
     with pytest.raises(EndpointError, match="--listen foo: not a zenoh endpoint"):

@@ -1,4 +1,4 @@
-"""tools/experiments/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
+"""experiments/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
 
 The real cluster is exercised in tests/integration/test_cluster.py.
 """
@@ -12,9 +12,9 @@ from types import SimpleNamespace
 
 import pytest
 
+from arena.experiments import cluster
+from arena.experiments.fixtures import Fixture
 from arena.runtime.config import ConfigError
-from arena.tools.experiments import cluster
-from arena.tools.experiments.fixtures import Fixture
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -102,8 +102,8 @@ def test_ray_missing_is_refused_before_anything_is_written(tmp_path, monkeypatch
     """`--ray` without Ray failed, but only after logs/, matches/ and settings.json were made."""
     import sys
 
+    from arena.experiments import tournament
     from arena.runtime.config import ConfigError
-    from arena.tools.experiments import tournament
 
     monkeypatch.setitem(sys.modules, "ray", None)  # as if not installed
     out = tmp_path / "t"

@@ -1,4 +1,4 @@
-"""The experiment file (tools/experiments/design.py): strict parsing, dotted paths over any
+"""The experiment file (experiments/design.py): strict parsing, dotted paths over any
 configuration field, the designs, and the matches (common seeds, ends swapped)."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import os
 
 import pytest
 
+from arena.experiments import design
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.tools.experiments import design
 
 
 def write(tmp_path, text: str, name: str = "exp.toml") -> str:

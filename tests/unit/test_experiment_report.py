@@ -1,11 +1,11 @@
-"""What `arena experiment run` computes from its rows (tools/experiments/experiment_report.py):
+"""What `arena experiment run` computes from its rows (experiments/experiment_report.py):
 bootstrap intervals over seeds, the difference to a reference cell paired by seed, the plots."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from arena.tools.experiments import design, experiment_report
+from arena.experiments import design, experiment_report
 
 
 def experiment(tmp_path, factors: str, seeds: int = 8):

@@ -7,11 +7,11 @@ import math
 import msgspec
 import pytest
 
+from arena.match.faults import Fault, blame, lapses, outcome
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
 from arena.schemas.validate import nonfinite, safe_default, suspect
 from arena.sim.physics import Physics
-from arena.tools.launch.faults import Fault, blame, lapses, outcome
 from tests.unit.test_lockstep import Harness
 
 

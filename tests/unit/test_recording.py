@@ -16,19 +16,19 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from arena.experiments import facts
+from arena.match.inprocess import play_in_process
 from arena.processes.recorder import data_topics
 from arena.recording import scene
 from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import RecordingError, load
+from arena.review import replay, review
 from arena.runtime.config import MatchConfig
 from arena.runtime.tap import Tap
 from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import registry
-from arena.tools.experiments import facts
-from arena.tools.launch.inprocess import play_in_process
-from arena.tools.review import replay, review
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
 

@@ -11,9 +11,9 @@ from msgspec.structs import replace
 from rich.console import Console
 
 from arena.match import MatchResult, play
+from arena.match.result import LinkStats
+from arena.review import report
 from arena.runtime.config import MatchConfig
-from arena.tools.launch.result import LinkStats
-from arena.tools.review import report
 from tests.integration.helpers import arena_in_process
 
 
