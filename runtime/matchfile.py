@@ -135,7 +135,12 @@ def load(path: str, under: dict[str, Any] | None = None) -> MatchConfig:
     """Read and validate FILE.toml; ConfigError naming the file and the bad key. `under`: values of
     the top-level keys (`TOP`) that apply where the file has none (a command's own defaults)."""
     data = userfile.load_toml(path, "--config")  # regular, bounded, UTF-8, nesting bounded
-    raw = {**{k: v for k, v in (under or {}).items() if k in TOP}, **to_dict(data, path)}
+    return from_data({**{k: v for k, v in (under or {}).items() if k in TOP}, **to_dict(data, path)}, path)
+
+
+def from_data(raw: dict[str, Any], path: str) -> MatchConfig:
+    """`MatchConfig.from_dict(raw)` with the file's checks (links, finite and positive numbers);
+    ConfigError naming `path` and the bad key (an experiment builds each cell's configuration so)."""
     try:
         cfg = MatchConfig.from_dict(raw)
     except ConfigError as exc:

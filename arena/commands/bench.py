@@ -18,6 +18,7 @@ EXAMPLES = """examples:
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
+  arena bench experiment          # CPU the experiment runner adds to the in-process matches it plays
   arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
   arena bench refbox               # RefBox bridge parsing of hostile messages: us per kB at 100 kB and 1 MB
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
@@ -37,6 +38,7 @@ USES = {
     "learn": {"runs", "half_time", "strategy"},
     "scenario": {"runs"},
     "refbox": {"runs"},
+    "experiment": {"runs", *MATCH, "strategy"},
     "nav": {"trials", "seed", "scenarios", "only", "plots"},
 }
 DEFAULTS = {
@@ -55,19 +57,20 @@ def add_parser(sub) -> None:
     b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario", "refbox"],
+        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario", "refbox", "experiment"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
         "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
         "on 2 workers vs. 1 (needs the learn extra); scenario: 10-s scenario runs per minute in process, "
         "and the ratio to a plain match of the same length; refbox: the bridge's parsing of hostile messages "
-        "(us per kB at 100 kB and 1 MB)",
+        "(us per kB at 100 kB and 1 MB); experiment: the CPU the experiment runner adds to "
+        "the in-process matches it plays, side by side with a bare loop",
     )
     b.add_argument(
         "--strategy",
         default=DEFAULTS["strategy"],
         metavar="NAME",
-        help="robot, throughput, learn: strategy (both teams) (AD)",
+        help="robot, throughput, learn: strategy (both teams); experiment: team a's, against BS (AD)",
     )
     b.add_argument("--runs", type=positive_int, default=DEFAULTS["runs"], metavar="N", help="runs (3)")
     # match, record, throughput: the match they play (learn: --half-time only)
@@ -99,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
         flag = "--" + unused[0].replace("_", "-")
         takes = ", ".join("--" + k.replace("_", "-") for k in DEFAULTS if k in USES[args.what])
         raise ConfigError(f"{flag} does not apply to arena bench {args.what} (it takes {takes} and --json)")
-    if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
+    if args.what in ("match", "record", "throughput", "experiment"):  # checked before the first run says it starts
         base = match_config(args, seed=False)  # --seed is nav's
         if args.what == "throughput":  # its matches are processes of their own: a bad name would fail in each
             strategy = registry.resolve_name(args.strategy)
@@ -114,6 +117,11 @@ def run(args: argparse.Namespace) -> int:
         except ImportError as exc:
             raise ConfigError(str(exc)) from None
         return bench_learn(args.runs, args.half_time or MATCH_DEFAULTS["half_time"], args.strategy, args.json)
+    if args.what == "experiment":
+        from arena.experiments.experiment_bench import bench_experiment
+
+        name = registry.resolve_name(args.strategy)
+        return bench_experiment(base.replace(home=name, away="basic-static"), args.runs, args.json)
     if args.what == "scenario":
         from arena.scenarios.bench import bench_scenario
 
