@@ -46,7 +46,7 @@ def _known(section: str) -> dict[str, Any]:
 
 
 def _check_keys(data: dict[str, Any], where: str) -> None:
-    allowed_top = set(TOP) | set(SECTIONS) | {"links"}
+    allowed_top = set(TOP) | set(SECTIONS) | {"links", "params"}
     for key in data:
         if key not in allowed_top:
             raise ConfigError(f"{where}: unknown key {key!r} (known: {', '.join(sorted(allowed_top))})")
@@ -99,6 +99,11 @@ def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
             raise ConfigError(f"{where}: unknown key links.{cls} (known: preset, and one table per link class)")
     if overrides:
         out["link_overrides"] = overrides
+    params = data.get("params", {})
+    if not isinstance(params, dict) or not all(isinstance(v, dict) for v in params.values()):
+        raise ConfigError(f"{where}: params must hold one table per team: [params.a] kick_speed = 7.0")
+    if params:
+        out["params"] = {team: dict(values) for team, values in params.items()}
     return out
 
 
@@ -160,6 +165,13 @@ def dump(cfg: MatchConfig | None = None) -> str:
     )
     for cls, params in sorted(cfg.link_overrides.items()):
         lines += ["", f"[links.{cls}]"] + [f"{p} = {_toml_value(v)}" for p, v in sorted(params.items())]
+    lines += [
+        "",
+        "# strategy parameters per team over the strategy's defaults (arena strategies --params NAME),",
+        "# e.g. [params.a] kick_speed = 7.0 (arena match --param a.kick_speed=7.0)",
+    ]
+    for team, values in sorted(cfg.params.items()):
+        lines += ["", f"[params.{team}]"] + [f"{p} = {_toml_value(v)}" for p, v in sorted(values.items())]
     for section in SECTIONS:
         params = getattr(cfg, section)
         notes = _comments(type(params))

@@ -10,7 +10,9 @@ from arena.commands._common import add_command
 EXAMPLES = """examples:
   arena strategies                 # every strategy, built-in or plugin, and whether it passes the conformance suite
   arena strategies AD chase        # only these (a plugin by its name too)
-  arena strategies --no-check --json"""
+  arena strategies --no-check --json
+  arena strategies --params AD     # AD's tunable parameters: name, type, default, range, unit, meaning
+  arena strategies --params AD --json"""
 
 
 def add_parser(sub) -> None:
@@ -21,6 +23,11 @@ def add_parser(sub) -> None:
         EXAMPLES,
     )
     st.add_argument("names", nargs="*", metavar="NAME", help="only these strategies (names or aliases)")
+    st.add_argument(
+        "--params",
+        metavar="NAME",
+        help="list this strategy's parameters (set them with arena match --param a.NAME=V or [params.a] in a file)",
+    )
     st.add_argument("--no-check", action="store_true", help="skip the conformance suite (~1.5 s per strategy)")
     st.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -28,6 +35,8 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from arena.strategies import registry
 
+    if args.params is not None:
+        return show_params(registry.get(args.params), args.json)
     wanted = {registry.resolve_name(n) for n in args.names}
     rows = [r for r in registry.describe(check=not args.no_check, only=wanted or None)]
     if args.json:
@@ -45,3 +54,39 @@ def run(args: argparse.Namespace) -> int:
         t.add_row(r["name"], "/".join(r["aliases"]) or "-", escape(r["source"]), escape(r["conformance"]))
     make_console().print(t)
     return 0 if not any(r["conformance"].startswith("fails") for r in rows) else 1
+
+
+def show_params(strategy, as_json: bool) -> int:
+    rows = [
+        {
+            "name": p.name,
+            "type": p.type,
+            "default": p.default,
+            "low": p.low,
+            "high": p.high,
+            "choices": list(p.choices),
+            "unit": p.unit,
+            "meaning": p.meaning,
+        }
+        for p in strategy.params
+    ]
+    if as_json:
+        print(json.dumps({"strategy": strategy.name, "params": rows}, indent=2))
+        return 0
+    from rich.markup import escape
+    from rich.table import Table
+
+    from arena.tools.console import console as make_console
+
+    if not rows:
+        print(f"{strategy.name} declares no parameters")
+        return 0
+    title = f"{strategy.name}'s parameters (arena match --param a.NAME=VALUE; [params.a] in a match file)"
+    t = Table(title=escape(title))
+    for col in ("name", "type", "default", "range", "unit", "meaning"):
+        t.add_column(col)
+    for r in rows:
+        span = "|".join(r["choices"]) if r["choices"] else "" if r["low"] is None else f"{r['low']:g}..{r['high']:g}"
+        t.add_row(r["name"], r["type"], str(r["default"]), span, r["unit"], escape(r["meaning"]))
+    make_console().print(t)
+    return 0
