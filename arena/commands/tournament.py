@@ -19,7 +19,8 @@ EXAMPLES = """examples:
   arena tournament --ray auto --out runs/big        # join the Ray cluster this node belongs to (ray start ...)
   arena tournament --ray 10.0.0.5:6379 --resume     # join the cluster whose head node is there
   arena tournament --ray auto --ray-runtime-env '{"pip": ["soccer-arena==0.1.0"]}'   # workers install it
-  arena tournament --legs 10 --engine inprocess     # one worker process per core, same digests, ~2.5x faster"""
+  arena tournament --legs 10 --engine inprocess     # one worker process per core, same digests, ~2.5x faster
+  arena tournament --param AD.kick_speed=6.0 --param BS.kick_speed=6.0 --out runs/k6   # strategy parameters"""
 
 
 def add_parser(sub) -> None:
@@ -35,6 +36,15 @@ def add_parser(sub) -> None:
     t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
     t.add_argument(
         "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
+    )
+    t.add_argument(
+        "--param",
+        dest="strategy_param",
+        action="append",
+        default=[],
+        metavar="STRATEGY.NAME=V",
+        help="set a strategy's parameter in every match it plays, e.g. AD.kick_speed=7.0 (repeatable; "
+        "arena strategies --params AD lists them)",
     )
     every_match_latency(t)
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
@@ -88,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
         robots=every.robots,
         link=every.link,
         link_param=tuple(args.link_param),
+        params=strategy_params(args.strategy_param, names),
         perception_latency=args.perception_latency,
         seed=args.seed,
         jobs=args.jobs,
@@ -107,3 +118,21 @@ def run(args: argparse.Namespace) -> int:
         print("arena tournament: interrupted; finished matches are kept (continue with --resume)", file=sys.stderr)
         return 130
     return 0
+
+
+def strategy_params(given: list[str], names: list[str]) -> tuple[tuple[str, str, object], ...]:
+    """`--param STRATEGY.NAME=V` as (strategy, name, value), each checked against the strategy's declarations."""
+    from arena.strategies import registry
+    from arena.strategies.base import check_values
+
+    out = []
+    for text in given:
+        who, name, value = registry.parse_param(text, teams=())
+        strategy = registry.get(who)
+        if strategy.name not in names:
+            raise ConfigError(
+                f"--param {text!r}: {strategy.name} plays no match of this tournament ({', '.join(names)})"
+            )
+        checked = check_values(strategy.name, strategy.params, {name: value})
+        out.append((strategy.name, name, checked[name]))
+    return tuple(out)

@@ -70,3 +70,12 @@ def test_a_batched_distributed_match_has_the_digests_of_one_frame_per_message(la
     single = arena_json(*base, "--engine", "inprocess", "--batch", "1")
     assert batched["outcome"] == "completed" and batched["rejected"] == 0
     assert batched["process_digests"] == single["process_digests"]
+
+
+def test_a_strategy_parameter_changes_the_digest_alike_on_both_engines():
+    base = ("match", "--home", "AD", "--away", "BS", "--half-time", "20", "--seed", "1", "--json")
+    plain = arena_json(*base, "--engine", "inprocess")
+    got = {e: arena_json(*base, "--engine", e, "--param", "a.kick_speed=6.0") for e in ("processes", "inprocess")}
+    assert got["processes"]["digest"] == got["inprocess"]["digest"] != plain["digest"]
+    assert got["processes"]["process_digests"] == got["inprocess"]["process_digests"]
+    assert got["processes"]["params"] == got["inprocess"]["params"] == {"a": {"kick_speed": 6.0}}

@@ -62,6 +62,7 @@ class Runner:
             link=self.opts.link,
             link_overrides=self.opts.link_overrides(),
             timing=TimingParams(perception_latency=self.opts.latency()),
+            params=self.opts.params_of(fx.home, fx.away),
         )
         cfg.validate()
         return cfg
@@ -177,14 +178,25 @@ def _play_inprocess(cfg) -> dict:
 
 def match_argv(cfg: MatchConfig, engine: str) -> list[str]:
     """The `arena match ... --json` command that plays `cfg` (strategies, size, half, seed, link and its
-    overrides, perception latency) on `engine`, as a user would type it."""
+    overrides, perception latency, strategy parameters) on `engine`, as a user would type it."""
     argv = [sys.executable, "-m", "arena", "match", "--home", cfg.home, "--away", cfg.away]
     argv += ["--robots", str(cfg.robots), "--half-time", str(cfg.half_time), "--seed", str(cfg.seed)]
     argv += ["--link", cfg.link, "--perception-latency", str(cfg.timing.perception_latency)]
     argv += ["--engine", engine, "--json"]
     for cls, params in cfg.link_overrides.items():
         argv += [x for p, v in params.items() for x in ("--link-param", f"{cls}.{p}={v!r}")]
+    for team, values in sorted(cfg.params.items()):
+        argv += [x for p, v in values.items() for x in ("--param", f"{team}.{p}={_toml(v)}")]
     return argv
+
+
+def _toml(value) -> str:
+    """A parameter value as `--param` reads it back (a TOML scalar): the same type and value."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
 
 
 def default_jobs() -> int:

@@ -29,9 +29,19 @@ from arena.tools.experiments.matches import Runner, play_local
 from arena.tools.experiments.tournament_report import report, show_value
 
 # Settings that decide what a match is: --resume refuses to mix results played with other values.
-BINDING = ("strategies", "legs", "half_time", "robots", "link", "link_overrides", "perception_latency", "seed")
+BINDING = (
+    "strategies",
+    "legs",
+    "half_time",
+    "robots",
+    "link",
+    "link_overrides",
+    "perception_latency",
+    "params",
+    "seed",
+)
 # What a settings.json written before a binding setting existed was played with.
-LEGACY = {"perception_latency": 0}
+LEGACY = {"perception_latency": 0, "params": {}}
 
 
 @dataclass(frozen=True)
@@ -44,6 +54,7 @@ class TournamentOptions:
     robots: int = 3
     link: str = "ideal"
     link_param: tuple[str, ...] = ()  # CLASS.PARAM=V, as given to --link-param
+    params: tuple[tuple[str, str, object], ...] = ()  # (strategy, name, value), checked: --param STRATEGY.NAME=V
     perception_latency: int | None = None  # [ticks] None: the default (runtime/config.py DEFAULT_PERCEPTION_LATENCY)
     seed: int = 0
     jobs: int = 0  # 0: one per core
@@ -65,6 +76,18 @@ class TournamentOptions:
 
         return parse_overrides(self.link_param)
 
+    def params_by_strategy(self) -> dict[str, dict[str, object]]:
+        """Strategy -> its parameter values, whichever side it plays."""
+        out: dict[str, dict[str, object]] = {}
+        for strategy, name, value in self.params:
+            out.setdefault(strategy, {})[name] = value
+        return out
+
+    def params_of(self, home: str, away: str) -> dict[str, dict[str, object]]:
+        """`MatchConfig.params` of a fixture: each team the values of the strategy it plays."""
+        by = self.params_by_strategy()
+        return {team: dict(by[s]) for team, s in (("a", home), ("b", away)) if s in by}
+
 
 def settings(opts: TournamentOptions) -> dict:
     """Everything needed to play the tournament again (tournament.json, report.md, --resume's check)."""
@@ -78,6 +101,7 @@ def settings(opts: TournamentOptions) -> dict:
         "link": opts.link,
         "link_overrides": opts.link_overrides(),
         "perception_latency": opts.latency(),
+        "params": opts.params_by_strategy(),
         "seed": opts.seed,
         "engine": opts.engine,
         "version": package_version(),
@@ -99,7 +123,12 @@ def check_resume(out: Path, now: dict) -> None:
         before = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--resume: cannot read {path}: {exc}") from None
-    flag = {"link_overrides": "link-param", "half_time": "half-time", "perception_latency": "perception-latency"}
+    flag = {
+        "link_overrides": "link-param",
+        "half_time": "half-time",
+        "perception_latency": "perception-latency",
+        "params": "param",
+    }
     diffs = [
         f"--{flag.get(k, k)} {show_value(before.get(k, LEGACY.get(k)))} there, {show_value(now[k])} now"
         for k in BINDING
