@@ -27,9 +27,9 @@ import numpy as np
 
 from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.single import SoccerEnv, make_vector_env
+from arena.match import play
 from arena.runtime.config import MatchConfig
 from arena.tools.console import console as make_console
-from arena.tools.launch.inprocess import play_in_process
 
 ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  # cycled: no draw in the loop
 
@@ -37,7 +37,7 @@ ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  #
 def match_rate(cfg: MatchConfig) -> float:
     """In-process match: ticks per CPU-second."""
     t0 = time.process_time()
-    play_in_process(cfg, watch=())
+    play(cfg)
     return (cfg.total_ticks + 1) / (time.process_time() - t0)
 
 

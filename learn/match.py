@@ -2,7 +2,7 @@
 
 The in-process engine (runtime/coop.py) runs every node of a match on one
 thread, each node's lockstep generator resumed while the link it waits on is
-ready. `SteppedMatch` builds the very same nodes, gives each learner's robot a
+ready. `SteppedMatch` has it build the very same nodes (`InProcess.stepped`), gives each learner's robot a
 `LearnerBrain` whose action the caller sets, and puts one more wait into that
 robot's loop: just before it acts at a decision tick k (its `sense` of k - L
 and its latest `order` are in), it waits on a `Gate` that only the caller
@@ -20,11 +20,9 @@ from typing import Any
 
 import msgspec
 
-from arena.processes import node_class
+from arena.match import InProcess
 from arena.runtime.config import MatchConfig, ProcessId
-from arena.runtime.coop import CoopBus, Task, run_runnable
-from arena.runtime.transport import MemoryTransport
-from arena.schemas.keys import Keys
+from arena.runtime.coop import Task
 from arena.schemas.messages import Order, Referee, Sense, World
 from arena.strategies.base import RobotContext
 from arena.strategies.learned import LearnerBrain
@@ -83,13 +81,10 @@ class SteppedMatch:
         self.worlds: list[World] = []
         self.referees: list[Referee] = []
         self.frame_skip = frame_skip
-        self.bus = bus = CoopBus()
-        keys = Keys("learn")
-        self.referee_ch = bus.subscribe(None, keys.key("referee"))
-        self.world_ch = bus.subscribe(None, keys.key("world"))
-        self.nodes = {
-            str(p): node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p))) for p in cfg.processes()
-        }
+        self.stepped = match = InProcess().stepped(cfg, watch=("referee", "world"), match="learn")
+        self.bus = match.bus
+        self.referee_ch, self.world_ch = match.taps["referee"], match.taps["world"]
+        self.nodes = match.nodes
         self.actions: dict[str, Any] = {}
         self.gates: dict[str, Gate] = {}
         self.robot_of: dict[str, Any] = {}
@@ -128,7 +123,7 @@ class SteppedMatch:
 
     def advance(self) -> None:
         """Play until every learner waits at its gate or has ended; then read the referee and the ball."""
-        run_runnable(self.bus)
+        self.stepped.run()
         waiting = [t for t in self.learner_tasks.values() if not t.done]
         for t in waiting:
             if t.waiting is None or not isinstance(t.waiting[0], Gate):

@@ -10,6 +10,7 @@ PACKAGES = (
     "processes",
     "schemas",
     "tools",
+    "match",
     "strategies",
     "navigation",
     "sim",

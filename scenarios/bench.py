@@ -18,12 +18,12 @@ from multiprocessing import get_context
 
 import msgspec
 
+from arena.match import play
 from arena.runtime.config import ScenarioParams
 from arena.scenarios.library import BEHAVIOUR
 from arena.scenarios.model import build, load
 from arena.scenarios.runner import run_one
 from arena.tools.experiments.bench import print_metrics
-from arena.tools.launch.inprocess import play_in_process
 
 SECONDS = 10.0  # [s] simulated per run
 
@@ -49,7 +49,7 @@ def bench_scenario(runs: int = 10, as_json: bool = False, jobs: int = 2) -> int:
         run_one(sc, seed)
         scenario_s.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        play_in_process(plain.replace(seed=seed), watch=())
+        play(plain.replace(seed=seed))
         plain_s.append(time.perf_counter() - t0)
     jobs = max(1, min(jobs, os.cpu_count() or 1))
     with ProcessPoolExecutor(jobs, mp_context=get_context("fork")) as pool:

@@ -11,13 +11,10 @@ its 95 % Wilson score interval, and the scenario's verdict (`min_pass`)."""
 
 from __future__ import annotations
 
-import hashlib
 import math
 import shlex
 import sys
-import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import msgspec
 
@@ -139,42 +136,18 @@ def _trace(sc: Scenario, worlds: list[World], referees: list[Referee], digests: 
     return Trace(dt=cfg.timing.dt, worlds=worlds, commands=commands, digests=digests, fence=fence)
 
 
-def combined_digest(cfg, digests: dict[str, str]) -> str:
-    """The match digest of `arena match --json` (tools/launch/result.py `assemble`): every process's, in order."""
-    combined = hashlib.blake2b(digest_size=16)
-    for p in cfg.processes():
-        name = str(p)
-        if name in digests and p.kind not in ("recorder", "refbox", "viewer"):
-            combined.update(name.encode() + b"=" + digests[name].encode() + b";")
-    return combined.hexdigest()
+def _play(sc: Scenario, seed: int, engine: str, record: str):
+    from arena.match import Processes, play
 
-
-def _inprocess(sc: Scenario, seed: int, record: str):
-    from arena.tools.launch.inprocess import play_in_process
-
-    summaries, frames = play_in_process(sc.config(seed), watch=("world", "referee"), record=record)
+    # An --external process is started by hand: the launcher says the command to type there.
+    announce = lambda text: print(text, file=sys.stderr, flush=True)
+    on = Processes(strict=True, announce=announce) if engine == "processes" else engine
+    result = play(sc.config(seed), engine=on, record=record, watch=("world", "referee"))
     wdec = msgspec.msgpack.Decoder(World).decode
     rdec = msgspec.msgpack.Decoder(Referee).decode
-    worlds = [wdec(p) for p in frames["world"]]
-    referees = [rdec(p) for p in frames["referee"]]
-    digests = {name: s.digest for name, s in summaries.items() if name != "recorder"}
-    return worlds, referees, digests, combined_digest(sc.config(seed), digests)
-
-
-def _processes(sc: Scenario, seed: int, record: str):
-    from arena.recording.reader import load
-    from arena.tools.launch.launcher import play_match
-
-    with tempfile.TemporaryDirectory(prefix="arena-scenario-") as tmp:
-        path = record or str(Path(tmp) / "run.mcap")
-        # An --external process is started by hand: the launcher says the command to type there.
-        announce = lambda text: print(text, file=sys.stderr, flush=True)
-        result = play_match(sc.config(seed), record=path, strict=True, announce=announce)
-        rec = load(path, keep={"world", "referee"})
-        worlds = rec.decoded("world", World)
-        referees = rec.decoded("referee", Referee)
-    digests = {k: v for k, v in result.process_digests.items() if k != "recorder"}
-    return worlds, referees, digests, result.digest
+    worlds = [wdec(p) for p in result.frames["world"]]
+    referees = [rdec(p) for p in result.frames["referee"]]
+    return worlds, referees, dict(result.process_digests), result.digest
 
 
 def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = "") -> Verdict:
@@ -184,8 +157,7 @@ def run_one(sc: Scenario, seed: int, engine: str = "inprocess", record: str = ""
     """
     if sc.spec.play.external and engine != "processes":
         raise ValueError(f"{sc.path}: scenario {sc.name!r} has external processes: it needs --engine processes")
-    play = _inprocess if engine == "inprocess" else _processes
-    worlds, referees, digests, total = play(sc, seed, record)
+    worlds, referees, digests, total = _play(sc, seed, engine, record)
     trace = _trace(sc, worlds, referees, digests)
     failures = []
     for e in sc.spec.expect:

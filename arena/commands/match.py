@@ -95,8 +95,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.launch import launcher
-    from arena.tools.launch.children import JoinError, MatchError
+    from arena.match import JoinError, MatchError, Processes, play
 
     cfg, record = full_config(args)
     if args.engine == "inprocess":
@@ -104,20 +103,19 @@ def run(args: argparse.Namespace) -> int:
     if cfg.refbox.follow:
         warn_unreachable_refbox(cfg.refbox.follow)
     show = not args.json and sys.stderr.isatty()
+    engine = Processes(
+        match=args.match,
+        listen=args.listen,
+        progress=show,
+        log_dir=args.logs,
+        announce=lambda text: print(text, file=sys.stderr, flush=True),
+        strict=args.strict,
+        live_host=args.live_host,
+        secure=args.secure,
+        credentials=args.credentials,
+    )
     try:
-        result = launcher.play_match(
-            cfg,
-            match=args.match,
-            listen=args.listen,
-            progress=show,
-            log_dir=args.logs,
-            announce=lambda text: print(text, file=sys.stderr, flush=True),
-            strict=args.strict,
-            live_host=args.live_host,
-            secure=args.secure,
-            credentials=args.credentials,
-            record=record,
-        )
+        result = play(cfg, engine=engine, record=record)
     except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 2 if isinstance(exc, JoinError) else 1
@@ -126,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
 
 def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = "") -> int:
     """`arena match --engine inprocess`: flags that need separate processes are refused."""
-    from arena.tools.launch import inprocess
+    from arena.match import MatchError, play
 
     for flag, given in (
         ("--realtime", args.realtime),
@@ -141,8 +139,8 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = ""
         if given:
             raise ConfigError(f"{flag} needs --engine processes (inprocess plays lockstep in one process)")
     try:
-        result = inprocess.play_match(cfg, record=record)
-    except inprocess.InprocessError as exc:
+        result = play(cfg, engine="inprocess", record=record)
+    except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 1
     return emit_match(result, args.json)

@@ -21,6 +21,7 @@ RANK = {
     "refbox": 3,  # the RefBox protocol's sockets and threads, over the pure rules
     "processes": 4,
     "tools": 5,
+    "match": 5,  # arena.match, the one way to play a match: inside rank 5, just above tools.launch (MATCH)
     "scenarios": 6,  # the scenario file, runner, pytest plugin and library: may use tools
     "learn": 7,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
     "arena": 8,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
@@ -28,7 +29,9 @@ RANK = {
 # arena's own modules: the command line. Nothing outside arena/ may import them.
 COMMAND_LINE = {"cli", "commands", "__main__"}
 # Inside tools/, bottom-up: a module of tools/ itself (console.py), then the sub-packages by concern.
-TOOLS_RANK = {"": 0, "launch": 1, "review": 2, "experiments": 3}
+TOOLS_RANK = {"": 0, "launch": 1, "review": 3, "experiments": 4}
+# arena.match wraps tools.launch's engines; tools.review and tools.experiments play matches through it.
+MATCH = (RANK["match"], 2)
 
 
 def unit(name: str) -> tuple[str, str] | None:
@@ -46,7 +49,7 @@ def unit(name: str) -> tuple[str, str] | None:
 
 
 def rank(u: tuple[str, str]) -> tuple[int, int]:
-    return (RANK[u[0]], TOOLS_RANK[u[1]])
+    return MATCH if u[0] == "match" else (RANK[u[0]], TOOLS_RANK[u[1]])
 
 
 def imported_units(path: Path) -> set[tuple[str, str]]:
@@ -96,11 +99,15 @@ def test_the_check_fails_on_a_planted_upward_import(tmp_path):
         "tools/experiments/scen.py": "import arena.commands.match\n",
         "processes/up.py": "from arena.tools.launch.run import start\n",
         "learn/cmd.py": "from arena.cli import parser\n",
+        "tools/launch/seam.py": "from arena.match import play\n",
+        "match/report.py": "from arena.tools.review import report\n",
     }
     fine = {
         "tools/review/ok.py": "from arena.tools.launch import launcher\nfrom arena import __version__\n",
         "arena/commands/ok.py": "from arena.tools.experiments import tournament\nfrom arena.commands import _common\n",
         "tools/launch/same.py": "from arena.tools.launch import run\nfrom arena.runtime.config import MatchConfig\n",
+        "match/ok.py": "from arena.tools.launch import inprocess\nfrom arena.match import engines\n",
+        "tools/experiments/ok.py": "from arena.match import play\n",
     }
     for rel, text in {**planted, **fine}.items():
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)

@@ -15,9 +15,10 @@ from pathlib import Path
 from rich.markup import escape
 from rich.table import Table
 
+from arena.match import play
 from arena.runtime.config import MatchConfig
 from arena.tools.console import console as make_console
-from arena.tools.launch import launcher, zygote
+from arena.tools.launch import zygote
 
 
 def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
@@ -31,7 +32,7 @@ def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:
     for i in range(runs):
         cfg = base.replace(seed=1000 + i)
         console.print(f"run {i + 1}/{runs}: 2 x {half_time:g} s, {robots}v{robots}, link {link} ...")
-        r = launcher.play_match(cfg).to_dict()
+        r = play(cfg, engine="processes").to_dict()
         results.append(r)
         console.print(
             f"  rtf {r['rtf']:.1f}x, {1000 * r['play_wall_seconds'] / max(1, r['ticks']):.3f} ms/tick, "
@@ -104,7 +105,7 @@ def bench_record(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int
             # Alternate which goes first, so that drift in the machine's load favours neither.
             order = [(False, ""), (True, str(path))]
             for rec, record in order if i % 2 == 0 else reversed(order):
-                r = launcher.play_match(cfg, record=record).to_dict()
+                r = play(cfg, engine="processes", record=record).to_dict()
                 (recorded if rec else plain).append(r)
                 console.print(f"run {i + 1}/{runs} {'recorded' if rec else 'plain   '}: rtf {r['rtf']:.1f}x")
             sizes.append(path.stat().st_size)

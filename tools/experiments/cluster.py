@@ -201,10 +201,10 @@ def play_on_worker(job: dict, driver: dict) -> dict:
         }
     t0 = time.monotonic()
     if "config" in job:
-        from arena.tools.launch.inprocess import play_match
+        from arena.match import play
 
         try:
-            m = play_match(job["config"]).to_dict()
+            m = play(job["config"]).to_dict()
         except Exception as exc:  # a failed match is a result for the driver, never a crashed task
             return {"rc": 1, "node": node, "reason": f"{type(exc).__name__}: {exc}".splitlines()[0]}
         return {"rc": 0, "match": m, "wall": time.monotonic() - t0, "node": node}

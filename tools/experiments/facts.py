@@ -1,7 +1,7 @@
 """`arena facts`: facts about whole matches played in process, the rules
 at work and play that looks like soccer.
 
-`match_facts(cfg)` plays one match in-process (tools/launch/inprocess.py, the very
+`match_facts(cfg)` plays one match in-process (arena.match `play`, the very
 `Node` code of a real match) and measures it with the one analysis of the
 World/Referee streams (`arena.recording.analysis.measure`, which also serves
 `arena review`); the facts are described there.
@@ -25,19 +25,18 @@ from itertools import combinations
 
 import msgspec
 
+from arena.match import play
 from arena.recording.analysis.facts import MatchFacts, measure
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.schemas.messages import Referee, World
 from arena.tools.experiments import facts_table, pools
-from arena.tools.launch.inprocess import play_in_process
 
 
 def match_facts(cfg: MatchConfig) -> MatchFacts:
-    summaries, frames = play_in_process(cfg, watch=("world", "referee"))
-    worlds = [msgspec.msgpack.decode(raw, type=World) for raw in frames["world"]]
-    referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in frames["referee"])}
-    extra = summaries["referee"].extra
-    return measure(cfg, worlds, referee, extra, summaries["engine"].extra.get("distance_m", {}))
+    result = play(cfg, watch=("world", "referee"))
+    worlds = [msgspec.msgpack.decode(raw, type=World) for raw in result.frames["world"]]
+    referee = {r.tick: r for r in (msgspec.msgpack.decode(raw, type=Referee) for raw in result.frames["referee"])}
+    return measure(cfg, worlds, referee, result.summaries["referee"].extra, result.distance_m)
 
 
 def many(cfgs: list[MatchConfig], workers: int | None = None, progress: bool = False) -> list[MatchFacts]:

@@ -166,14 +166,15 @@ def _worker_init() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except OSError:
         pass
+    import arena.match
     import arena.processes.engine
     import arena.tools.launch.inprocess  # noqa: F401
 
 
 def _play_inprocess(cfg) -> dict:
-    from arena.tools.launch.inprocess import play_match
+    from arena.match import play
 
-    return play_match(cfg).to_dict()
+    return play(cfg).to_dict()
 
 
 def match_argv(cfg: MatchConfig, engine: str) -> list[str]:

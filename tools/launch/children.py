@@ -14,7 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from arena.runtime.config import ProcessId
+from arena.tools.launch.result import JoinError, MatchError
 from arena.tools.launch.run import Job
+
+__all__ = ["Child", "JoinError", "MatchError", "run_argv", "spawn", "stop_all", "stopped_on_error"]
 
 _PR_SET_PDEATHSIG = 1
 
@@ -25,14 +28,6 @@ def _die_with_parent() -> None:
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
     except OSError:
         pass
-
-
-class MatchError(RuntimeError):
-    """The match could not be played to the end; the message says why."""
-
-
-class JoinError(MatchError):
-    """An `--external` process never joined (a user's or a network's matter: exit 2)."""
 
 
 @dataclass

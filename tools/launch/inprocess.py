@@ -23,21 +23,79 @@ from typing import TYPE_CHECKING
 
 from arena.processes import node_class
 from arena.runtime import coop
-from arena.runtime.config import MatchConfig
+from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.coop import CoopBus, NodeFailed, Task
 from arena.runtime.node import killed_at, match_heap
 from arena.runtime.transport import MemoryTransport
 from arena.schemas.keys import Keys
+from arena.tools.launch.result import MatchError
 
 if TYPE_CHECKING:
+    from arena.runtime.node import Node
+    from arena.schemas.messages import Summary
     from arena.tools.launch.result import MatchResult
 
 ENGINE = "inprocess"
 LOCKSTEP_KINDS = {"engine", "referee", "basestation", "robot", "recorder"}  # what this engine can host
 
 
-class InprocessError(RuntimeError):
+class InprocessError(MatchError):
     """The match could not be played to the end; the message says why (one line)."""
+
+
+class Stepped:
+    """A match built on this thread and not yet played: the in-memory `bus`, the `keys`, every
+    lockstep node (`nodes`, by name, each driven by its own `coop.Task`), the recorder if the
+    configuration has one, and a tap on each key of `watch` (`frames` drains it).
+
+    `play()` plays it to the end (what `play_match` does); a caller that pauses the match drives
+    the tasks itself and runs them a stretch at a time with `run()` (learn/match.py stops where a
+    learner needs an action), or builds `only` some processes and feeds them recorded inputs
+    (tools/review/replay.py). `match`: the key prefix (never part of a digest)."""
+
+    def __init__(
+        self,
+        cfg: MatchConfig,
+        *,
+        watch: tuple[str, ...] = (),
+        record: str = "",
+        only: tuple[ProcessId, ...] | None = None,
+        match: str = "inprocess",
+    ):
+        self.cfg = cfg
+        self.bus = bus = CoopBus()
+        self.keys = keys = Keys(match)
+        self.taps = {name: bus.subscribe(None, keys.key(name)) for name in watch}
+        self.recorder = None
+        self.nodes: dict[str, Node] = {}
+        for p in cfg.processes() if only is None else only:
+            if p.kind == "recorder":  # an observer: it drains the taps between rounds of the run queue
+                self.recorder = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, path=record)
+            else:
+                self.nodes[str(p)] = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p)))
+
+    def frames(self, name: str) -> list[bytes]:
+        """What arrived on the watched key `name` since the last call, in order."""
+        ch, got = self.taps[name], []
+        while (raw := ch.try_recv()) is not None:
+            got.append(raw)
+        return got
+
+    def run(self) -> None:
+        """Resume runnable tasks until none is (`coop.run_runnable`); a task that raises: `NodeFailed`."""
+        coop.run_runnable(self.bus)
+
+    def drive(self, tasks: list[Task]) -> list[str]:
+        """Run `tasks` to their end (`coop.drive`); returns the deadlocks met."""
+        return coop.drive(self.bus, tasks)
+
+    def play(self, quit_early: set[str]) -> tuple[dict[str, Summary], list[str]]:
+        """Play every node's match to the end (loop and summary; the recorder drains its taps between
+        rounds): their summaries by name and the deadlocks met. `quit_early` collects the nodes whose
+        loop ended while others still waited for them."""
+        cfg, nodes, recorder = self.cfg, list(self.nodes.values()), self.recorder
+        killed = frozenset(n.name for n in nodes if killed_at(cfg, n.name) >= 0)  # a scenario's `kill` steps
+        return coop.play(self.bus, nodes, recorder.pump if recorder is not None else None, quit_early, killed)
 
 
 def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
@@ -47,24 +105,12 @@ def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
 
 
 def _play_here(cfg: MatchConfig, watch: tuple[str, ...], record: str):
-    cfg = cfg.replace(tap=bool(record))
-    bus = CoopBus()
-    keys = Keys("inprocess")
-    taps = {name: bus.subscribe(None, keys.key(name)) for name in watch}
-    recorder = None
-    nodes = []
-    for p in cfg.processes():
-        if p.kind == "recorder":  # an observer: it drains the taps between rounds of the run queue
-            recorder = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, path=record)
-        else:
-            nodes.append(node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p))))
+    match = Stepped(cfg.replace(tap=bool(record)), watch=watch, record=record)
+    recorder, nodes = match.recorder, list(match.nodes.values())
     quit_early: set[str] = set()
     t0 = time.perf_counter()
     try:
-        killed = frozenset(n.name for n in nodes if killed_at(cfg, n.name) >= 0)  # a scenario's `kill` steps
-        summaries, deadlocks = coop.play(
-            bus, nodes, recorder.pump if recorder is not None else None, quit_early, killed
-        )
+        summaries, deadlocks = match.play(quit_early)
     except NodeFailed as exc:
         if recorder is not None:
             recorder.finish()
@@ -80,12 +126,7 @@ def _play_here(cfg: MatchConfig, watch: tuple[str, ...], record: str):
     if recorder is not None:
         recorder.finish()
         summaries["recorder"] = recorder.conclude()
-    frames = {}
-    for name, ch in taps.items():
-        got = []
-        while (raw := ch.try_recv()) is not None:
-            got.append(raw)
-        frames[name] = got
+    frames = {name: match.frames(name) for name in watch}
     return summaries, frames, play, deadlocks, quit_early
 
 
@@ -106,8 +147,9 @@ def play_in_process(
     return summaries, frames
 
 
-def play_match(cfg: MatchConfig, record: str = "") -> MatchResult:
-    """Play one match in-process and return the result of `arena match --json`; `record`: an MCAP path."""
+def play_match(cfg: MatchConfig, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
+    """Play one match in-process and return the result of `arena match --json`; `record`: an MCAP path;
+    `watch`: keys whose payloads the result keeps (`frames`)."""
     from arena.tools.launch.result import Collected, assemble
 
     if cfg.realtime:
@@ -119,7 +161,7 @@ def play_match(cfg: MatchConfig, record: str = "") -> MatchResult:
         raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
     t_start = time.monotonic()
     launched = time.time()
-    summaries, _, play, deadlocks, quit_early = _play(cfg, watch=(), record=record)
+    summaries, frames, play, deadlocks, quit_early = _play(cfg, watch=watch, record=record)
     lost = {name: "its loop ended while others still waited for it" for name in quit_early}
     got = Collected(summaries=summaries, started=0.0, ended=play, lost=lost)
     result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, record=record)
@@ -129,4 +171,5 @@ def play_match(cfg: MatchConfig, record: str = "") -> MatchResult:
     result.play_started_unix = summaries["engine"].extra["play_started"]
     result.pid = os.getpid()
     result.deadlocks = deadlocks
+    result.frames = frames
     return result

@@ -15,10 +15,37 @@ from typing import Any
 import msgspec
 from msgspec import UNSET, UnsetType
 
-from arena.runtime.config import MatchConfig
+from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.stats import percentile
 from arena.schemas.messages import Referee, Summary
 from arena.tools.launch.faults import outcome as match_outcome
+
+# The recorder and the viewer send no data, and the RefBox bridge's worldstates are
+# what the teams sent (no process's input): the digest is the same with or without them.
+NOT_COUNTED = frozenset(("recorder", "refbox", "viewer"))
+
+
+def counted(cfg: MatchConfig) -> list[ProcessId]:
+    """The processes whose digests make the match's, in the canonical order (the only place that says so)."""
+    return [p for p in cfg.processes() if p.kind not in NOT_COUNTED]
+
+
+def combined_digest(cfg: MatchConfig, digests: dict[str, str]) -> str:
+    """The match digest of `arena match --json`: every counted process's digest, in order."""
+    combined = hashlib.blake2b(digest_size=16)
+    for p in counted(cfg):
+        name = str(p)
+        if name in digests:
+            combined.update(name.encode() + b"=" + digests[name].encode() + b";")
+    return combined.hexdigest()
+
+
+class MatchError(RuntimeError):
+    """The match could not be played to the end; the message says why."""
+
+
+class JoinError(MatchError):
+    """An `--external` process never joined (a user's or a network's matter: exit 2)."""
 
 
 @dataclass
@@ -90,24 +117,24 @@ class MatchResult(msgspec.Struct, kw_only=True):
     pid: int | UnsetType = UNSET  # inprocess
     deadlocks: list[Any] | UnsetType = UNSET  # inprocess
     logs: str | UnsetType = UNSET  # processes: where a failed match's logs are kept
+    # Never printed (`NOT_PRINTED`): what a caller in this process reads further.
+    summaries: dict[str, Summary] = {}  # every process's own Summary, by name
+    frames: dict[str, list[bytes]] = {}  # the payloads on each key `play(..., watch=...)` named, in order
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of `arena match --json` (values as they are; UNSET fields left out)."""
-        return {f: v for f in self.__struct_fields__ if (v := getattr(self, f)) is not UNSET}
+        return {f: v for f in self.__struct_fields__ if f not in NOT_PRINTED and (v := getattr(self, f)) is not UNSET}
+
+
+NOT_PRINTED = frozenset(("summaries", "frames"))
 
 
 def assemble(
     cfg: MatchConfig, got: Collected, wall_total: float, pids: dict[str, int] | None = None, record: str = ""
 ) -> MatchResult:
     """The match result (what `arena match --json` prints)."""
-    # The recorder and the viewer send no data, and the RefBox bridge's worldstates are
-    # what the teams sent (no process's input): the digest is the same with or without them.
-    order = [str(p) for p in cfg.processes() if p.kind not in ("recorder", "refbox", "viewer")]
+    order = [str(p) for p in counted(cfg)]
     sums = got.summaries
-    combined = hashlib.blake2b(digest_size=16)
-    for name in order:
-        if name in sums:
-            combined.update(name.encode() + b"=" + sums[name].digest.encode() + b";")
     referee = sums.get("referee")
     engine = sums.get("engine")
     links: dict[str, dict] = {}
@@ -188,7 +215,7 @@ def assemble(
         wall_seconds=round(wall_total, 3),
         play_wall_seconds=round(play, 3),
         rtf=round(sim_seconds / play, 2),
-        digest=combined.hexdigest(),
+        digest=combined_digest(cfg, {name: s.digest for name, s in sums.items()}),
         process_digests={name: sums[name].digest for name in order if name in sums},
         processes=processes,
         links=links,
@@ -209,6 +236,7 @@ def assemble(
         refbox=sums["refbox"].extra if "refbox" in sums else None,
         refbox_follow=referee.extra.get("refbox_follow") if referee else None,
         referee_log=referee.extra.get("log", []) if referee else [],
+        summaries=sums,
     )
 
 

@@ -2,9 +2,9 @@
 
 A lockstep match is a pure function of (configuration, seed), and so is each
 process given its inputs. Replay rebuilds the `MatchConfig` from the file's
-metadata and runs that ONE process's `Node` class (processes/__init__.py)
-over an in-memory bus, in this process and this thread, with the in-process
-engine's cooperative driver (runtime/coop.py):
+metadata and has the in-process engine build that ONE process's node
+(`InProcess.stepped`, the very `Node` class of processes/) over its in-memory
+bus, in this process and this thread, driven cooperatively (runtime/coop.py):
 
 1. every frame recorded on each of its input keys is put on the bus, in the
    order its sender sent them. The node's own link emulators, seeded from the
@@ -31,13 +31,11 @@ from dataclasses import dataclass, field
 
 import msgspec
 
-from arena.processes import node_class
+from arena.match import InProcess, counted
 from arena.recording.reader import Recording, RecordingError, load
 from arena.runtime.config import ConfigError, ProcessId
-from arena.runtime.coop import CoopBus, NodeFailed, Task, drive
+from arena.runtime.coop import NodeFailed
 from arena.runtime.lockstep import BATCH_HEADS, decode_batch
-from arena.runtime.transport import MemoryTransport
-from arena.schemas.keys import Keys
 from arena.schemas.messages import KillProcess
 
 
@@ -111,10 +109,9 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
         raise ReplayError(f"this match's scenario killed {who} {when} (a kill step): only matches without one replay")
     cfg = cfg.replace(tap=False)  # the replayed node taps nothing
     name = str(pid)
-    bus = CoopBus()
-    keys = Keys("replay")
-    task = Task(name)  # its driver: only its lockstep is driven (no barrier; its summary below)
-    node = node_class(pid.kind)(pid, cfg, MemoryTransport(bus), keys, driver=task)
+    match = InProcess().stepped(cfg, only=(pid,), match="replay")
+    bus, keys, node = match.bus, match.keys, match.nodes[name]
+    task = node.driver  # its `Task`: only its lockstep is driven (no barrier; its summary below)
     task.steps = node.lockstep()
     outputs = [(keys.rel(ob.key), bus.subscribe(None, ob.key)) for ob in node.outbound]
     for ib in node.inbound:
@@ -123,7 +120,7 @@ def replay(source: str | Recording, process: str) -> ReplayResult:  # noqa: C901
     if rec.truncated:  # its inputs stop where the file does; giving up on every sender there is expected
         node.log.addFilter(lambda r: r.msg != "treating %s as dead: %s")
     try:
-        drive(bus, [task])
+        match.drive([task])
     except NodeFailed as exc:
         raise exc.__cause__ from None  # the node's own error, as if it had run alone
     summary = [node.conclude()]
@@ -180,7 +177,7 @@ def _describe(r: ReplayResult) -> str:
 def main(path: str, processes: list[str], as_json: bool = False) -> int:
     try:
         rec = load(path)
-        every = [str(p) for p in rec.cfg.processes() if p.kind not in ("recorder", "refbox", "viewer")]
+        every = [str(p) for p in counted(rec.cfg)]
         names = every if "all" in processes else processes
         results = [replay(rec, p) for p in names]
     except (RecordingError, ReplayError) as exc:
