@@ -206,6 +206,18 @@ BAD = [
         "cannot connect to",
         PROCESS,
     ),
+    # arena experiment
+    (
+        ["experiment", "tune", "--strategy", "AD", "--opponents", "BS", "--params", "kick"],
+        "parameters are kick_speed",
+    ),
+    (["experiment", "tune", "--strategy", "chase", "--opponents", "BS"], "chase declares no parameters to tune"),
+    (["experiment", "tune", "--strategy", "AD", "--opponents", "BS", "--a", "-1"], "--a must be > 0"),
+    (
+        ["experiment", "tune", "--strategy", "AD", "--opponents", "BS", "--out", "{tmp}/t", "--resume"],
+        "holds no tune.json",
+    ),
+    (["experiment", "tune", "--strategy", "AD"], "required: --opponents"),
     # arena strategies
     (["strategies", "tiki-taka"], "once its package is installed: entry point soccer_arena.strategies"),
     (["strategies", "--check"], "unrecognized arguments: --check"),
