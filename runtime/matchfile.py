@@ -116,7 +116,12 @@ def load(path: str) -> MatchConfig:
         raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"--config {path} is not valid TOML: {exc}") from None
-    raw = to_dict(data, path)
+    return from_data(to_dict(data, path), path)
+
+
+def from_data(raw: dict[str, Any], path: str) -> MatchConfig:
+    """`MatchConfig.from_dict(raw)` with the file's checks (links, finite and positive numbers);
+    ConfigError naming `path` and the bad key (an experiment builds each cell's configuration so)."""
     try:
         cfg = MatchConfig.from_dict(raw)
     except ConfigError as exc:
