@@ -106,6 +106,15 @@ def add_tune_parser(what) -> None:
     )
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     t.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
+        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
+    )
+    t.add_argument(
         "--out",
         default="tune",
         metavar="DIR",
@@ -125,6 +134,10 @@ def run_tune(args: argparse.Namespace) -> int:
 
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
+    if args.ray is not None:
+        from arena.tools.experiments.cluster import parse_address
+
+        parse_address(args.ray)
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ConfigError(f"--out {args.out} exists and is not a directory")
     strategy = registry.get(args.strategy)
@@ -154,6 +167,7 @@ def run_tune(args: argparse.Namespace) -> int:
         remeasure=args.remeasure,
         method=args.method,
         jobs=args.jobs,
+        ray=args.ray,
         out=Path(args.out),
         resume=args.resume,
         progress=not args.json,

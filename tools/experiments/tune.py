@@ -54,6 +54,7 @@ class TuneOptions:
     remeasure: int = 10  # fresh seeds for the final measurement
     method: str = "spsa"
     jobs: int = 0
+    ray: str | None = None  # None: this machine; "": a local Ray instance; "auto" or HOST:PORT
     out: Path = Path("tune")
     resume: bool = False
     progress: bool = True
@@ -117,63 +118,42 @@ class TuneError(RuntimeError):
 
 
 class Player:
-    """Plays lists of configurations in process (--jobs 1) or on a pool of worker processes, through
-    `arena.match.play`; a match that fails twice stops the run with its reason (--resume continues)."""
+    """Plays lists of configurations through the experiments' executor (tools/experiments/executor.py):
+    in this process (--jobs 1), on a pool of worker processes, or as Ray tasks (--ray); every match by
+    `experiment.play_one`, the in-process engine. A match that fails twice stops the run with its reason
+    (what is done stays: --resume)."""
 
-    def __init__(self, jobs: int):
-        from arena.tools.experiments.matches import default_jobs
+    def __init__(self, jobs: int, ray: str | None, log_dir: Path):
+        from arena.tools.experiments.executor import Executor
 
-        self.jobs = jobs or default_jobs()
-        self.pool = None
-        if self.jobs > 1:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            from arena.tools.experiments.matches import _worker_init
-
-            ctx = multiprocessing.get_context("spawn")
-            self.pool = ProcessPoolExecutor(self.jobs, mp_context=ctx, initializer=_worker_init)
+        log_dir.mkdir(parents=True, exist_ok=True)
+        self.executor = Executor(jobs, ray, log_dir)
 
     def play(self, cfgs: list[MatchConfig], done=None) -> list[dict]:
-        from arena.tools.experiments.fixtures import void_reason
-        from arena.tools.experiments.matches import _play_inprocess
-
+        ex = self.executor
         results: list[dict | None] = [None] * len(cfgs)
-        for _attempt in (1, 2):
-            todo = [i for i, r in enumerate(results) if r is None]
-            if not todo:
-                break
-            if self.pool is None:
-                got = {}
-                for i in todo:
-                    got[i] = self._one(_play_inprocess, cfgs[i])
-                    done and done()
-            else:
-                futures = {i: self.pool.submit(_play_inprocess, cfgs[i]) for i in todo}
-                got = {}
-                for i, f in futures.items():
-                    got[i] = self._one(f.result)
-                    done and done()
-            for i, m in got.items():
-                if isinstance(m, dict) and not void_reason(m):
-                    results[i] = m
-        if any(r is None for r in results):
-            i = results.index(None)
-            raise TuneError(f"match seed {cfgs[i].seed} {cfgs[i].home} v {cfgs[i].away} failed twice")
+        tries = [0] * len(cfgs)
+        todo = list(range(len(cfgs)))
+        while todo or ex.pending:
+            while todo and ex.pending < ex.capacity:
+                i = todo.pop(0)
+                tries[i] += 1
+                ex.submit(i, (cfgs[i], "inprocess", False))
+            for i, got, reason in ex.wait():
+                if got is not None:
+                    results[i] = got
+                    if done:
+                        done()
+                elif tries[i] < 2:
+                    todo.append(i)
+                else:
+                    ex.abandon()
+                    c = cfgs[i]
+                    raise TuneError(f"match seed {c.seed} {c.home} v {c.away} failed twice: {reason}")
         return results  # type: ignore[return-value]
 
-    @staticmethod
-    def _one(call, *args):
-        try:
-            return call(*args)
-        except Exception as exc:  # a failed match is played again once
-            return f"{type(exc).__name__}: {exc}"
-
-    def close(self) -> None:
-        if self.pool is not None:
-            from arena.tools.experiments import pools
-
-            pools.stop(self.pool, now=False)
+    def close(self, stopped: bool = False) -> None:
+        self.executor.__exit__(KeyboardInterrupt if stopped else None, None, None)
 
 
 def measure(player: Player, sets: list[list[tuple[MatchConfig, str]]], done=None) -> list[list[tuple[int, int]]]:
@@ -367,7 +347,7 @@ def run(base: MatchConfig, opts: TuneOptions, space: Space) -> tuple[dict, bool]
     _save(opts, state)
     per = match_count(opts)
     left = max(0, opts.iterations - len(state["iterations"])) * per + 4 * len(opts.opponents) * opts.remeasure
-    player = Player(opts.jobs)
+    player = Player(opts.jobs, opts.ray, opts.out / "logs")
     interrupted = False
     t0 = time.monotonic()
     try:
@@ -379,7 +359,7 @@ def run(base: MatchConfig, opts: TuneOptions, space: Space) -> tuple[dict, bool]
     except KeyboardInterrupt:
         interrupted = True
     finally:
-        player.close()
+        player.close(stopped=interrupted)
     result = summary(opts, space, state, time.monotonic() - t0)
     if not interrupted:
         from arena.tools.experiments.tune_report import write_outputs
