@@ -53,3 +53,34 @@ def test_the_shipped_table2_study_loads():
         (8.0, 0),
         (8.0, 3),
     }
+
+
+def _row(cell, gf, ga, r1=10.0, r2=5.0):
+    return {"cell": cell, "status": "ok", "goals_for": gf, "goals_against": ga, "coverage_r1": r1, "coverage_r2": r2}
+
+
+def test_a_round_robin_per_setting_gives_table_2(tmp_path):
+    from arena.tools.experiments import experiment_standings
+
+    path = _file(tmp_path, 'home = ["AD", "BS"]\n"timing.perception_latency" = [0, 3]\n')
+    exp = design.load(path)
+    # cells: c000 AD L0, c001 AD L3, c002 BS L0, c003 BS L3; one seed, both ends: two matches a setting
+    rows = [_row("c000", 2, 0), _row("c000", 1, 1), _row("c002", 0, 2, 9.0, 6.0), _row("c002", 1, 1, 9.0, 6.0)]
+    rows += [_row("c001", 0, 1), _row("c001", 0, 0), _row("c003", 1, 0), _row("c003", 0, 0)]
+    got = experiment_standings.build(exp, rows)
+    by = {s["setting"]["timing.perception_latency"]: s for s in got}
+    assert by[0]["order"] == "AD > BS" and by[3]["order"] == "BS > AD"
+    ad = by[0]["standings"][0]
+    assert (ad["W"], ad["D"], ad["L"], ad["GF"], ad["GA"], ad["P"], ad["coverage_ratio"]) == (1, 1, 0, 3, 1, 4, 2.0)
+    assert by[0]["standings"][1]["coverage_ratio"] == 1.5
+    assert by[0]["matches"] == 2 and by[0]["goals_per_match"] == 2.0
+    tied = experiment_standings.build(exp, [_row("c000", 0, 0), _row("c002", 0, 0)])
+    assert tied[0]["order"] == "AD = BS"
+    assert experiment_standings.plot(got, tmp_path / "plots").stat().st_size > 0
+
+
+def test_no_round_robin_no_standings(tmp_path):
+    from arena.tools.experiments import experiment_standings
+
+    exp = design.load(_file(tmp_path, '"timing.perception_latency" = [0, 3]\n'))
+    assert experiment_standings.build(exp, []) == [] and experiment_standings.markdown([]) == []
