@@ -2,9 +2,12 @@
 
 The file holds the `MatchConfig` tree a user may want to change: the match
 (seed, strategies, robots, half time), `[links]` (the preset and per-class
-overrides), and `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and
-`[timing]`. Every key is optional; a missing one keeps its default. An unknown
-key, a wrong type or a value out of range is a `ConfigError` that names the key
+overrides), `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and
+`[timing]`, and `[params.a]`/`[params.b]` (each team's strategy parameters;
+which names, types and ranges a strategy takes is checked where the
+strategies are known, `registry.check_params`). Every key is optional; a
+missing one keeps its default. An unknown key, a wrong type or a value out of
+range is a `ConfigError` that names the key
 (`field.lenght`, `robot.mass`). `dump()` writes the defaults with each key's
 unit and meaning taken from the comments in runtime/config.py, so the printed
 file documents itself. Deployment matters (real time, --external, --record,
