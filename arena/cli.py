@@ -60,7 +60,7 @@ def command(name: str):
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM (`kill`, a service manager): stopped and cleaned up as Ctrl-C is, exit code 143.
-    The processes a match forks set SIGTERM back to its default (tools/launch/forkstart.py)."""
+    The processes a match forks set SIGTERM back to its default (match/forkstart.py)."""
 
 
 _TERMINATED_IN: list[int] = []  # the pid that installed `_terminated`

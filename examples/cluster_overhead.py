@@ -14,7 +14,7 @@ import time
 
 import ray
 
-from arena.tools.experiments import cluster
+from arena.experiments import cluster
 
 
 def empty() -> int:

@@ -4,6 +4,7 @@
 robots), `SoccerEnv` (Gymnasium, one robot), `make_vector_env` (N worker
 processes), and the policy files a match plays as the strategy `policy:PATH`.
 Needs the `learn` extra: pip install 'soccer-arena[learn]'.
+May import arena.scenarios, arena.match and every package below them; only the CLI imports it.
 """
 
 try:

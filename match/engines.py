@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
 if TYPE_CHECKING:
+    from arena.match.inprocess import Stepped
+    from arena.match.result import MatchResult
     from arena.runtime.config import MatchConfig, ProcessId
-    from arena.tools.launch.inprocess import Stepped
-    from arena.tools.launch.result import MatchResult
 
 ENGINES = ("processes", "inprocess")
 
@@ -35,7 +35,7 @@ class InProcess:
     name: ClassVar[str] = "inprocess"
 
     def play(self, cfg: MatchConfig, *, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
-        from arena.tools.launch import inprocess
+        from arena.match import inprocess
 
         return inprocess.play_match(cfg, record=record, watch=watch)
 
@@ -47,15 +47,15 @@ class InProcess:
         only: tuple[ProcessId, ...] | None = None,
         match: str = "inprocess",
     ) -> Stepped:
-        """The match built and not yet played, for a caller that drives it (tools/launch/inprocess.py `Stepped`)."""
-        from arena.tools.launch.inprocess import Stepped
+        """The match built and not yet played, for a caller that drives it (match/inprocess.py `Stepped`)."""
+        from arena.match.inprocess import Stepped
 
         return Stepped(cfg, watch=watch, only=only, match=match)
 
 
 @dataclass(frozen=True)
 class Processes:
-    """Every process its own OS process over zenoh, supervised (tools/launch/launcher.py `play_match`
+    """Every process its own OS process over zenoh, supervised (match/launcher.py `play_match`
     says what each option does). `watch` is read back from the recording (a temporary one if no
     `record` is given)."""
 
@@ -85,7 +85,7 @@ class Processes:
         return result
 
     def _play(self, cfg: MatchConfig, record: str) -> MatchResult:
-        from arena.tools.launch import launcher
+        from arena.match import launcher
 
         return launcher.play_match(
             cfg,

@@ -28,7 +28,7 @@ The contract is spelled out in :mod:`.base`. Heading and wheels:
 :mod:`.omni4` (paper 2 eq. 3-4), :mod:`.diffdrive` (paper 3 eq. 8, 9, 11, 13),
 :mod:`.saturation` (direction-keeping wheel-speed limit), :mod:`.frames`.
 See docs/navigation.md. Imports nothing of arena but itself; used by `arena.sim`,
-`arena.strategies` and `arena.tools`.
+`arena.strategies` and `arena.experiments` (navbench).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ wiring, `act` and its loops, or for the two that watch from outside the lockstep
 an `Observer` with its `observe`; argument parsing stays in arena/commands/. The
 library they use lives below: `arena.sim`, `arena.rules`, `arena.recording`,
 `arena.strategies`, `arena.runtime`, `arena.schemas`. Only the packages above it
-(tools and up) import this package."""
+(arena.match and up) import this package."""
 
 from __future__ import annotations
 

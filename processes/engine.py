@@ -7,7 +7,7 @@ Per tick k (lockstep):
    the ball on its spot and pins it there (KICKOFF also places every robot);
    START first moves every robot that is still too close to the ball spot to
    the nearest legal place (`setpieces.py`, docs/rules.md), then frees the
-   ball; then a scenario's teleports due at k (processes/director.py);
+   ball; then a scenario's teleports due at k (sim/director.py);
 2. publish every robot's `sense` for tick k, `world` (G_V), and every referee
    period the ball `events` (G_Re) gathered since the previous frame, with
    ROBOT_STUCK for robots driven but in one place (`StuckWatch`);
@@ -41,7 +41,6 @@ import time
 
 import numpy as np
 
-from arena.processes.director import Director, operator_inbox, referee_steps
 from arena.rules.referee_box import check_referee
 from arena.rules.setpieces import Restarts
 from arena.runtime import seeds
@@ -51,6 +50,7 @@ from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node, killed_at
 from arena.runtime.pace import LIVE_WORLD_HZ, Pacer, WireGate
 from arena.schemas.messages import BallEvent, Cmd, EngineEvents, FieldSpec, Referee, TeleportBall, TeleportRobot, encode
+from arena.sim.director import Director, operator_inbox, referee_steps
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics, StuckWatch
 from arena.sim.sensors import NormalStream, sense_every
@@ -88,7 +88,7 @@ class EngineNode(Node):
         self.physics.kickoff_positions("a")
         self.physics.stop_play()
         self.restarts = Restarts(cfg, self.physics)
-        # A scenario's steps (processes/director.py); its teleports at tick 0 are its start.
+        # A scenario's steps (sim/director.py); its teleports at tick 0 are its start.
         self.director = Director(cfg, self.physics) if cfg.scenario.active else None
         self.operator = operator_inbox(self, (TeleportBall, TeleportRobot))  # live sessions: `arena operator`
         if any(t == 0 and o.command == "START" for t, o in referee_steps(cfg.scenario.steps)):
@@ -123,7 +123,7 @@ class EngineNode(Node):
         """A live lockstep match (`--live`): the viewer's pace, pause and steps (runtime/pace.py)."""
         if self.cfg.live < 0 or self.cfg.realtime:
             return None
-        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log)
+        pacer = Pacer(self.cfg.timing.dt, self.cfg.pace, self.log, self.clock)
         key = self.keys.control()
         # Unpaced, the viewer draws at most 30 frames a second of wall time: only every
         # Nth world frame goes on the wire, and the held one whenever the pacer holds
@@ -269,7 +269,8 @@ class EngineNode(Node):
         last_cmd = {r: 0 for r in self.robots}
         ph = self.physics
         self.field_out.send(self.field_spec())
-        start = time.monotonic()
+        clock = self.clock  # the wall clock it keeps pace with (runtime/clock.py)
+        start = clock.monotonic()
         for k in range(last + 1):
             t0 = time.perf_counter()
             self.ref_in.poll(k)
@@ -292,9 +293,9 @@ class EngineNode(Node):
                         self.park(r, k)
             self.pending_events.extend(ph.step())
             self.timed(t0)
-            delay = start + (k + 1) * dt - time.monotonic()
+            delay = start + (k + 1) * dt - clock.monotonic()
             if delay > 0:
-                time.sleep(delay)
+                clock.sleep(delay)
 
     def close(self) -> None:
         super().close()

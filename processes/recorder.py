@@ -43,7 +43,6 @@ import platform
 import signal
 import subprocess
 import threading
-import time
 from pathlib import Path
 
 import msgspec
@@ -388,7 +387,7 @@ class RecorderNode(Observer):
 
         Every peer is looked at on every poll, so that a peer's grace runs from when its token
         vanished, not from when every peer before it in the list had finished."""
-        now = time.monotonic()
+        now = self.clock.monotonic()
         done = True
         for name in self.peers:
             gone = name in self.gone
@@ -477,15 +476,15 @@ class RecorderNode(Observer):
                 previous[sig] = signal.signal(sig, self._on_signal(stop))
             os.nice(NICE)  # a process of its own (arena run recorder); never a test's thread
         try:
-            silent_since = time.monotonic()
+            silent_since = self.clock.monotonic()
             while not self._finished() and not stop.is_set():
                 if self._drain():
-                    silent_since = time.monotonic()
+                    silent_since = self.clock.monotonic()
                     continue
-                if time.monotonic() - silent_since > self.cfg.timing.wait_timeout:
+                if self.clock.monotonic() - silent_since > self.cfg.timing.wait_timeout:
                     self.log.error("no tap batch for %g s: closing the recording", self.cfg.timing.wait_timeout)
                     break
-                time.sleep(POLL_S)
+                self.clock.sleep(POLL_S)
         finally:
             self.finish()
             for sig, handler in previous.items():
@@ -493,7 +492,7 @@ class RecorderNode(Observer):
         if self.interrupted:
             raise SystemExit(128 + signal.Signals[self.interrupted].value)
 
-    # A cooperative match (tools/launch/inprocess.py) calls these two instead of `observe`.
+    # A cooperative match (match/inprocess.py) calls these two instead of `observe`.
     def pump(self) -> None:
         """Take in the tap batches and summaries that are there; write what every watermark passed."""
         self._drain()

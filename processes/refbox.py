@@ -40,20 +40,20 @@ class RefboxNode(Node):
         self.server = BridgeServer(host, port, cfg.refbox, self.log)
         self.log.warning("refbox: listening on tcp/%s:%d", host, self.server.port)
         self.forwarded = 0
-        self._clock = (0, time.monotonic())  # real time: (tick, wall time) of the last referee frame
+        self._clock = (0, self.clock.monotonic())  # real time: (tick, wall time) of the last referee frame
         self._ws_tick = 0  # worldstate ticks never go back (the recorder writes in tick order)
 
     def barrier(self) -> None:
         # Our own base stations (--via-refbox) must hear the first FIRST_HALF and KICKOFF too.
         want = 2 if self.cfg.refbox.via else self.cfg.refbox.wait
-        deadline = time.monotonic() + self.cfg.timing.startup_timeout
+        deadline = self.clock.monotonic() + self.cfg.timing.startup_timeout
         while self.server.sides() < want:
-            if time.monotonic() > deadline:
+            if self.clock.monotonic() > deadline:
                 raise StartupError(
                     f"refbox: {self.server.sides()} of {want} base stations connected within "
                     f"{self.cfg.timing.startup_timeout:g} s (--refbox-wait)"
                 )
-            self.server.connected.wait(0.2)
+            self.clock.wait(self.server.connected, 0.2)
             self.server.connected.clear()
         super().barrier()
 
@@ -105,7 +105,7 @@ class RefboxNode(Node):
                 r = self.ref_in.recv_clock()
                 if r is None:
                     return
-                self._clock = (min(r, last), time.monotonic())
+                self._clock = (min(r, last), self.clock.monotonic())
                 self.act(min(r, last))
                 if r >= last:
                     return

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import time
 
-from arena.processes.director import operator_inbox, referee_steps
 from arena.refbox.follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
 from arena.schemas.messages import RefereeOverride
+from arena.sim.director import operator_inbox, referee_steps
 
 
 class RefereeNode(Node):
@@ -29,7 +29,7 @@ class RefereeNode(Node):
         # --refbox-follow: a human at a real MSL RefBox decides (docs/refbox.md); our rules only end the match.
         self.follower = Follower(self.box, self.log) if self.cfg.refbox.follow else None
         self.decide = self.follower.step if self.follower else self.box.step
-        # A scenario's referee overrides (processes/director.py), each forced at the first referee tick >= its own.
+        # A scenario's referee overrides (sim/director.py), each forced at the first referee tick >= its own.
         self.forced = referee_steps(self.cfg.scenario.steps)
         self.operator = operator_inbox(self, (RefereeOverride,))  # live sessions: `arena operator`
 

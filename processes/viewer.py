@@ -40,7 +40,6 @@ import collections
 import functools
 import os
 import threading
-import time
 
 import foxglove
 import msgspec
@@ -393,7 +392,7 @@ class ViewerNode(Observer):
         next_scene = last_scene = next_ask = 0.0
         while True:
             moved = self._drain()
-            now = time.monotonic()
+            now = self.clock.monotonic()
             if now >= next_ask and self.world is not None:
                 self.ask_beliefs()
                 next_ask = now + 1.0 / BELIEF_HZ
@@ -401,14 +400,14 @@ class ViewerNode(Observer):
                 self.act()
                 next_scene, last_scene = now + every, now
             if self._over():
-                end = time.monotonic() + LINGER_S  # the last frames may still be on their way
-                while time.monotonic() < end:
-                    time.sleep(POLL_S)
+                end = self.clock.monotonic() + LINGER_S  # the last frames may still be on their way
+                while self.clock.monotonic() < end:
+                    self.clock.sleep(POLL_S)
                     self._drain()
                 self.act()
-                time.sleep(LINGER_S)  # and the clients' backlogs drain before the server stops
+                self.clock.sleep(LINGER_S)  # and the clients' backlogs drain before the server stops
                 return
-            time.sleep(POLL_S)
+            self.clock.sleep(POLL_S)
 
     # ---------------------------------------------------------------- loops
     def observe(self) -> None:

@@ -6,7 +6,7 @@ the field), and the MSL RefBox's own wire as pure functions: the protocol
 (refbox_protocol.py) and following a real RefBox's commands (refbox_follow.py).
 Pure: no socket, no thread, no clock; the RefBox's sockets and threads are
 `arena.refbox`. May import `arena.runtime` and `arena.schemas`; imported by
-strategies, refbox, processes and tools.
+strategies, refbox, processes and the packages above.
 
 The referee's vocabulary (command and stage names as `Literal` types, the set
 pieces, `other_team`) is defined once in `arena.schemas.vocabulary`, because

@@ -116,7 +116,7 @@ class Clock:
 
 @dataclass(frozen=True)
 class Forced:
-    """A scenario's step, or a live session's operator, forces `override` at `tick` (processes/director.py)."""
+    """A scenario's step, or a live session's operator, forces `override` at `tick` (sim/director.py)."""
 
     tick: int
     override: RefereeOverride

@@ -124,7 +124,7 @@ def permissions(principal: str, prefix: str, robots: int) -> dict[str, list[str]
         perms["query/ingress"] = [*config, *asked]
         perms["reply/egress"] = [*config, *asked]
         perms["declare_queryable/egress"] = [*config, *asked]
-    claim = f"{prefix}{CLAIM}/{principal}"  # its identity, asked of the router (tools/launch/claims.py)
+    claim = f"{prefix}{CLAIM}/{principal}"  # its identity, asked of the router (match/claims.py)
     for what, key in (("liveliness_token/ingress", f"{claim}/*"), ("query/ingress", claim), ("reply/egress", claim)):
         perms[what] = [*perms[what], key]
     return {k: v for k, v in perms.items() if v}

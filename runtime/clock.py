@@ -1,8 +1,11 @@
-"""Wall time for failure detection, behind a small interface a test can drive (after trio's `MockClock`).
+"""The one wall clock of a run, behind a small interface a test can drive (after trio's `MockClock`).
 
-The runtime reads wall time only to bound waits (the `Watchdog`, the `Reactor`,
-the start barrier): never for simulation behaviour. Those readers take a
-`Clock`; the real one is `MONOTONIC`. A test gives them a `ManualClock`
+The runtime and the processes read wall time only to bound waits (the
+`Watchdog`, the `Reactor`, the start barrier, a summary's delivery, the
+recorder's idle bound, the RefBox bridge's start) and to keep pace with it (the
+live pacer, runtime/pace.py; the real-time engine; the viewer): never for
+simulation behaviour. Each reads the `Clock` its process was given
+(`Peer.clock`); the real one is `MONOTONIC`, the only reader of `time` here. A test gives them a `ManualClock`
 instead and moves its time on with `advance`, so a 60 s timeout takes no wall
 time at all, and a test says which instant it checks instead of sleeping and
 hoping the other thread got there.

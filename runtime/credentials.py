@@ -127,9 +127,9 @@ class Secrets:
         """Write every principal's fragment (mode 0600) into `directory`; returns their paths.
 
         `more`: zenoh settings added to some principals' fragments (top-level keys),
-        e.g. the launcher's own peers' `qos` (tools/launch/launcher.py, `relay_safe`).
+        e.g. the launcher's own peers' `qos` (match/launcher.py, `relay_safe`).
         `launched`: the principals `arena match` starts itself, whose identity it holds for them
-        (`metadata.arena.launched`: they claim none, tools/launch/claims.py)."""
+        (`metadata.arena.launched`: they claim none, match/claims.py)."""
         private_directory(directory, create=True)
         out = {}
         for p in principals(self.processes):

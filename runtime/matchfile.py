@@ -110,8 +110,9 @@ def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
     return out
 
 
-def load(path: str) -> MatchConfig:
-    """Read and validate FILE.toml; ConfigError naming the file and the bad key."""
+def load(path: str, under: dict[str, Any] | None = None) -> MatchConfig:
+    """Read and validate FILE.toml; ConfigError naming the file and the bad key. `under`: values of
+    the top-level keys (`TOP`) that apply where the file has none (a command's own defaults)."""
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
@@ -119,7 +120,7 @@ def load(path: str) -> MatchConfig:
         raise ConfigError(f"cannot read --config {path}: {exc.strerror}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"--config {path} is not valid TOML: {exc}") from None
-    return from_data(to_dict(data, path), path)
+    return from_data({**{k: v for k, v in (under or {}).items() if k in TOP}, **to_dict(data, path)}, path)
 
 
 def from_data(raw: dict[str, Any], path: str) -> MatchConfig:

@@ -271,17 +271,18 @@ class Peer:
         put = self.transport.publisher(
             self.keys.summary(self.name), sign=self.keyring.signer(self.keys.summary(self.name))
         )
-        deadline = time.monotonic() + timeout
+        clock = self.clock
+        deadline = clock.monotonic() + timeout
         while True:
             put(payload)
             if not self._collector:
                 return
-            wait_until = min(deadline, time.monotonic() + 0.25)
-            while time.monotonic() < wait_until:
+            wait_until = min(deadline, clock.monotonic() + 0.25)
+            while clock.monotonic() < wait_until:
                 if ack.try_recv() is not None:
                     return
-                time.sleep(0.005)
-            if time.monotonic() >= deadline:
+                clock.sleep(0.005)
+            if clock.monotonic() >= deadline:
                 self.log.warning("no collector acknowledged the summary within %g s", timeout)
                 return
 
@@ -332,7 +333,7 @@ class Node(Peer):
     """A process in the lockstep: its links, its lockstep loop, and the `Driver` that runs it.
 
     `driver`: `Pull` (blocking on this thread) unless given; a zenoh match in lockstep
-    gives a `Reactor` (tools/launch/run.py), a cooperative match a `coop.Task`.
+    gives a `Reactor` (match/run.py), a cooperative match a `coop.Task`.
     """
 
     def __init__(

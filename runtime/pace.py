@@ -9,7 +9,8 @@ lockstep loop yields `(pacer, k)`, and the pacer is ready for tick k when
 
 The pacer only ever delays a tick; what the engine computes and sends at tick
 k is the same whenever it runs, so pacing and pausing never change a digest.
-The wall clock is read for waiting only, never for behaviour.
+The wall clock (the engine's `Clock`, runtime/clock.py) is read for waiting
+only, never for behaviour.
 
 The viewer sends `Control` frames on `arena/<m>/control`; the engine hands
 them to `control`. In reactive lockstep (runtime/drivers.py, `Reactor`) the
@@ -28,9 +29,9 @@ from __future__ import annotations
 
 import logging
 import threading
-import time
 from collections.abc import Callable
 
+from arena.runtime.clock import MONOTONIC, Clock
 from arena.schemas.messages import Control
 
 BEHIND_S = 0.25  # [s] wall: further behind its schedule than this, the pacer restarts it from now (no sprint)
@@ -86,7 +87,8 @@ class Pacer:
     key = "control"
     paired = False  # a held tick is a wait like any other: the engine puts its held `sense` batches first
 
-    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None):
+    def __init__(self, dt: float, pace: float, log: logging.Logger | None = None, clock: Clock = MONOTONIC):
+        self.clock = clock  # the wall time it paces to (a test's ManualClock)
         self.dt = dt
         self.pace = pace
         self.log = log or logging.getLogger("arena.pace")
@@ -120,7 +122,7 @@ class Pacer:
                 self._due = None
                 return False
             if self.pace > 0.0 and not self.paused:
-                now = time.monotonic()
+                now = self.clock.monotonic()
                 if self._anchor is None:
                     self._anchor = (now, k)
                 t0, k0 = self._anchor
@@ -144,9 +146,9 @@ class Pacer:
             if self.ready(k):
                 return
             with self._cond:
-                left = POLL_S if self._due is None else min(POLL_S, self._due - time.monotonic())
+                left = POLL_S if self._due is None else min(POLL_S, self._due - self.clock.monotonic())
                 if left > 0:
-                    self._cond.wait(left)
+                    self.clock.wait_on(self._cond, left)
 
     def drain(self) -> None:
         """Nothing to take in: control frames come through `pull_from` or `control`."""
@@ -209,11 +211,11 @@ class Pacer:
                     return
                 due = self._due
                 if due is None:
-                    self._cond.wait(0.5)
+                    self.clock.wait_on(self._cond, 0.5)
                     continue
-                left = due - time.monotonic()
+                left = due - self.clock.monotonic()
                 if left > 0:
-                    self._cond.wait(left)
+                    self.clock.wait_on(self._cond, left)
                     continue
                 self._due = None
             self._poke()

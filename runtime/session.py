@@ -140,7 +140,7 @@ ONE_THREAD_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(handover:rx),
 CLIENT_RUNTIME = "(rx:(worker_threads:1),acc:(handover:rx),tx:(worker_threads:1),net:(handover:rx),app:(handover:rx))"
 
 # Whether this process has opened a zenoh session: zenoh's runtime threads then
-# exist, and a fork of this process would not have them (tools/launch/forkstart.py).
+# exist, and a fork of this process would not have them (match/forkstart.py).
 OPENED = [False]
 
 

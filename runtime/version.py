@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 # The packages below `arena` (pyproject.toml `packages`, first level): the bytecode the launcher writes
-# before a match (tools/launch/launcher.py) and the source a cluster's version check hashes
-# (tools/experiments/cluster.py) cover them all. learn is hashed by path: its extra need not be installed.
+# before a match (match/launcher.py) and the source a cluster's version check hashes
+# (experiments/cluster.py) cover them all. learn is hashed by path: its extra need not be installed.
 PACKAGES = (
     "runtime",
     "processes",
     "schemas",
-    "tools",
+    "review",
+    "experiments",
     "match",
     "strategies",
     "navigation",

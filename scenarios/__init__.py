@@ -8,8 +8,11 @@ expectations that must come true. The stable API:
   read and validate (a bad file raises `ScenarioError`, one line);
 * `Scenario.config(seed, base=None) -> MatchConfig`: the match that plays it;
   its `scenario` field carries the start and the steps, which the engine and
-  the referee apply at their ticks (processes/director.py), on either engine;
+  the referee apply at their ticks (sim/director.py), on either engine;
 * `run_one(scenario, seed, engine) -> Verdict`: play and judge one run.
+
+May import arena.match, arena.experiments (its benchmark's table) and every package
+below them; imported by learn (a scenario's reset) and the CLI.
 """
 
 from arena.scenarios.model import Scenario, ScenarioError, discover, load, load_all

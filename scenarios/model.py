@@ -6,7 +6,7 @@ teleports, referee commands, parked robots, at a simulated time or when a
 condition first holds) and what must come true (`expect`, each with a name).
 `Scenario.config(seed)` turns one into the `MatchConfig` every engine plays:
 the start becomes steps at tick 0 (`MatchConfig.scenario`), so the engine and
-the referee apply it like any other step (processes/director.py).
+the referee apply it like any other step (sim/director.py).
 
 Every problem is a `ScenarioError` with one line: the file, the key
 (`scenario[1].expect[0].within`) and what is wrong."""

@@ -377,7 +377,7 @@ not part of it. **It is checked:** for every `--external` process the
 launcher (the match's router) recomputes the digest from the frames it
 receives on that process's keys, counting, like a receiver, only the
 in-sequence frame of each scheduled tick that decodes as the key's message
-(so put nothing else: no malformed frame, no extra tick) (tools/launch/witness.py),
+(so put nothing else: no malformed frame, no extra tick) (match/witness.py),
 and a Summary whose digest
 differs is refused (counted under `forged_summaries`, the process gets no
 summary); the match JSON lists the processes whose digest matched under

@@ -1,5 +1,6 @@
-"""The simulated world the engine owns: pymunk physics (physics.py), wheel
-drive (drive.py) and the robots' noisy sensors (sensors.py). No transport and
-no clock: the engine process calls it once per tick. May import
+"""The simulated world the engine owns: pymunk physics (physics/), wheel
+drive (drive.py), the robots' noisy sensors (sensors.py) and a scenario's steps
+on the physics (director.py). No transport and no clock: the engine process
+calls it once per tick. May import
 `arena.navigation`, `arena.runtime` and `arena.schemas`; imported by
-`arena.processes` and `arena.tools`."""
+`arena.processes` and the packages above it."""

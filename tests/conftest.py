@@ -14,7 +14,7 @@ def pytest_collection(session: pytest.Session):
     Without it pytest rewrites the asserts of every test module and compiles it again on every
     run: ~3 s of the ~5 s of CPU that collecting the suite took. With it the rewritten modules
     are cached in the usual `__pycache__` directories (ignored by git), as arena's own are
-    (tools/launch/launcher.py, `compile_sources`). The tests themselves run with the setting
+    (match/launcher.py, `compile_sources`). The tests themselves run with the setting
     the environment gave.
     """
     wrote = sys.dont_write_bytecode

@@ -18,6 +18,7 @@ ORDER = (
     "credentials",
     "up",
     "tournament",
+    "experiment",
     "bench",
     "facts",
     "review",

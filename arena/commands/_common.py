@@ -10,7 +10,7 @@ import sys
 from typing import TYPE_CHECKING, NoReturn
 
 if TYPE_CHECKING:
-    from arena.tools.launch.result import MatchResult
+    from arena.match.result import MatchResult
 
 
 class Parser(argparse.ArgumentParser):
@@ -102,20 +102,20 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
     """Print a match result (arena match, arena up): one JSON object, or the tables.
 
     Faults and keys with two senders are also printed on stderr, one line
-    each. A void match (tools/launch/faults.py) exits 1 with one line naming the cause.
+    each. A void match (match/faults.py) exits 1 with one line naming the cause.
     """
-    from arena.tools.launch import faults
-    from arena.tools.review import report
+    from arena.match import faults
+    from arena.review import report
 
-    result = match.to_dict()
     if as_json:
-        result.pop("referee_log", None)
-        print(json.dumps(result, indent=2))
+        printed = match.to_dict()
+        printed.pop("referee_log", None)
+        print(json.dumps(printed, indent=2))
     else:
-        report.print_match(result)
-    for line in faults.warnings(result):
+        report.print_match(match)
+    for line in faults.warnings(match):
         print(f"{prog}: warning: {line}", file=sys.stderr)
-    if result.get("outcome") == "void":
-        print(f"{prog}: void: {'; '.join(result['outcome_reasons'])}", file=sys.stderr)
+    if match.outcome == "void":
+        print(f"{prog}: void: {'; '.join(match.outcome_reasons)}", file=sys.stderr)
         return 1
     return 0

@@ -13,7 +13,7 @@ def full_config(args: argparse.Namespace) -> tuple[MatchConfig, str]:
     """The match `arena match` plays, and the absolute path of its recording ("" for none)."""
     from arena.commands._match_flags import match_config
     from arena.commands._refbox_flags import refbox_params
-    from arena.tools.launch.run import record_path
+    from arena.match.run import record_path
 
     missing = [f for f, v in (("--home", args.home), ("--away", args.away)) if v is None]
     if missing and not args.config_file:

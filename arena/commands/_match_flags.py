@@ -9,22 +9,54 @@ import dataclasses
 from arena.commands._common import seconds
 from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 
+# The match flags' defaults where a command gives none of its own: the match's (runtime/config.py).
+MATCH_DEFAULTS = {k: getattr(MatchConfig(), k) for k in ("seed", "home", "away", "robots", "half_time", "link")}
 
-def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = True) -> None:
-    p.add_argument("--home", required=required, metavar="STRATEGY", help="team a's strategy (name or BS/BD/AS/AD)")
-    p.add_argument("--away", required=required, metavar="STRATEGY", help="team b's strategy")
-    # Defaults of None: the match's own default, or --config FILE's value, applies (match_config).
-    p.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team, goalkeeper included (3)")
+
+def add_match_flags(
+    p: argparse.ArgumentParser,
+    required: bool = False,
+    seed: bool = True,
+    *,
+    teams: bool = True,
+    config: bool = False,
+    defaults: dict | None = None,
+) -> None:
+    """The match flags on `p`. `seed=False`: the command's --seed is its own (a tournament's);
+    `teams=False`: no --home/--away (a tournament's --strategies); `config`: also --config FILE.toml;
+    `defaults`: the command's own defaults of `MATCH_DEFAULTS`' keys, e.g. {"half_time": 60.0}, under
+    a --config file's values and the flags (`match_config`)."""
+    d = {**MATCH_DEFAULTS, **(defaults or {})}
+    # Flags default to None: the command's default, or --config FILE's value, applies (match_config).
+    p.set_defaults(match_defaults=defaults or {})
+    if config:
+        p.add_argument(
+            "--config",
+            dest="config_file",
+            metavar="FILE.toml",
+            help="the match's configuration: field, robot, rules, timing, links (arena config --print writes one); "
+            "flags given here win",
+        )
+    if teams:
+        own = defaults or {}
+        home, away = (f" ({own[k]})" if k in own else "" for k in ("home", "away"))
+        p.add_argument(
+            "--home", required=required, metavar="STRATEGY", help=f"team a's strategy (name or BS/BD/AS/AD){home}"
+        )
+        p.add_argument("--away", required=required, metavar="STRATEGY", help=f"team b's strategy{away}")
+    p.add_argument(
+        "--robots", type=int, default=None, metavar="N", help=f"robots per team, goalkeeper included ({d['robots']})"
+    )
     p.add_argument(
         "--half-time",
         type=seconds,
         default=None,
         metavar="SECONDS",
-        help=f"simulated half length [s], at most {MAX_HALF_TIME:g} (300)",
+        help=f"simulated half length [s], at most {MAX_HALF_TIME:g} ({d['half_time']:g})",
     )
     if seed:
-        p.add_argument("--seed", type=int, default=None, metavar="N", help="master seed (0)")
-    p.add_argument("--link", default=None, metavar="PRESET", help="ideal | lan | wifi | congested-wifi (ideal)")
+        p.add_argument("--seed", type=int, default=None, metavar="N", help=f"master seed ({d['seed']})")
+    p.add_argument("--link", default=None, metavar="PRESET", help=f"ideal | lan | wifi | congested-wifi ({d['link']})")
     p.add_argument(
         "--link-param",
         action="append",
@@ -32,14 +64,15 @@ def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tru
         metavar="CLASS.PARAM=V",
         help="override one link parameter, e.g. wifi.latency_ms=12 (repeatable)",
     )
-    p.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="TEAM.NAME=V",
-        help="set one of team a's or b's strategy parameters, e.g. a.kick_speed=7.0 (repeatable; "
-        "arena strategies --params NAME lists them)",
-    )
+    if teams:  # a command without --home/--away sets a strategy's parameters its own way (tournament)
+        p.add_argument(
+            "--param",
+            action="append",
+            default=[],
+            metavar="TEAM.NAME=V",
+            help="set one of team a's or b's strategy parameters, e.g. a.kick_speed=7.0 (repeatable; "
+            "arena strategies --params NAME lists them)",
+        )
     p.add_argument(
         "--perception-latency",
         type=int,
@@ -58,25 +91,14 @@ def add_match_flags(p: argparse.ArgumentParser, required: bool, seed: bool = Tru
     )
 
 
-def every_match_latency(p: argparse.ArgumentParser) -> None:
-    """`--perception-latency` of a command that plays many matches (tournament, facts)."""
-    p.add_argument(
-        "--perception-latency",
-        type=int,
-        default=None,
-        metavar="TICKS",
-        help="every match's perception latency, as arena match's (default: timing.perception_latency, 3), "
-        "e.g. 0 for robots that see the present",
-    )
-
-
 def match_config(
     args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None, seed: bool = True
 ) -> MatchConfig:
     """The one place flags become a `MatchConfig`: the match flags a command has (`--home`, `--away`,
     `--robots`, `--half-time`, `--seed`, `--link`, `--link-param`, `--param`, `--perception-latency`, `--batch`,
-    `--config FILE`) over the file's values or the defaults, every range checked by `MatchConfig.validate`,
-    the strategy parameters by the strategies' declarations (`registry.check_params`).
+    `--config FILE`) over the file's values, over the command's own defaults (`add_match_flags`) or the
+    match's, every range checked by `MatchConfig.validate`, the strategy parameters by the strategies'
+    declarations (`registry.check_params`).
     A command that plays many matches gets the one they share (`seed=False`: its --seed is not a match's)."""
     from arena.runtime.links import parse_overrides, resolve
     from arena.strategies import registry
@@ -85,11 +107,14 @@ def match_config(
         return getattr(args, name, None)
 
     overrides = parse_overrides(given("link_param") or ())
-    base = MatchConfig()
+    own = dict(given("match_defaults") or {})  # the command's own defaults, under the file's values
+    if not seed:
+        own.pop("seed", None)
+    base = MatchConfig(**own)
     if given("config_file"):
         from arena.runtime import matchfile
 
-        base = matchfile.load(args.config_file)
+        base = matchfile.load(args.config_file, under=own)
     link = given("link") if given("link") is not None else base.link
     if given("link") is None:  # the file's overrides, then the flags' on top
         merged = {cls: dict(ps) for cls, ps in base.link_overrides.items()}

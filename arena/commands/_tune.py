@@ -1,4 +1,4 @@
-"""`arena experiment tune`: its flags and the call of tools/experiments/tune.py (docs/strategies.md, "Tuning")."""
+"""`arena experiment tune`: its flags and the call of experiments/tune.py (docs/strategies.md, "Tuning")."""
 
 from __future__ import annotations
 
@@ -128,14 +128,14 @@ def run_tune(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from arena.commands._match_flags import match_config
+    from arena.experiments import tune
+    from arena.experiments.spsa import Gains, Space
     from arena.strategies import registry
-    from arena.tools.experiments import tune
-    from arena.tools.experiments.spsa import Gains, Space
 
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
-        from arena.tools.experiments.cluster import parse_address
+        from arena.experiments.cluster import parse_address
 
         parse_address(args.ray)
     if Path(args.out).exists() and not Path(args.out).is_dir():

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from arena.commands._common import add_command, positive_int, seconds
-from arena.commands._match_flags import match_config
+from arena.commands._common import add_command, positive_int
+from arena.commands._match_flags import add_match_flags, match_config
 from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
@@ -18,28 +18,31 @@ EXAMPLES = """examples:
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
   arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
+  arena bench experiment          # CPU the experiment runner adds to the in-process matches it plays
   arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
   arena bench nav                  # paper 1 Tables 4-6 and paper 3's SAROG/GNRON, 10 trials per scheme
   arena bench nav --trials 3 --only static,SAROG --plots navplots/
-  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see tools/experiments/navbench/navbench.toml)"""
+  arena bench nav --scenarios my_scenarios.toml --json   # your own scenarios (see experiments/navbench/navbench.toml)"""
 
 
+# The match flags (arena match's, `add_match_flags`; None or [] when not given) and bench's own defaults.
+MATCH = ("config_file", "half_time", "robots", "link", "link_param", "perception_latency", "batch")
+MATCH_DEFAULTS = {"half_time": 60.0}
 # The flags each benchmark reads (besides --json); any other one given is refused, not ignored.
 USES = {
-    "match": {"runs", "half_time", "robots", "link"},
-    "record": {"runs", "half_time", "robots", "link"},
-    "throughput": {"runs", "half_time", "robots", "link", "strategy"},
+    "match": {"runs", *MATCH},
+    "record": {"runs", *MATCH},
+    "throughput": {"runs", *MATCH, "strategy"},
     "robot": {"strategy"},
     "learn": {"runs", "half_time", "strategy"},
     "scenario": {"runs"},
+    "experiment": {"runs", *MATCH, "strategy"},
     "nav": {"trials", "seed", "scenarios", "only", "plots"},
 }
 DEFAULTS = {
     "strategy": "advance-dynamic",
     "runs": 3,
-    "half_time": 60.0,
-    "robots": 3,
-    "link": "ideal",
+    **{k: [] if k == "link_param" else None for k in MATCH},
     "trials": 10,
     "seed": 0,
     "scenarios": None,
@@ -52,25 +55,23 @@ def add_parser(sub) -> None:
     b = add_command(sub, "bench", "benchmarks: print throughput and ratios (medians of several runs)", EXAMPLES)
     b.add_argument(
         "what",
-        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario"],
+        choices=["match", "record", "robot", "nav", "throughput", "learn", "scenario", "experiment"],
         help="match: speed; record: the cost of --record; robot: us per robot control step and F-SFM step; "
         "nav: the navigators in their papers' scenarios; throughput: both engines (--engine) interleaved, "
         "side by side; learn: env steps vs. in-process match ticks per CPU-second, and the vector env "
         "on 2 workers vs. 1 (needs the learn extra); scenario: 10-s scenario runs per minute in process, "
-        "and the ratio to a plain match of the same length",
+        "and the ratio to a plain match of the same length; experiment: the CPU the experiment runner adds to "
+        "the in-process matches it plays, side by side with a bare loop",
     )
     b.add_argument(
         "--strategy",
         default=DEFAULTS["strategy"],
         metavar="NAME",
-        help="robot, throughput, learn: strategy (both teams) (AD)",
+        help="robot, throughput, learn: strategy (both teams); experiment: team a's, against BS (AD)",
     )
     b.add_argument("--runs", type=positive_int, default=DEFAULTS["runs"], metavar="N", help="runs (3)")
-    b.add_argument(
-        "--half-time", type=seconds, default=DEFAULTS["half_time"], metavar="SECONDS", help="half length [s] (60)"
-    )
-    b.add_argument("--robots", type=int, default=DEFAULTS["robots"], metavar="N", help="match, record, throughput (3)")
-    b.add_argument("--link", default=DEFAULTS["link"], metavar="PRESET", help="match, record, throughput (ideal)")
+    # match, record, throughput: the match they play (learn: --half-time only)
+    add_match_flags(b, seed=False, teams=False, config=True, defaults=MATCH_DEFAULTS)
     b.add_argument("--json", action="store_true")
     b.add_argument(
         "--trials",
@@ -83,24 +84,24 @@ def add_parser(sub) -> None:
     b.add_argument(
         "--scenarios",
         metavar="FILE",
-        help="nav: scenario file (default: the built-in tools/experiments/navbench/navbench.toml)",
+        help="nav: scenario file (default: the built-in experiments/navbench/navbench.toml)",
     )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
 
 
 def run(args: argparse.Namespace) -> int:
+    from arena.experiments import bench
     from arena.strategies import registry
-    from arena.tools.experiments import bench
 
     unused = [k for k, v in DEFAULTS.items() if k not in USES[args.what] and getattr(args, k) != v]
     if unused:  # learn and scenario played 3v3 on ideal links whatever --robots and --link said
         flag = "--" + unused[0].replace("_", "-")
         takes = ", ".join("--" + k.replace("_", "-") for k in DEFAULTS if k in USES[args.what])
         raise ConfigError(f"{flag} does not apply to arena bench {args.what} (it takes {takes} and --json)")
-    if args.what in ("match", "record", "throughput"):  # checked before the first run says it starts
+    if args.what in ("match", "record", "throughput", "experiment"):  # checked before the first run says it starts
         base = match_config(args, seed=False)  # --seed is nav's
-        if args.what == "throughput":  # its matches are `arena match` commands: a bad name would fail in each
+        if args.what == "throughput":  # its matches are processes of their own: a bad name would fail in each
             strategy = registry.resolve_name(args.strategy)
     if args.what == "record":
         return bench.bench_record(base, args.runs, args.json)
@@ -112,17 +113,22 @@ def run(args: argparse.Namespace) -> int:
             from arena.learn.bench import bench_learn
         except ImportError as exc:
             raise ConfigError(str(exc)) from None
-        return bench_learn(args.runs, args.half_time, args.strategy, args.json)
+        return bench_learn(args.runs, args.half_time or MATCH_DEFAULTS["half_time"], args.strategy, args.json)
+    if args.what == "experiment":
+        from arena.experiments.experiment_bench import bench_experiment
+
+        name = registry.resolve_name(args.strategy)
+        return bench_experiment(base.replace(home=name, away="basic-static"), args.runs, args.json)
     if args.what == "scenario":
         from arena.scenarios.bench import bench_scenario
 
         return bench_scenario(args.runs, args.json)
     if args.what == "throughput":
-        from arena.tools.experiments import throughput
+        from arena.experiments import throughput
 
         return throughput.bench_throughput(base, args.runs, strategy, args.json)
     if args.what == "nav":
-        from arena.tools.experiments import navbench
+        from arena.experiments import navbench
 
         return navbench.main(
             scenarios=args.scenarios,

@@ -13,11 +13,11 @@ from arena.commands._tune import add_tune_parser, run_tune
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
-  arena experiment run examples/studies/wifi.toml --out runs/wifi           # every cell, every seed, both ends
+  arena experiment run examples/studies/wifi-latency.toml --out runs/wifi   # every cell, seed and end
   arena experiment run sweep.toml --jobs 2 --out runs/sweep --resume        # continue after Ctrl-C or a crash
   arena experiment run sweep.toml --ray --out runs/sweep                    # every match a task on a local Ray
   arena experiment run sweep.toml --ray auto --json                         # join this node's Ray cluster
-  arena experiment compare --candidate AD --baseline BS --half-time 30      # SPRT: is AD better than BS?
+  arena experiment compare --candidate AD --baseline BS --half-time 30 --elo1 50   # SPRT: is AD better?
   arena experiment compare --candidate AD --baseline AS --opponents BD,BS --elo0 0 --elo1 10 --max-pairs 200
   arena experiment tune --strategy AD --opponents AS,BS --params kick_speed,keeper_gain --out runs/tune-ad
 (docs/experiments.md: the experiment file key by key, and what compare prints)"""
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
-        from arena.tools.experiments.cluster import parse_address
+        from arena.experiments.cluster import parse_address
 
         parse_address(args.ray)
     if args.experiment == "compare":
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from arena.tools.experiments import design, experiment
+    from arena.experiments import design, experiment
 
     exp = design.load(args.file)
     source = Path(args.file).read_text()
@@ -132,8 +132,8 @@ def _run(args: argparse.Namespace) -> int:
 
 def _compare(args: argparse.Namespace) -> int:
     from arena.commands._match_flags import match_config
+    from arena.experiments import compare
     from arena.strategies import registry
-    from arena.tools.experiments import compare
 
     if args.half_time is not None and not 0 < args.half_time <= 3600:
         raise ConfigError(f"--half-time must be in (0, 3600] s, got {args.half_time}")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from arena.commands._common import add_command, seconds
-from arena.commands._match_flags import every_match_latency, match_config
+from arena.commands._common import add_command
+from arena.commands._match_flags import add_match_flags, match_config
 from arena.runtime.config import ConfigError
 
 CATCH_SIGTERM = True
@@ -16,7 +16,8 @@ EXAMPLES = """examples:
   arena facts --seeds 10 --home AD --away BS         # shots, saves, blocks, stuck robots, fouls per team
   arena facts --round-robin AD,AS,BD,BS --legs 4 --half-time 120   # the paper's Table 2 and Fig. 9 ratio
   arena facts --seeds 10 --home AD --away BS --perception-latency 0  # robots that see the present
-  arena facts --seeds 10 --home AD --away BS --json  # every match's facts and the totals per strategy, as JSON"""
+  arena facts --seeds 10 --home AD --away BS --json  # every match's facts and the totals per strategy, as JSON
+  arena facts --seeds 10 --config match.toml         # every match with the file's field, rules, timing, links"""
 
 
 def add_parser(sub) -> None:
@@ -28,19 +29,17 @@ def add_parser(sub) -> None:
     )
     fa.add_argument("--seeds", type=int, default=20, metavar="N", help="matches, seeds first-seed.. (20)")
     fa.add_argument("--first-seed", type=int, default=0, metavar="S", help="first seed (0)")
-    fa.add_argument("--half-time", type=seconds, default=60.0, metavar="SECONDS", help="simulated half length [s] (60)")
-    fa.add_argument("--home", default="chase", metavar="NAME", help="team a's strategy (chase)")
-    fa.add_argument("--away", default="chase", metavar="NAME", help="team b's strategy (chase)")
+    # The match every seed plays: arena match's flags, with facts' own defaults; --seed is the round robin's.
+    add_match_flags(fa, seed=False, config=True, defaults={"half_time": 60.0, "home": "chase", "away": "chase"})
     fa.add_argument("--workers", type=int, default=0, metavar="N", help="matches at once; 0 (the default): up to 2")
     fa.add_argument("--round-robin", metavar="A,B,...", help="instead: every pairing of these strategies --legs times")
     fa.add_argument("--legs", type=int, default=4, metavar="N", help="round robin: matches per pairing (4)")
     fa.add_argument("--seed", type=int, default=0, metavar="N", help="round robin: the tournament seed (0)")
     fa.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
-    every_match_latency(fa)
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.experiments import facts
+    from arena.experiments import facts
 
     if args.round_robin is not None and len({s.strip() for s in args.round_robin.split(",") if s.strip()}) < 2:
         raise ConfigError(f"--round-robin {args.round_robin}: needs at least two different strategies")

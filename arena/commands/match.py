@@ -41,14 +41,7 @@ EXAMPLES = """examples:
 
 def add_parser(sub) -> None:
     m = add_command(sub, "match", "play one match, every process its own OS process, and print the score", EXAMPLES)
-    add_match_flags(m, required=False)
-    m.add_argument(
-        "--config",
-        dest="config_file",
-        metavar="FILE.toml",
-        help="the match's configuration: field, robot, rules, timing, links (arena config --print writes one); "
-        "flags given here win",
-    )
+    add_match_flags(m, config=True)
     m.add_argument("--realtime", action="store_true", help="pace to the wall clock (HIL, live viewing)")
     m.add_argument(
         "--external", action="append", default=[], metavar="PROC", help="leave PROC (e.g. a/1) to be started by hand"

@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         actions = parse_actions(args.actions)
         base, mode = "", args.mode
         if args.credentials:
-            from arena.tools.launch.run import load_credentials
+            from arena.match.run import load_credentials
 
             base, asked, _ = load_credentials(args.credentials, OPERATOR_PRINCIPAL)
             mode = asked or mode

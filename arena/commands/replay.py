@@ -26,6 +26,6 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.review import replay
+    from arena.review import replay
 
     return replay.main(args.file, args.process, as_json=args.json)

@@ -72,7 +72,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.launch.run import Job, start
+    from arena.match.run import Job, start
 
     job = Job(
         kind=args.kind,

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.markup import escape
     from rich.table import Table
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     t = Table(title="strategies (arena match --home NAME --away ALIAS)")
     for col in ("name", "alias", "from", "conformance"):
@@ -76,7 +76,7 @@ def show_params(strategy, as_json: bool) -> int:
     from rich.markup import escape
     from rich.table import Table
 
-    from arena.tools.console import console as make_console
+    from arena.review.console import console as make_console
 
     if not rows:
         print(f"{strategy.name} declares no parameters")

@@ -6,8 +6,8 @@ import argparse
 import json
 import sys
 
-from arena.commands._common import ENGINE_FLAG, add_command, positive_int, seconds
-from arena.commands._match_flags import every_match_latency, match_config
+from arena.commands._common import ENGINE_FLAG, add_command, positive_int
+from arena.commands._match_flags import add_match_flags, match_config
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
@@ -15,6 +15,7 @@ EXAMPLES = """examples:
   arena tournament --strategies AD,BS --legs 4 --half-time 60 --out runs/quick
   arena tournament --out runs/paper --resume        # continue after Ctrl-C or a crash
   arena tournament --link congested-wifi --jobs 2 --json
+  arena tournament --config match.toml --legs 4     # every match with the file's field, rules, timing, links
   arena tournament --ray                            # every match a task on a local Ray instance (docs/cluster.md)
   arena tournament --ray auto --out runs/big        # join the Ray cluster this node belongs to (ray start ...)
   arena tournament --ray 10.0.0.5:6379 --resume     # join the cluster whose head node is there
@@ -29,14 +30,7 @@ def add_parser(sub) -> None:
     t.add_argument(
         "--legs", type=positive_int, default=10, metavar="N", help="matches per pairing, home and away alternating (10)"
     )
-    t.add_argument(
-        "--half-time", type=seconds, default=300.0, metavar="SECONDS", help="simulated half length [s] (300)"
-    )
-    t.add_argument("--robots", type=int, default=3, metavar="N", help="robots per team (3)")
-    t.add_argument("--link", default="ideal", metavar="PRESET", help="link preset (ideal)")
-    t.add_argument(
-        "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
-    )
+    add_match_flags(t, seed=False, teams=False, config=True)  # what every match shares
     t.add_argument(
         "--param",
         dest="strategy_param",
@@ -46,7 +40,6 @@ def add_parser(sub) -> None:
         help="set a strategy's parameter in every match it plays, e.g. AD.kick_speed=7.0 (repeatable; "
         "arena strategies --params AD lists them)",
     )
-    every_match_latency(t)
     t.add_argument("--seed", type=int, default=0, metavar="N", help="tournament seed; match seeds derive from it (0)")
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
@@ -72,20 +65,20 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from arena.experiments import tournament
+    from arena.experiments.tournament_report import print_summary
     from arena.strategies import registry
-    from arena.tools.experiments import tournament
-    from arena.tools.experiments.tournament_report import print_summary
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ConfigError(f"--out {args.out} exists and is not a directory")
     names = [registry.resolve_name(s) for s in args.strategies.split(",") if s.strip()]
     if len(set(names)) < 2:
         raise ConfigError("--strategies needs at least two different strategies")
-    every = match_config(args, seed=False)  # what every match shares, each range checked as for arena match
+    base = match_config(args, seed=False)  # what every match shares, each range checked as for arena match
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:
-        from arena.tools.experiments.cluster import parse_address, parse_runtime_env
+        from arena.experiments.cluster import parse_address, parse_runtime_env
 
         parse_address(args.ray)
         parse_runtime_env(args.ray_runtime_env)
@@ -93,13 +86,9 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--ray-runtime-env needs --ray")
     opts = tournament.TournamentOptions(
         strategies=tuple(names),
-        legs=args.legs,
-        half_time=every.half_time,
-        robots=every.robots,
-        link=every.link,
-        link_param=tuple(args.link_param),
+        base=base,
         params=strategy_params(args.strategy_param, names),
-        perception_latency=args.perception_latency,
+        legs=args.legs,
         seed=args.seed,
         jobs=args.jobs,
         out=Path(args.out),

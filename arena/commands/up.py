@@ -31,7 +31,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.tools.launch import compose
+    from arena.match import compose
 
     try:
         result = compose.up(args.file, timeout=args.timeout)

@@ -1,6 +1,6 @@
 """The one analysis of a match's World/Referee streams, used by `arena review`
 (from an MCAP recording), `arena facts` and the tournament-style round robin
-(from matches played in process, tools/experiments/facts.py), and the tests.
+(from matches played in process, experiments/facts.py), and the tests.
 
 * `facts.py`: `measure`, the match facts (rules: ball outside, stalls,
   stuck ball; team play: shots, saves, blocks, fouls, robots stuck by the

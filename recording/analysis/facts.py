@@ -2,7 +2,7 @@
 
 `measure` reads one match's ground truth (`world`, every tick) and the
 referee's frames, from a recording (`arena review`) or from a match played in
-process (`arena facts`, tools/experiments/facts.py), and measures:
+process (`arena facts`, experiments/facts.py), and measures:
 
 * `score` and `events`, the referee's command counts, as in the match JSON;
 * `outside`: ticks at which the ball's centre was beyond the fence;

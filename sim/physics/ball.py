@@ -132,7 +132,7 @@ class BallFlight:
         self._pin = (x, y)
 
     def teleport_ball(self, x: float, y: float, z: float, vx: float, vy: float, vz: float) -> None:
-        """Scenario control (processes/director.py): the ball at (x, y, z) [m] moving at (vx, vy, vz) [m/s].
+        """Scenario control (sim/director.py): the ball at (x, y, z) [m] moving at (vx, vy, vz) [m/s].
 
         Unlike `place_ball` it also releases a pinned set-piece ball; above the
         ground it flies from there.

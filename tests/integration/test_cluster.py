@@ -182,7 +182,7 @@ def test_worker_with_another_version_refuses(cluster):
     c, _ = cluster
     script = f"""
 import json, ray
-from arena.tools.experiments import cluster
+from arena.experiments import cluster
 ray.init(address={c.address!r}, logging_level="ERROR", log_to_driver=False)
 task = ray.remote(cluster.play_on_worker).options(num_cpus=1)
 mine = cluster.fingerprint()
@@ -208,7 +208,7 @@ from arena.cli import main
 code = main(["tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "1", "--jobs", "1",
              "--out", {str(tmp_path)!r}, "--json"])
 assert code == 0, code
-assert "ray" not in sys.modules and "arena.tools.experiments.cluster" not in sys.modules, "Ray was imported"
+assert "ray" not in sys.modules and "arena.experiments.cluster" not in sys.modules, "Ray was imported"
 """
     r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr[-3000:]
@@ -279,7 +279,7 @@ def test_runtime_env_with_another_version_fails_naming_both(tmp_path):
             [
                 sys.executable,
                 "-c",
-                "import json; from arena.tools import cluster; print(json.dumps(cluster.fingerprint()))",
+                "import json; from arena.experiments import cluster; print(json.dumps(cluster.fingerprint()))",
             ],
             capture_output=True,
             text=True,

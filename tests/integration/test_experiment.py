@@ -97,7 +97,11 @@ def test_resume_plays_only_what_is_missing(played, tmp_path):
     r = arena("experiment", "run", str(f), "--out", str(copy), "--jobs", "1", "--resume", "--json")
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stderr.count("] c0") == 3  # three matches played, one progress line each
-    assert json.loads((copy / "rows.json").read_text()) == json.loads((out / "rows.json").read_text())
+
+    def rows(d):  # the CPU time of a match replayed differs; what it played does not
+        return [{k: v for k, v in r.items() if k != "cpu_s"} for r in json.loads((d / "rows.json").read_text())]
+
+    assert rows(copy) == rows(out)
 
 
 def test_facts_responses(tmp_path):
@@ -143,7 +147,7 @@ def test_ad_is_accepted_better_than_bs_within_a_few_dozen_pairs():
 @pytest.mark.slow
 @pytest.mark.parametrize("opponents", ["", "AS,BD"])
 def test_a_strategy_against_itself_is_never_accepted_better(opponents):
-    args = ["--candidate", "BS", "--baseline", "BS", "--half-time", "20", "--elo1", "50", "--max-pairs", "40"]
+    args = ["--candidate", "BS", "--baseline", "BS", "--half-time", "10", "--elo1", "50", "--max-pairs", "20"]
     if opponents:  # the baseline under another name: the same matches, every game drawn
         args = ["--candidate", "BS", "--baseline", "basic-static", "--opponents", opponents, *args[4:]]
         r = arena("experiment", "compare", *args)
@@ -151,3 +155,4 @@ def test_a_strategy_against_itself_is_never_accepted_better(opponents):
         return
     code, out = compare(*args, "--jobs", "2", "--first-seed", "100")
     assert code != 0 and out["state"] != "accepted", out["line"]
+    assert out["penta"] == [0, 0, 20, 0, 0]  # both ends are the very same match: every pair is drawn

@@ -21,9 +21,9 @@ import pytest
 import zenoh
 
 from arena.recording.reader import load
+from arena.review.review import print_review
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas.messages import Referee, World
-from arena.tools.review.review import print_review
 from tests.integration.helpers import ARENA, alive, arena_in_process, cmdline, descendants, spawn, wait_for
 
 MATCH = ("match", "--home", "BS", "--away", "BS", "--json")
@@ -106,7 +106,7 @@ def test_kill_9_of_a_robot_is_a_fault_and_its_team_plays_on(reap, tmp_path, capf
             if r is not me:
                 assert math.hypot(r.x - me.x, r.y - me.y) > reach, (w.tick, r)
     # `arena review` analysed once, in this process (its real processes: tests/integration/test_recording.py);
-    # its text mode prints that same analysis with `print_review` (tools/review/review.py `main`).
+    # its text mode prints that same analysis with `print_review` (review/review.py `main`).
     review = arena_in_process(["review", str(mcap), "--json"], capfd)
     assert review.returncode == 0, review.stderr
     reviewed = json.loads(review.stdout)

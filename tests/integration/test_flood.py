@@ -23,10 +23,10 @@ import msgspec
 import pytest
 import zenoh
 
+from arena.match.inprocess import play_match
 from arena.runtime.config import MatchConfig
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
-from arena.tools.launch.inprocess import play_match
 from tests.integration.helpers import spawn, wait_for
 from tests.integration.test_faults import finish, wait_for_tick
 

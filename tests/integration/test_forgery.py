@@ -22,10 +22,10 @@ import time
 
 import zenoh
 
+from arena.match.inprocess import play_match
 from arena.runtime.config import MatchConfig
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
-from arena.tools.launch.inprocess import play_match
 from tests.integration.helpers import ARENA, wait_for
 from tests.integration.test_fuzz import CFG, GOLDEN, TOTAL, Launcher, stacks_after
 

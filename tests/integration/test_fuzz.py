@@ -211,7 +211,7 @@ class Launcher:
             self.reader.join(10)  # every line it wrote, read
             return out[0]
         stuck = sorted((pid, cmdline(pid)) for pid in descendants(self.proc.pid) if alive(pid))
-        for pid, _ in stuck:  # each `arena run` writes every thread's stack to its log (tools/launch/run.py)
+        for pid, _ in stuck:  # each `arena run` writes every thread's stack to its log (match/run.py)
             os.kill(pid, signal.SIGUSR1)
         time.sleep(1.0)
         tails = "".join(

@@ -59,7 +59,7 @@ def test_a_secure_match_refuses_a_wrong_or_missing_credential(tmp_path, reap):
     endpoint = f"tls/127.0.0.1:{port}"
     wait_for(lambda: "waiting for" in match.stderr.readline(), 60, "the match to listen")
     # Each wrong set-up is told its own cause (issue 34). The three are refused side by side: a
-    # peer is told only after `REFUSED_AFTER` (6 s, tools/launch/run.py), the clients within ~1 s.
+    # peer is told only after `REFUSED_AFTER` (6 s, match/run.py), the clients within ~1 s.
     cases = (
         (["--credentials", str(wrong)], f"the router at {endpoint} refused robot-a-1's password from {wrong}"),
         (["--mode", "client"], f"the router at {endpoint} is a secure match's: it needs this process's own"),

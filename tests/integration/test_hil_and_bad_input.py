@@ -58,7 +58,7 @@ def test_a_robot_started_by_hand_plays_its_part(tmp_path, reap):
     assert a1["external"] and a1["pid"] == robot.pid
     assert result["distance_m"]["a/1"] > 0.5, "the hand-started robot moved"
     assert result["rejected"] == 0 and result["dead"] == []
-    # Its digest was recomputed from the frames it put (tools/launch/witness.py), not taken on trust.
+    # Its digest was recomputed from the frames it put (match/witness.py), not taken on trust.
     assert result["digests_verified"] == ["robot/a/1"]
 
 

@@ -7,9 +7,9 @@ import time
 
 import pytest
 
+from arena.match.inprocess import play_in_process
 from arena.runtime.config import MatchConfig
 from arena.runtime.links import PRESETS
-from arena.tools.launch.inprocess import play_in_process
 from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 
 BASE = ("match", "--home", "basic-static", "--away", "basic-static", "--half-time", "30")

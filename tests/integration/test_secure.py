@@ -29,7 +29,7 @@ def baseline() -> dict:
     and message counts of the distributed one (tests/integration/test_engines.py), no processes started."""
     from arena import cli
     from arena.commands._live import full_config
-    from arena.tools.launch import inprocess
+    from arena.match import inprocess
 
     cfg, _ = full_config(cli.parser("match").parse_args(["match", *GAME]))
     return json.loads(json.dumps(inprocess.play_match(cfg).to_dict()))

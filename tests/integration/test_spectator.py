@@ -12,7 +12,7 @@ of that process, the one that would have written the queue out: for 5 s
 (`wait_before_close`), then zenoh closed the link and the router saw the
 engine's token vanish (a fault; in 3 of ~11 earlier runs, and in every run
 with these pauses). The launcher's own peers now put towards the router with
-congestion control DROP (`relay_safe` in tools/launch/launcher.py), and the router
+congestion control DROP (`relay_safe` in match/launcher.py), and the router
 relays to clients with DROP, so the spectator only loses frames. The match
 must complete whatever the spectator does; no timing is asserted.
 """

@@ -8,10 +8,10 @@ import subprocess
 
 import pytest
 
+from arena.experiments.fixtures import Result
+from arena.experiments.tournament import TournamentOptions, check_resume, settings
+from arena.experiments.tournament_report import report
 from arena.runtime.config import ConfigError
-from arena.tools.experiments.fixtures import Result
-from arena.tools.experiments.tournament import TournamentOptions, check_resume, settings
-from arena.tools.experiments.tournament_report import report
 from tests.integration.helpers import ARENA
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--seed", "5", "--jobs", "1")
@@ -45,11 +45,12 @@ def test_resume_refuses_another_perception_latency_and_an_old_directory_counts_a
     now = settings(opts)
     (tmp_path / "settings.json").write_text(json.dumps(now))
     check_resume(tmp_path, now)
+    base = opts.base.replace(timing=dataclasses.replace(opts.base.timing, perception_latency=0))
     with pytest.raises(ConfigError, match="--perception-latency 3 there, 0 now"):
-        check_resume(tmp_path, settings(dataclasses.replace(opts, perception_latency=0)))
+        check_resume(tmp_path, settings(dataclasses.replace(opts, base=base)))
     # A directory written before the setting was recorded was played with L = 0, the default then.
     (tmp_path / "settings.json").write_text(json.dumps({k: v for k, v in now.items() if k != "perception_latency"}))
-    check_resume(tmp_path, settings(dataclasses.replace(opts, perception_latency=0)))
+    check_resume(tmp_path, settings(dataclasses.replace(opts, base=base)))
     with pytest.raises(ConfigError, match="--perception-latency 0 there, 3 now"):
         check_resume(tmp_path, now)
 
@@ -71,3 +72,14 @@ def test_a_partial_report_counts_the_whole_schedule(tmp_path):
     assert (summary["played"], summary["scheduled"]) == (1, 6)
     assert "1 of 6 matches played" in (tmp_path / "report.md").read_text()
     assert "3 legs" in (tmp_path / "report.md").read_text()
+
+
+def test_resume_refuses_another_rules_value_and_an_old_directory_counts_as_the_defaults(tmp_path):
+    opts = TournamentOptions(strategies=("basic-static", "advance-dynamic"))
+    now = settings(opts)
+    assert now["config"] == {}
+    (tmp_path / "settings.json").write_text(json.dumps({k: v for k, v in now.items() if k != "config"}))
+    check_resume(tmp_path, now)
+    base = opts.base.replace(rules=dataclasses.replace(opts.base.rules, kickoff_time=0.5))
+    with pytest.raises(ConfigError, match="--config none there, rules.kickoff_time=0.5 now"):
+        check_resume(tmp_path, settings(dataclasses.replace(opts, base=base)))

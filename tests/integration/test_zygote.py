@@ -1,4 +1,4 @@
-"""The fork server (tools/launch/zygote.py): every match of a long-lived process starts forked, nothing is orphaned."""
+"""The fork server (match/zygote.py): every match of a long-lived process starts forked, nothing is orphaned."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ PLAYER = textwrap.dedent(
     """
     import json, os, sys
     from arena.runtime.config import MatchConfig
-    from arena.tools.launch import launcher, zygote
+    from arena.match import launcher, zygote
 
     z = zygote.start(ready=10)
     out = []
@@ -48,7 +48,7 @@ def test_every_match_of_a_long_lived_process_is_forked_with_the_same_digests():
 PARKED = textwrap.dedent(
     """
     import json, time
-    from arena.tools.launch import zygote
+    from arena.match import zygote
 
     z = zygote.start(ready=4)
     print(json.dumps([z.pid, *[pid for pid, _ in z._parked]]), flush=True)

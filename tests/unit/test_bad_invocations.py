@@ -124,6 +124,20 @@ BAD = [
     ([*T, "--link-param", "x"], "bad link override"),
     ([*T, "--jobs", "-1"], "--jobs"),
     ([*T, "--robots", "9"], "--robots"),
+    # arena experiment
+    (["experiment", "run", "{file}"], "is not valid TOML", PROCESS),
+    (["experiment", "run", "{tmp}"], "is not a regular file"),
+    (["experiment", "run", "/nonexistent/exp.toml"], "cannot read experiment file"),
+    (["experiment", "run", "{file}", "--jobs", "-1"], "--jobs must be 0"),
+    (["experiment", "run", "{file}", "--ray", "nohost"], "give auto or HOST:PORT"),
+    (["experiment", "compare", "--candidate", "AD"], "required: --baseline"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "tiki-taka"], "unknown strategy 'tiki-taka'"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "BS", "--elo0", "5", "--elo1", "1"], "elo0 < elo1"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "BS", "--alpha", "0"], "alpha and beta"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "BS", "--max-pairs", "0"], "--max-pairs must be"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "BS", "--half-time", "nan"], "--half-time"),
+    (["experiment", "compare", "--candidate", "AD", "--baseline", "AD", "--opponents", "BS"], "name two"),
+    (["experiment"], "the following arguments are required"),
     # arena bench
     (["bench", "match", "--runs", "0"], "--runs: '0'"),
     (["bench", "match", "--half-time", "1e12"], "at most 3600 s"),
@@ -368,9 +382,9 @@ def test_a_jobs_of_0_is_said_to_mean_the_default(capfd):
 
 def test_a_malformed_listen_is_said_before_a_process_is_forked(monkeypatch):
     """`arena match --listen foo` forked the match's ten processes, then refused the endpoint."""
+    from arena.match import forkstart, launcher
     from arena.runtime.config import MatchConfig
     from arena.runtime.session import EndpointError
-    from arena.tools.launch import forkstart, launcher
 
     monkeypatch.setattr(forkstart, "starter", lambda *args: pytest.fail("forked before the endpoint was checked"))
     with pytest.raises(EndpointError, match="--listen foo: not a zenoh endpoint"):

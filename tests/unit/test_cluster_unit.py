@@ -1,4 +1,4 @@
-"""tools/experiments/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
+"""experiments/cluster.py without Ray: address and runtime_env parsing, the version fingerprint, one attempt's result.
 
 The real cluster is exercised in tests/integration/test_cluster.py.
 """
@@ -12,9 +12,9 @@ from types import SimpleNamespace
 
 import pytest
 
+from arena.experiments import cluster
+from arena.experiments.fixtures import Fixture
 from arena.runtime.config import ConfigError
-from arena.tools.experiments import cluster
-from arena.tools.experiments.fixtures import Fixture
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -63,14 +63,25 @@ def runner(tmp_path):
 
 
 FX = Fixture(0, "basic-static", "advance-dynamic", 1, "basic-static", "advance-dynamic", 42)
-MATCH = {"score": [1, 2], "distance_m": {"a/1": 3.0}, "rtf": 20.0, "digest": "d" * 32, "engine": "processes"}
 
 
-def test_an_ok_attempt_is_written_once(runner):
-    r = cluster.finish(runner, FX, 1, {"rc": 0, "out": json.dumps(MATCH), "err": "", "wall": 1.5, "node": "n1"})
-    assert r.status == "ok" and r.score == [1, 2] and r.attempts == 1
+@pytest.fixture(scope="module")
+def match():
+    """A match's result as a task returns it (what it played is the driver's to read, not ours here)."""
+    from msgspec.structs import replace
+
+    from arena.match import play
+    from arena.runtime.config import MatchConfig
+
+    played = play(MatchConfig(half_time=0.2))
+    return replace(played, score=[1, 2], distance_m={"a/1": 3.0}, rtf=20.0, digest="d" * 32, engine="processes")
+
+
+def test_an_ok_attempt_is_written_once(runner, match):
+    r = cluster.finish(runner, FX, 1, {"rc": 0, "match": match, "err": "", "wall": 1.5, "node": "n1"})
+    assert r.status == "ok" and r.score == [1, 2] and r.attempts == 1 and r.engine == "processes"
     saved = json.loads((runner.matches_dir / f"{FX.id}.json").read_text())
-    assert saved["digest"] == MATCH["digest"]
+    assert saved["digest"] == match.digest
     assert "played on node n1" in (runner.logs_dir / f"{FX.id}.log").read_text()
 
 
@@ -80,8 +91,9 @@ def test_a_failed_attempt_is_played_again_then_recorded(runner):
     assert not (runner.matches_dir / f"{FX.id}.json").exists()
     r = cluster.finish(runner, FX, 2, mismatch)
     assert r.status == "failed" and r.attempts == 2 and r.reason.startswith("version mismatch")
-    no_json = cluster.finish(runner, FX, 2, {"rc": 0, "out": "garbage", "err": "", "wall": 1.0, "node": "n1"})
-    assert no_json.status == "failed" and no_json.reason == "the match printed no JSON"
+    no_result = {"rc": 0, "reason": "the match printed no result (JSON is malformed)", "err": "", "wall": 1.0}
+    printed = cluster.finish(runner, FX, 2, no_result)
+    assert printed.status == "failed" and printed.reason.startswith("the match printed no result")
     crashed = cluster.finish(runner, FX, 2, {"rc": 1, "out": "", "err": "boom\nlast line\n", "wall": 1.0})
     assert crashed.reason == "last line"
 
@@ -90,8 +102,8 @@ def test_ray_missing_is_refused_before_anything_is_written(tmp_path, monkeypatch
     """`--ray` without Ray failed, but only after logs/, matches/ and settings.json were made."""
     import sys
 
+    from arena.experiments import tournament
     from arena.runtime.config import ConfigError
-    from arena.tools.experiments import tournament
 
     monkeypatch.setitem(sys.modules, "ray", None)  # as if not installed
     out = tmp_path / "t"

@@ -123,8 +123,8 @@ def test_our_frames_are_plain_msgpack_maps_any_msgpack_library_reads_and_writes(
     import msgpack
     import msgspec
 
+    from arena.match.inprocess import play_in_process
     from arena.schemas import messages as m
-    from arena.tools.launch.inprocess import play_in_process
 
     _, frames = play_in_process(MatchConfig(seed=5, half_time=1.0), watch=("field", "world", "referee", "events"))
     types = {"field": m.FieldSpec, "world": m.World, "referee": m.Referee, "events": m.EngineEvents}

@@ -11,9 +11,9 @@ import threading
 
 import pytest
 
+from arena.match.connect import why_refused
+from arena.match.run import configure_logging
 from arena.runtime.credentials import Secrets
-from arena.tools.launch.connect import why_refused
-from arena.tools.launch.run import configure_logging
 
 
 def _server(tls: tuple[bytes, bytes, bytes] | None, tmp_path):

@@ -7,10 +7,10 @@ import threading
 
 import pytest
 
+from arena.match import inprocess
 from arena.processes import node_class
 from arena.processes.robot import RobotNode
 from arena.runtime.config import MatchConfig
-from arena.tools.launch import inprocess
 
 
 class QuitsAtTick20(RobotNode):
@@ -70,6 +70,7 @@ def test_observers_are_not_nodes_and_a_node_takes_its_driver():
     """The recorder and viewer are `Observer`s (no lockstep, no driver); a `Node` is driven by what it is given."""
     import gc
 
+    from arena.match import run
     from arena.processes import OBSERVERS
     from arena.runtime.config import ProcessId
     from arena.runtime.coop import CoopBus, Task
@@ -77,7 +78,6 @@ def test_observers_are_not_nodes_and_a_node_takes_its_driver():
     from arena.runtime.node import Node, Observer
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
-    from arena.tools.launch import run
 
     for kind in OBSERVERS:
         cls = node_class(kind)

@@ -1,4 +1,4 @@
-"""The experiment file (tools/experiments/design.py): strict parsing, dotted paths over any
+"""The experiment file (experiments/design.py): strict parsing, dotted paths over any
 configuration field, the designs, and the matches (common seeds, ends swapped)."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import os
 
 import pytest
 
+from arena.experiments import design
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.tools.experiments import design
 
 
 def write(tmp_path, text: str, name: str = "exp.toml") -> str:
@@ -89,7 +89,6 @@ def test_an_open_dict_field_takes_new_keys(monkeypatch):
         ('[design]\nkind = "sobol"\n', "design.kind must be one of"),
         ('responses = ["elo"]\n', "unknown response 'elo'"),
         ('opponents = ["BS"]\n[base]\nhome = "BS"\n', "no match to play"),
-        ('engine = "processes"\nresponses = ["shots"]\n', "need engine"),
     ],
 )
 def test_bad_files_are_one_line_errors(tmp_path, text, error):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.experiments import design
 from arena.runtime.config import ConfigError
-from arena.tools.experiments import design
 
 
 def _file(tmp_path, factors: str, extra: str = "") -> str:
@@ -60,7 +60,7 @@ def _row(cell, gf, ga, r1=10.0, r2=5.0):
 
 
 def test_a_round_robin_per_setting_gives_table_2(tmp_path):
-    from arena.tools.experiments import experiment_standings
+    from arena.experiments import experiment_standings
 
     path = _file(tmp_path, 'home = ["AD", "BS"]\n"timing.perception_latency" = [0, 3]\n')
     exp = design.load(path)
@@ -80,7 +80,7 @@ def test_a_round_robin_per_setting_gives_table_2(tmp_path):
 
 
 def test_no_round_robin_no_standings(tmp_path):
-    from arena.tools.experiments import experiment_standings
+    from arena.experiments import experiment_standings
 
     exp = design.load(_file(tmp_path, '"timing.perception_latency" = [0, 3]\n'))
     assert experiment_standings.build(exp, []) == [] and experiment_standings.markdown([]) == []

@@ -7,11 +7,11 @@ import math
 import msgspec
 import pytest
 
+from arena.match.faults import Fault, blame, lapses, outcome
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
 from arena.schemas.validate import nonfinite, safe_default, suspect
 from arena.sim.physics import Physics
-from arena.tools.launch.faults import blame, lapses, outcome
 from tests.unit.test_lockstep import Harness
 
 
@@ -120,22 +120,22 @@ def test_a_process_that_was_lost_itself_blames_nobody():
 def test_outcomes():
     cfg = MatchConfig(seed=1, half_time=1.0)
     full = {str(p): _summary(str(p), tick=cfg.total_ticks) for p in cfg.processes()}
-    assert outcome(cfg, full, {}, {}, {})["outcome"] == "completed"
+    assert outcome(cfg, full, {}, {}, {}).outcome == "completed"
     crashed = dict(full)
     crashed.pop("robot/b/1")
     crashed["engine"] = _summary("engine", ["robot/b/1"], {"robot/b/1": 20}, tick=cfg.total_ticks)
     o = outcome(cfg, crashed, {"robot/b/1": "exited with code -9 (SIGKILL)"}, {}, {})
-    assert o["outcome"] == "completed_with_faults" and o["faults"] == [
-        {"process": "robot/b/1", "tick": 20, "reason": "exited with code -9 (SIGKILL)"}
+    assert o.outcome == "completed_with_faults" and o.faults == [
+        Fault(process="robot/b/1", tick=20, reason="exited with code -9 (SIGKILL)")
     ]
     short = dict(full, engine=_summary("engine", tick=10))
-    assert outcome(cfg, short, {}, {}, {})["outcome_reasons"] == [f"the engine played 10 of {cfg.total_ticks} ticks"]
+    assert outcome(cfg, short, {}, {}, {}).outcome_reasons == [f"the engine played 10 of {cfg.total_ticks} ticks"]
     noref = dict(full)
     noref.pop("referee")
     o = outcome(cfg, noref, {"referee": "exited with code 1"}, {}, {}, void="referee exited with code 1")
-    assert o["void"] and o["outcome_reasons"] == ["referee exited with code 1"]
+    assert o.void and o.outcome_reasons == ["referee exited with code 1"]
     spoofed = dict(full, engine=_summary("engine", tick=cfg.total_ticks, conflicts={"robot/b/1/cmd": 3}))
-    assert outcome(cfg, spoofed, {}, {}, {})["conflicts"] == {"robot/b/1/cmd": 3}
+    assert outcome(cfg, spoofed, {}, {}, {}).conflicts == {"robot/b/1/cmd": 3}
 
 
 def test_a_process_that_lost_everyone_while_nobody_lost_it_is_the_one_blamed():
@@ -181,8 +181,8 @@ def test_a_failed_engine_or_referee_voids_the_match_even_with_its_summary():
     full["robot/a/1"] = _summary("robot/a/1", ["engine"], {"engine": 30}, tick=cfg.total_ticks)
     why = "stopped responding for a while: its liveliness token vanished mid-match"
     o = outcome(cfg, full, {}, {"engine": why}, {})
-    assert o["outcome"] == "void" and o["void"], o
-    assert o["outcome_reasons"] == [f"engine: {why}"]
-    assert [f["process"] for f in o["faults"]] == ["engine"]
+    assert o.outcome == "void" and o.void, o
+    assert o.outcome_reasons == [f"engine: {why}"]
+    assert [f.process for f in o.faults] == ["engine"]
     o = outcome(cfg, full, {}, {"referee": why}, {})
-    assert o["outcome"] == "void" and o["outcome_reasons"] == [f"referee: {why}"]
+    assert o.outcome == "void" and o.outcome_reasons == [f"referee: {why}"]

@@ -5,9 +5,9 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from arena.match.inprocess import play_in_process
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import World
-from arena.tools.launch.inprocess import play_in_process
 
 decode_world = msgspec.msgpack.Decoder(World).decode
 
@@ -78,8 +78,8 @@ def _noisy_referee():
 
 
 def test_bad_referee_frames_are_rejected_by_engine_and_base_stations_and_change_nothing(monkeypatch):
+    from arena.match import inprocess
     from arena.processes import node_class
-    from arena.tools.launch import inprocess
 
     cfg = MatchConfig(seed=3, half_time=2.0)
     clean, _ = play_in_process(cfg, watch=())
@@ -99,9 +99,9 @@ def test_bad_referee_frames_are_rejected_by_engine_and_base_stations_and_change_
 
 def test_ctrl_c_in_process_leaves_a_whole_recording_that_says_it_was_stopped(tmp_path, monkeypatch):
     """The in-process engine left a truncated file on Ctrl-C; the recorder process writes one that says SIGINT."""
+    from arena.match import inprocess
     from arena.recording.reader import load
     from arena.runtime import coop
-    from arena.tools.launch import inprocess
 
     def interrupted(bus, tasks, **kw):
         kw["on_idle"]()

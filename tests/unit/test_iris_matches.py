@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.match.inprocess import play_in_process
 from arena.runtime.config import MatchConfig
-from arena.tools.launch.inprocess import play_in_process
 
 
 @pytest.mark.slow

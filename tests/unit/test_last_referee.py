@@ -7,8 +7,8 @@ import time
 
 import msgspec
 
+from arena.match.run import await_last_referee
 from arena.schemas.messages import Referee
-from arena.tools.launch.run import await_last_referee
 
 
 def frame(tick: int, stage: str) -> bytes:

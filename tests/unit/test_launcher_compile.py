@@ -7,8 +7,8 @@ import importlib.util
 import os
 import sys
 
+from arena.match import launcher
 from arena.runtime import seeds
-from arena.tools.launch import launcher
 
 
 def test_writes_arenas_bytecode_when_the_interpreters_would_not(monkeypatch):

@@ -1,7 +1,6 @@
 """Imports never point up. Each package may import only packages of a lower rank
-(and itself); the ranks are the package map of docs/architecture.md. Inside
-tools/, the sub-packages are ranked the same way, and the command line
-(arena.cli, arena.commands) is above everything: nothing else imports it."""
+(and itself); the ranks are the package map of docs/architecture.md, and the
+command line (arena.cli, arena.commands) is above everything: nothing else imports it."""
 
 from __future__ import annotations
 
@@ -20,39 +19,29 @@ RANK = {
     "strategies": 3,
     "refbox": 3,  # the RefBox protocol's sockets and threads, over the pure rules
     "processes": 4,
-    "tools": 5,
-    "match": 5,  # arena.match, the one way to play a match: inside rank 5, just above tools.launch (MATCH)
-    "scenarios": 6,  # the scenario file, runner, pytest plugin and library: may use tools
-    "learn": 7,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
-    "arena": 8,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
+    "match": 5,  # the one way to play a match, both engines (the launcher, the in-process engine)
+    "review": 6,  # looking back at a match: review, replay, the text report, the console
+    "experiments": 7,  # many matches or measurements: tournaments, cluster, facts, benchmarks
+    "scenarios": 8,  # the scenario file, runner, pytest plugin and library: may use experiments' bench
+    "learn": 9,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
+    "arena": 10,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
 }
 # arena's own modules: the command line. Nothing outside arena/ may import them.
 COMMAND_LINE = {"cli", "commands", "__main__"}
-# Inside tools/, bottom-up: a module of tools/ itself (console.py), then the sub-packages by concern.
-TOOLS_RANK = {"": 0, "launch": 1, "review": 3, "experiments": 4}
-# arena.match wraps tools.launch's engines; tools.review and tools.experiments play matches through it.
-MATCH = (RANK["match"], 2)
 
 
-def unit(name: str) -> tuple[str, str] | None:
-    """The (package, tools sub-package or "") that the module `arena.x.y...` belongs to; None for
-    what the layering does not rank (arena's root package itself, e.g. `arena.__version__`)."""
+def unit(name: str) -> str | None:
+    """The package that the module `arena.x.y...` belongs to; None for what the layering does not
+    rank (arena's root package itself, e.g. `arena.__version__`)."""
     parts = name.split(".")
     if parts[0] != "arena" or len(parts) < 2:
         return None
     if parts[1] in COMMAND_LINE:
-        return ("arena", "")
-    if parts[1] not in RANK:
-        return None
-    sub = parts[2] if parts[1] == "tools" and len(parts) > 2 and parts[2] in TOOLS_RANK else ""
-    return (parts[1], sub)
+        return "arena"
+    return parts[1] if parts[1] in RANK else None
 
 
-def rank(u: tuple[str, str]) -> tuple[int, int]:
-    return MATCH if u[0] == "match" else (RANK[u[0]], TOOLS_RANK[u[1]])
-
-
-def imported_units(path: Path) -> set[tuple[str, str]]:
+def imported_units(path: Path) -> set[str]:
     """Every ranked unit this file imports, at module level or inside functions."""
     out = set()
     for node in ast.walk(ast.parse(path.read_text(), str(path))):
@@ -66,24 +55,30 @@ def imported_units(path: Path) -> set[tuple[str, str]]:
 
 
 def upward_imports(root: Path) -> list[str]:
-    """Every import in the tree at `root` that points to its own rank or above (its own unit aside)."""
+    """Every import in the tree at `root` that points to its own rank or above (its own package aside)."""
     bad = []
     for pkg in RANK:
         for path in sorted((root / pkg).rglob("*.py")):
-            rel = path.relative_to(root / pkg).parts
-            own = (pkg, rel[0] if pkg == "tools" and len(rel) > 1 and rel[0] in TOOLS_RANK else "")
-            for dep in sorted(imported_units(path) - {own}):
-                if rank(dep) >= rank(own):
-                    name = "the command line" if dep[0] == "arena" else ".".join(("arena", *filter(None, dep)))
-                    bad.append(f"{path.relative_to(root)} imports {name} (rank {rank(dep)} >= {rank(own)})")
+            for dep in sorted(imported_units(path) - {pkg}):
+                if RANK[dep] >= RANK[pkg]:
+                    name = "the command line" if dep == "arena" else f"arena.{dep}"
+                    bad.append(f"{path.relative_to(root)} imports {name} (rank {RANK[dep]} >= {RANK[pkg]})")
     return bad
 
 
 def test_every_package_is_ranked():
     pkgs = {p.parent.name for p in ROOT.glob("*/__init__.py")} - {"tests", "examples"}
     assert pkgs <= set(RANK), f"unranked packages: {sorted(pkgs - set(RANK))}"
-    subs = {p.parent.name for p in (ROOT / "tools").glob("*/__init__.py")}
-    assert subs <= set(TOOLS_RANK), f"unranked tools sub-packages: {sorted(subs - set(TOOLS_RANK))}"
+
+
+def test_every_room_says_what_it_holds_and_what_it_may_import():
+    """Each package's __init__ opens with what lives there and names what it may import."""
+    quiet = []
+    for pkg in RANK:
+        doc = ast.get_docstring(ast.parse((ROOT / pkg / "__init__.py").read_text())) or ""
+        if len(doc.split()) < 12 or "import" not in doc.lower():
+            quiet.append(pkg)
+    assert not quiet, f"say what lives there and what it may import: {quiet}"
 
 
 def test_imports_never_point_up():
@@ -93,21 +88,24 @@ def test_imports_never_point_up():
 
 def test_the_check_fails_on_a_planted_upward_import(tmp_path):
     planted = {
-        "tools/launch/forked.py": "def go():\n    from arena.cli import main\n",
+        "match/forked.py": "def go():\n    from arena.cli import main\n",
         "runtime/plugin.py": "from arena import commands\n",
-        "tools/launch/table.py": "from arena.tools.experiments import tournament\n",
-        "tools/experiments/scen.py": "import arena.commands.match\n",
-        "processes/up.py": "from arena.tools.launch.run import start\n",
+        "match/table.py": "from arena.experiments import tournament\n",
+        "experiments/scen.py": "import arena.commands.match\n",
+        "processes/up.py": "from arena.match.run import start\n",
         "learn/cmd.py": "from arena.cli import parser\n",
-        "tools/launch/seam.py": "from arena.match import play\n",
-        "match/report.py": "from arena.tools.review import report\n",
+        "processes/seam.py": "from arena.match import play\n",
+        "match/report.py": "from arena.review import report\n",
+        "review/bench.py": "from arena.experiments.bench import print_metrics\n",
+        "sim/steps.py": "from arena.rules import setpieces\n",  # the same rank
     }
     fine = {
-        "tools/review/ok.py": "from arena.tools.launch import launcher\nfrom arena import __version__\n",
-        "arena/commands/ok.py": "from arena.tools.experiments import tournament\nfrom arena.commands import _common\n",
-        "tools/launch/same.py": "from arena.tools.launch import run\nfrom arena.runtime.config import MatchConfig\n",
-        "match/ok.py": "from arena.tools.launch import inprocess\nfrom arena.match import engines\n",
-        "tools/experiments/ok.py": "from arena.match import play\n",
+        "review/ok.py": "from arena.match import launcher\nfrom arena import __version__\n",
+        "arena/commands/ok.py": "from arena.experiments import tournament\nfrom arena.commands import _common\n",
+        "match/same.py": "from arena.match import run\nfrom arena.runtime.config import MatchConfig\n",
+        "match/ok.py": "from arena.processes import node_class\nfrom arena.match import engines\n",
+        "experiments/ok.py": "from arena.match import play\nfrom arena.review.console import console\n",
+        "sim/director.py": "from arena.sim.physics import Physics\nfrom arena.schemas import messages\n",
     }
     for rel, text in {**planted, **fine}.items():
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)

@@ -16,9 +16,9 @@ from gymnasium.utils.env_checker import check_env
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from arena.learn import SoccerEnv, SoccerParallelEnv, make_vector_env
+from arena.match.inprocess import play_in_process
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.strategies import registry
-from arena.tools.launch.inprocess import play_in_process
 
 SHORT = dict(home="AD", away="BS", half_time=0.6)  # 61 ticks: fast, and the kick-off is played
 
@@ -171,7 +171,7 @@ def test_docs_learning_md_lists_every_observation_part_and_discrete_action():
 
 
 def test_a_tournament_names_a_policy_files_matches_by_its_file_name():
-    from arena.tools.experiments.fixtures import Fixture
+    from arena.experiments.fixtures import Fixture
 
     fx = Fixture(3, "policy:/runs/x/keeper.pkl", "advance-dynamic", 2, "policy:/runs/x/keeper.pkl", "AD", 1)
     assert fx.id == "003-policy-keeper.pkl-AD-leg02"

@@ -1,5 +1,5 @@
 """One place turns flags into a MatchConfig (arena/commands/_match_flags.py `match_config`), for
-every command that plays matches; the commands that run `arena match` build its argv from a config."""
+every command that plays matches, each with its own defaults; a match process is handed the config itself."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ import pytest
 from arena.cli import parser
 from arena.commands._match_flags import match_config
 from arena.runtime.config import ConfigError, MatchConfig, TimingParams
-from arena.tools.experiments.matches import match_argv
 
 
 def config(*argv: str, seed: bool = True) -> MatchConfig:
@@ -38,12 +37,29 @@ def test_each_range_is_the_configurations(argv, needle):
         config(*argv, seed=False)
 
 
-def test_the_argv_of_a_config_is_that_config():
-    cfg = config(
-        "match", "--home", "AD", "--away", "BS", "--half-time", "7.5", "--seed", "41", "--robots", "4",
-        "--link", "wifi", "--link-param", "wifi.latency_ms=12.5", "--perception-latency", "2",
-    )  # fmt: skip
-    argv = match_argv(cfg, "inprocess")
-    assert argv[3] == "match" and argv[argv.index("--engine") + 1] == "inprocess" and "--json" in argv
-    what = [a for i, a in enumerate(argv) if a not in ("--engine", "inprocess", "--json")]
-    assert config(*what[3:]) == cfg
+def test_a_command_s_own_defaults_lie_under_the_file_and_the_flags(tmp_path):
+    facts = config("facts", seed=False)
+    assert (facts.half_time, facts.home, facts.away) == (60.0, "chase", "chase")
+    assert config("tournament", seed=False).half_time == 300.0 and config("bench", "match", seed=False).half_time == 60
+    path = tmp_path / "m.toml"
+    path.write_text("half_time = 10.0\n[rules]\nkickoff_time = 0.5\n")
+    from_file = config("facts", "--config", str(path), seed=False)
+    assert (from_file.half_time, from_file.home, from_file.rules.kickoff_time) == (10.0, "chase", 0.5)
+    assert config("facts", "--config", str(path), "--half-time", "5", seed=False).half_time == 5.0
+    assert config("tournament", "--config", str(path), seed=False).rules.kickoff_time == 0.5
+
+
+def test_a_match_process_is_handed_the_whole_configuration():
+    """`python -m arena.match` (match/child.py) gets every field, rules and field included."""
+    import dataclasses
+
+    from arena.match import child, play
+
+    cfg = config("match", "--home", "AD", "--away", "BS", "--half-time", "2", "--seed", "41", "--robots", "2")
+    cfg = cfg.replace(rules=dataclasses.replace(cfg.rules, kickoff_time=0.5))
+    cfg = cfg.replace(field=dataclasses.replace(cfg.field, runoff=cfg.field.runoff + 0.25))
+    proc, given = child.start(cfg, "inprocess")
+    out, _ = proc.communicate(input=given, timeout=120)
+    assert proc.returncode == 0
+    result = child.decode(out)
+    assert result.digest == play(cfg).digest != play(cfg.replace(rules=MatchConfig().rules)).digest

@@ -1,4 +1,4 @@
-"""`arena bench nav` (tools/experiments/navbench/): scenario files, determinism, paper 3's local minima, output shape.
+"""`arena bench nav` (experiments/navbench/): scenario files, determinism, paper 3's local minima, output shape.
 
 Safe rates are measurements, reported by the benchmark and docs/navigation.md;
 they are not asserted here. What is asserted is what the issue claims as fact
@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from arena.experiments import navbench as nb
 from arena.navigation import fsfm
-from arena.tools.experiments import navbench as nb
 from tests.integration.helpers import arena_in_process
 
 MINI = """

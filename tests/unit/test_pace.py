@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
+import threading
 
 import pytest
 
+from arena.runtime.clock import ManualClock
 from arena.runtime.config import ConfigError, MatchConfig
-from arena.runtime.pace import Pacer, WireGate
+from arena.runtime.pace import BEHIND_S, Pacer, WireGate
 from arena.schemas.messages import Control, encode
 from tests.integration.helpers import arena_in_process
 
@@ -53,13 +54,51 @@ def test_the_wire_gate_passes_every_nth_frame_and_the_held_one_when_the_pacer_ho
     assert len(wire) == 5  # nothing held: nothing sent twice
 
 
-def test_a_pace_waits_for_the_wall_clock():
-    p = Pacer(0.02, 1.0)
-    assert p.ready(0)
+def test_a_paced_tick_is_ready_when_the_clock_reaches_its_time():
+    clock = ManualClock()
+    p = Pacer(0.02, 1.0, clock=clock)
+    assert p.ready(0)  # the schedule counts from here
     assert not p.ready(5)  # 0.1 s later at real-time pace
-    t0 = time.monotonic()
-    p.sync(5)
-    assert time.monotonic() - t0 >= 0.05
+    clock.advance(0.05)
+    assert not p.ready(5)
+    clock.advance(0.05)
+    assert p.ready(5)
+    p.pace = 2.0  # twice real time: tick 10 is due 0.05 s after tick 5's time, from the same anchor
+    clock.advance(BEHIND_S + 0.1)  # far behind: the schedule restarts from now instead of sprinting
+    assert p.ready(6) and not p.ready(7)
+    clock.advance(0.01)
+    assert p.ready(7)
+
+
+def test_sync_blocks_until_the_clock_reaches_the_tick():
+    clock = ManualClock()
+    p = Pacer(0.02, 1.0, clock=clock)
+    assert p.ready(0)
+    done = threading.Event()
+    t = threading.Thread(target=lambda: (p.sync(10), done.set()), daemon=True)
+    t.start()
+    clock.until_sleeping()
+    clock.advance(0.1)
+    assert not done.is_set(), "tick 10 is due at 0.2 s"
+    clock.advance(0.1)
+    t.join(5.0)
+    assert done.is_set()
+
+
+def test_the_reactive_pacer_pokes_the_loop_when_a_tick_is_due():
+    clock = ManualClock()
+    p = Pacer(0.02, 1.0, clock=clock)
+    pokes: list[float] = []
+    assert p.ready(0) and not p.ready(20)  # due at 0.4 s
+    p.start(lambda: pokes.append(clock.monotonic()))
+    try:
+        clock.until_sleeping()  # its thread waits for tick 20's time
+        clock.advance(0.3)
+        assert pokes == []
+        clock.advance(0.1)
+        assert pokes == [0.4] and p.ready(20)
+    finally:
+        p.stop()
 
 
 def test_malformed_control_frames_are_rejected_not_applied():

@@ -16,11 +16,11 @@ def test_every_printer_uses_the_console_that_does_not_wrap_when_piped():
     made_here = []
     for path in sorted(ROOT.rglob("*.py")):
         rel = path.relative_to(ROOT)
-        if rel.parts[0] in {"tests", ".venv", "examples", "build"} or str(rel) == "tools/console.py":
+        if rel.parts[0] in {"tests", ".venv", "examples", "build"} or str(rel) == "review/console.py":
             continue
         if re.search(r"\bConsole\(", path.read_text()):
             made_here.append(str(rel))
-    assert made_here == [], "make consoles with arena.tools.console.console(), which never wraps piped output"
+    assert made_here == [], "make consoles with arena.review.console.console(), which never wraps piped output"
 
 
 def test_a_piped_match_report_keeps_every_line_whole():
@@ -38,7 +38,7 @@ def test_a_piped_match_report_keeps_every_line_whole():
 
 
 def test_the_console_is_wide_when_piped_and_the_terminals_width_on_a_terminal(monkeypatch):
-    from arena.tools import console
+    from arena.review import console
 
     monkeypatch.delenv("COLUMNS", raising=False)
     monkeypatch.setattr(sys.stdout, "isatty", lambda: False, raising=False)

@@ -1,4 +1,4 @@
-"""Issue 19 part 5: the trajectory and heatmap pictures' data (tools/review/plots.py)."""
+"""Issue 19 part 5: the trajectory and heatmap pictures' data (review/plots.py)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import math
 import numpy as np
 from matplotlib.colors import to_rgb
 
+from arena.review import plots
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RobotState, World
-from arena.tools.review import plots
 
 CFG = MatchConfig(half_time=1.0)  # 50 ticks a half
 

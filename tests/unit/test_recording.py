@@ -16,19 +16,19 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from arena.experiments import facts
+from arena.match.inprocess import play_in_process
 from arena.processes.recorder import data_topics
 from arena.recording import scene
 from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import RecordingError, load
+from arena.review import replay, review
 from arena.runtime.config import MatchConfig
 from arena.runtime.tap import Tap
 from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
 from arena.schemas.vocabulary import SET_PIECES
 from arena.strategies import registry
-from arena.tools.experiments import facts
-from arena.tools.launch.inprocess import play_in_process
-from arena.tools.review import replay, review
 
 CFG = MatchConfig(seed=11, half_time=4.0, link="congested-wifi")
 
@@ -400,24 +400,24 @@ def test_a_crafted_recording_is_a_one_line_error_in_every_review_mode(recorded, 
         assert field in err[0], err
 
 
-def test_the_recorder_waits_for_a_gone_peer_from_when_its_token_vanished(tmp_path, monkeypatch):
+def test_the_recorder_waits_for_a_gone_peer_from_when_its_token_vanished(tmp_path):
     """A peer that crashed mid-match gets GONE_GRACE_S from its token's vanishing, not from when every
     peer listed before it had finished: a recorded match with a crash used to end 2 s late."""
     from arena.processes import recorder
+    from arena.runtime.clock import ManualClock
     from arena.runtime.config import ProcessId
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
 
-    now = [100.0]
-    monkeypatch.setattr(recorder.time, "monotonic", lambda: now[0])
+    clock = ManualClock(100.0)
     cfg = CFG.replace(tap=True)
     node = recorder.RecorderNode(ProcessId("recorder"), cfg, MemoryTransport(MemoryBus()), Keys("t"),
-                                 path=str(tmp_path / "r.mcap"))  # fmt: skip
+                                 path=str(tmp_path / "r.mcap"), clock=clock)  # fmt: skip
     crashed = "robot/b/1"
     assert node.peers.index(crashed) < len(node.peers) - 1, "a peer listed before others"
     node.gone.add(crashed)
     assert not node._finished()
-    now[0] += recorder.GONE_GRACE_S  # the match plays on meanwhile; then every other peer is done
+    clock.advance(recorder.GONE_GRACE_S)  # the match plays on meanwhile; then every other peer is done
     node.finals.update(p for p in node.peers if p != crashed)
     node.summaries.update((p, object()) for p in node.peers if p != crashed)
     assert node._finished(), "its grace ran while the match played"

@@ -6,8 +6,8 @@ import json
 
 import zenoh
 
+from arena.match.launcher import relay_safe
 from arena.runtime.credentials import Secrets, load_fragment, new_zid
-from arena.tools.launch.launcher import relay_safe
 
 NAMES = ["engine", "referee", "basestation/a", "basestation/b", "robot/a/0", "robot/b/0"]
 
@@ -71,8 +71,8 @@ def test_a_secure_router_opens_with_the_viewers_drop_rule(tmp_path):
 
 def test_a_standalone_secure_router_serves_the_viewer_it_wrote_credentials_for_with_drop(tmp_path):
     """`arena run router --credentials DIR` (compose): the same rule, naming the id in DIR/viewer.json5."""
+    from arena.match.router import secure_router
     from arena.runtime.session import NetConfig
-    from arena.tools.launch.router import secure_router
 
     net = secure_router(
         "m1", NetConfig(mode="router", listen=(f"unixsock-stream/{tmp_path}/r.sock",)), str(tmp_path), tmp_path

@@ -8,9 +8,9 @@ import re
 import msgspec
 
 from arena.recording.reader import Recording
+from arena.review.replay_page import write_page
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
-from arena.tools.review.replay_page import write_page
 
 
 def test_a_full_match_page_is_under_the_5_mb_budget(tmp_path):

@@ -1,4 +1,4 @@
-"""The review GIF (tools/review/animation.py): grass, every robot in its own colour, a frame per half second of play."""
+"""The review GIF (review/animation.py): grass, every robot in its own colour, a frame per half second of play."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import numpy as np
 from PIL import Image
 
 from arena.recording.analysis.timeline import last_mark, score_at, timeline
+from arena.review import animation
+from arena.review.plots import robot_colour
+from arena.review.review import _draw_field
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
-from arena.tools.review import animation
-from arena.tools.review.plots import robot_colour
-from arena.tools.review.review import _draw_field
 
 
 def _match(cfg: MatchConfig, ticks: int = 60, robots: int = 3):

@@ -1,6 +1,6 @@
 """Twenty whole 2 x 60 s chase-and-shoot matches under the rules (issue 3 acceptance; opt-in: -m slow).
 
-About a minute on two cores: the matches run in-process (tools/experiments/facts.py, measured by arena.recording.analysis),
+About a minute on two cores: the matches run in-process (experiments/facts.py, measured by arena.recording.analysis),
 in spawned worker processes.
 """
 
@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
+from arena.experiments.facts import many
 from arena.runtime.config import MatchConfig
 from arena.schemas.vocabulary import RESTARTS
-from arena.tools.experiments.facts import many
 
 SEEDS = range(20)
 REFEREE_LAG = 0.5  # [s] from the engine's event to the referee's command, with margin

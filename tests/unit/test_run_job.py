@@ -6,8 +6,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from arena.match.run import Job, run_job
 from arena.runtime.config import ProcessId
-from arena.tools.launch.run import Job, run_job
 
 
 def parsed(job: Job) -> Job:
@@ -68,6 +68,6 @@ def test_every_flag_survives_the_command_line():
 
 
 def test_a_job_crosses_to_a_zygote_child_unchanged():
-    """The zygote gets the job as JSON (tools/launch/zygote.py)."""
+    """The zygote gets the job as JSON (match/zygote.py)."""
     job = run_job(ProcessId("robot", "b", 2), "m", "tcp/127.0.0.1:7447", "/c.json", credentials="/k")
     assert msgspec.json.decode(msgspec.json.encode(msgspec.to_builtins(job)), type=Job) == job

@@ -1,6 +1,6 @@
 """Control as messages: teleports and referee overrides applied at a tick, inside the digest.
 
-processes/director.py (the engine's share), rules/referee_box.py `Forced` (the
+sim/director.py (the engine's share), rules/referee_box.py `Forced` (the
 referee's); played in process, where the digests are those of real processes.
 """
 
@@ -11,7 +11,7 @@ import math
 import msgspec
 import pytest
 
-from arena.processes.director import referee_steps
+from arena.match.inprocess import play_in_process
 from arena.rules.referee_box import Forced, RefereeState, Rules, process
 from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
 from arena.schemas.messages import (
@@ -23,7 +23,7 @@ from arena.schemas.messages import (
     TeleportRobot,
     World,
 )
-from arena.tools.launch.inprocess import play_in_process
+from arena.sim.director import referee_steps
 
 
 def play(steps, ticks=60, stage="FIRST_HALF", seed=3, **kw):

@@ -36,7 +36,7 @@ def test_robot_a1_puts_only_on_its_cmd_and_report():
         "ack/robot/a/1",
     }
     # its liveliness, and the tokens that announce its long lockstep waits (runtime/drivers.py Reactor)
-    # ... the token that holds its identity (one process per identity: tools/launch/claims.py), and the
+    # ... the token that holds its identity (one process per identity: match/claims.py), and the
     # tokens that say it saw forged or conflicting frames on a key (the launcher prints them)
     assert _rel(perms["liveliness_token/ingress"]) == {
         "alive/robot/a/1",

@@ -1,4 +1,4 @@
-"""The pentanomial SPRT of `arena experiment compare` (tools/experiments/sprt.py) against
+"""The pentanomial SPRT of `arena experiment compare` (experiments/sprt.py) against
 numbers published by others: fishtest's LLRs of real Stockfish tests and an OpenBench Elo line."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from arena.tools.experiments import sprt
+from arena.experiments import sprt
 
 # fishtest's own results lines (normalised Elo bounds), as its database printed them in
 # https://github.com/official-stockfish/fishtest/pull/2088: LLR, bounds and Ptnml(0-2).

@@ -16,7 +16,7 @@ def test_a_lone_router_does_not_sleep_before_it_starts():
 
 
 def test_bench_throughput_reports_both_start_ups_with_their_definitions():
-    from arena.tools.experiments import throughput
+    from arena.experiments import throughput
 
     def run(rtf, command, play_match):
         return {
@@ -43,7 +43,7 @@ def test_a_ctrl_c_inside_the_starters_close_does_not_make_the_next_close_fail(mo
 
     import pytest
 
-    from arena.tools.launch import forkstart
+    from arena.match import forkstart
 
     starter = forkstart.Starter.__new__(forkstart.Starter)
     starter._go_r, starter._go_w = fds = os.pipe()

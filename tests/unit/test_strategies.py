@@ -92,7 +92,7 @@ def test_a_plugin_entry_point_is_found_and_plays(monkeypatch):
         assert registry.resolve_name("cr") == "creep"
         assert registry.get("creep") is PLUGIN
         assert registry.resolve_name("AD") == "advance-dynamic"  # built-ins still there
-        from arena.tools.launch.inprocess import play_in_process
+        from arena.match.inprocess import play_in_process
 
         summaries, _ = play_in_process(MatchConfig(seed=2, home="creep", away="BS", half_time=1.0), watch=())
         assert [e["command"] for e in summaries["referee"].extra["log"][-3:]] == ["END_GAME", "PARK", "GAMEOVER"]

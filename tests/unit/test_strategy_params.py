@@ -10,12 +10,12 @@ import random
 import msgspec
 import pytest
 
+from arena.match import play
 from arena.runtime import matchfile
 from arena.runtime.config import ConfigError, MatchConfig
 from arena.strategies import conformance, registry
 from arena.strategies.base import Param, RobotContext, Strategy, TeamContext, check_values
 from arena.strategies.iris import IrisParams, tunable
-from arena.tools.launch.inprocess import play_match
 from tests.unit.test_strategies import _example_plugin
 
 
@@ -128,15 +128,6 @@ def test_param_flag_values_read_as_toml_scalars(text, want):
     assert registry.parse_param(text) == want
 
 
-def test_the_tournament_argv_gives_each_value_back_with_its_type():
-    from arena.tools.experiments.matches import match_argv
-
-    cfg = MatchConfig(home="advance-dynamic", params={"a": {"kick_speed": 7.0, "navigator": "f-sfm"}})
-    argv = match_argv(cfg, "inprocess")
-    given = [argv[i + 1] for i, a in enumerate(argv) if a == "--param"]
-    assert [registry.parse_param(g) for g in given] == [("a", "kick_speed", 7.0), ("a", "navigator", "f-sfm")]
-
-
 def _toy(params: tuple[Param, ...]) -> Strategy:
     base = registry.get("chase")
     return dataclasses.replace(base, params=params)
@@ -192,9 +183,9 @@ def test_the_example_plugin_declares_and_plays_its_parameters():
 
 def test_a_value_given_changes_the_digest_and_none_given_keeps_it():
     cfg = MatchConfig(home="advance-dynamic", away="basic-static", half_time=30.0, seed=1)
-    plain = play_match(cfg)
-    defaults = play_match(cfg.replace(params={"a": {"kick_speed": 8.0, "keeper_gain": 0.0}}))
-    slower = play_match(cfg.replace(params={"a": {"kick_speed": 6.0}}))
+    plain = play(cfg)
+    defaults = play(cfg.replace(params={"a": {"kick_speed": 8.0, "keeper_gain": 0.0}}))
+    slower = play(cfg.replace(params={"a": {"kick_speed": 6.0}}))
     assert defaults.digest == plain.digest  # the defaults, given, play as before
     assert slower.digest != plain.digest
     assert slower.params == {"a": {"kick_speed": 6.0}} and plain.params == {}

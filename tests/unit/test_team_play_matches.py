@@ -1,7 +1,7 @@
 """Whole matches of the paper's strategies look like soccer (issue 4; opt-in: -m slow).
 
 About a minute on two cores: 10 seeds of 2 x 60 s AD vs BS and of BS vs BS, in-process
-(tools/experiments/facts.py, measured by arena.recording.analysis), in two worker processes. The numbers these bounds come from are
+(experiments/facts.py, measured by arena.recording.analysis), in two worker processes. The numbers these bounds come from are
 in docs/strategies.md ("Measured"); the bounds leave room for other seeds, not for
 another kind of play.
 """
@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.experiments.facts import many
 from arena.runtime.config import MatchConfig
-from arena.tools.experiments.facts import many
 
 SEEDS = range(10)
 

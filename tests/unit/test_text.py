@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import subprocess
 import sys
 
+from msgspec.structs import replace
 from rich.console import Console
 
-from arena.tools.review import report
+from arena.match import MatchResult, play
+from arena.match.result import LinkStats
+from arena.review import report
+from arena.runtime.config import MatchConfig
 from tests.integration.helpers import arena_in_process
 
 
@@ -16,26 +21,24 @@ def arena(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "arena", *args], capture_output=True, text=True, timeout=120)
 
 
-def match_result() -> dict:
-    """The least of `arena match --json` that `report.print_match` reads."""
-    return {
-        "home": "basic-static",
-        "away": "chase",
-        "score": [1, 0],
-        "seed": 7,
-        "link": "wifi",
-        "sim_seconds": 2.0,
-        "play_wall_seconds": 1.0,
-        "rtf": 2.0,
-        "wall_seconds": 1.5,
-        "digest": "0" * 32,
-        "ticks": 100,
-        "links": {"wifi": {"sent": 10, "dropped": 1, "drop_rate": 0.1, "delay_ms_mean": 3.0, "delay_ms_p95": 5.0}},
-        "distance_m": {"a/1": 12.5},
-        "events": {},
-        "rejected": 0,
-        "dead": [],
-    }
+@functools.cache
+def played() -> MatchResult:
+    return play(MatchConfig(half_time=0.2))
+
+
+def match_result() -> MatchResult:
+    """A match's result with the values `report.print_match` is checked on."""
+    return replace(
+        played(),
+        home="basic-static",
+        away="chase",
+        score=[1, 0],
+        seed=7,
+        link="wifi",
+        links={"wifi": LinkStats(sent=10, dropped=1, drop_rate=0.1, delay_ms_mean=3.0, delay_ms_p95=5.0)},
+        distance_m={"a/1": 12.5},
+        events={},
+    )
 
 
 def test_units_in_table_headers_survive_rich():
@@ -49,14 +52,16 @@ def test_units_in_table_headers_survive_rich():
 def test_a_recorder_that_failed_is_reported_not_a_crash():
     console = Console(record=True, width=200)
     why = "the recorder failed: exited with code 2"
-    report.print_match({**match_result(), "recording": {"path": "/x/m.mcap", "complete": False, "error": why}}, console)
+    report.print_match(
+        replace(match_result(), recording={"path": "/x/m.mcap", "complete": False, "error": why}), console
+    )
     assert f"not recorded: {why} (/x/m.mcap)" in console.export_text()
 
 
 def test_a_refbox_that_never_answered_is_said():
     console = Console(record=True, width=200)
     follow = {"endpoint": "10.0.0.9:28097", "connected": False, "applied": 0, "ignored": {}, "errors": 0}
-    report.print_match({**match_result(), "refbox_follow": follow}, console)
+    report.print_match(replace(match_result(), refbox_follow=follow), console)
     assert "refbox-follow 10.0.0.9:28097: never connected; 0 commands applied" in console.export_text()
 
 

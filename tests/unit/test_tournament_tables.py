@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from arena.tools.experiments.fixtures import Result, schedule
-from arena.tools.experiments.ratings import bradley_terry, coverage, ratings, replay_odds, standings
-from arena.tools.experiments.tournament_report import charts, print_summary, report, table1_rows
+from arena.experiments.fixtures import Result, schedule
+from arena.experiments.ratings import bradley_terry, coverage, ratings, replay_odds, standings
+from arena.experiments.tournament_report import charts, print_summary, report, table1_rows
 
 AD, AS, BD, BS = "advance-dynamic", "advance-static", "basic-dynamic", "basic-static"
 
@@ -143,13 +143,17 @@ def test_table1_lists_each_pairings_score_first_named_team_first():
 
 
 def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_path):
-    from arena.tools.experiments.fixtures import void_reason
-    from arena.tools.experiments.tournament_report import report
+    from msgspec.structs import replace
 
-    assert void_reason({"outcome": "void", "outcome_reasons": ["referee exited with code -9 (SIGKILL)"]}) == (
-        "void: referee exited with code -9 (SIGKILL)"
-    )
-    assert void_reason({"outcome": "completed_with_faults"}) == "" and void_reason({"score": [1, 0]}) == ""
+    from arena.experiments.fixtures import void_reason
+    from arena.experiments.tournament_report import report
+    from arena.match import play
+    from arena.runtime.config import MatchConfig
+
+    played = play(MatchConfig(half_time=0.2))
+    void = replace(played, outcome="void", void=True, outcome_reasons=["referee exited with code -9 (SIGKILL)"])
+    assert void_reason(void) == "void: referee exited with code -9 (SIGKILL)"
+    assert void_reason(replace(played, outcome="completed_with_faults")) == "" and void_reason(played) == ""
     faulty = match(AD, BS, 2, 1)
     faulty.faults = [{"process": "robot/b/1", "tick": 1500, "reason": "exited with code -9 (SIGKILL)"}]
     summary = report([faulty], [AD, BS], 1, tmp_path, 1.0, 0)

@@ -7,8 +7,8 @@ import random
 
 import pytest
 
+from arena.experiments import spsa, tune
 from arena.strategies.base import Param
-from arena.tools.experiments import spsa, tune
 from tests.integration.helpers import arena_in_process
 
 

@@ -7,12 +7,12 @@ import dataclasses
 
 import pytest
 
+from arena.match import run as run_module
+from arena.match.run import Job, start
+from arena.match.supervise import supervision_deadline
 from arena.runtime import matchfile
 from arena.runtime.config import ConfigError, MatchConfig, TimingParams
 from arena.runtime.session import NetConfig
-from arena.tools.launch import run as run_module
-from arena.tools.launch.run import Job, start
-from arena.tools.launch.supervise import supervision_deadline
 
 
 def test_the_defaults_are_a_6_s_lease_and_6_and_10_s_of_grace():

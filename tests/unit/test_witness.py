@@ -1,4 +1,4 @@
-"""The launcher's digest check of an external process (tools/launch/witness.py), and the digest layout the README gives."""
+"""The launcher's digest check of an external process (match/witness.py), and the digest layout the README gives."""
 
 from __future__ import annotations
 
@@ -6,10 +6,10 @@ import hashlib
 
 import msgspec
 
+from arena.match.witness import Witness, digest_update
 from arena.runtime.lockstep import Outbound
 from arena.schemas.keys import DEFAULT_PERIODS, Keys
 from arena.schemas.messages import Cmd, Pose, Report
-from arena.tools.launch.witness import Witness, digest_update
 
 PERIODS = dict(DEFAULT_PERIODS)
 

@@ -1,0 +1,3 @@
+from arena.match.child import main
+
+raise SystemExit(main())
