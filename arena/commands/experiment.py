@@ -9,6 +9,7 @@ import json
 import sys
 
 from arena.commands._common import add_command
+from arena.commands._match_flags import add_match_flags
 from arena.commands._tune import add_tune_parser, run_tune
 from arena.runtime.config import ConfigError
 
@@ -81,14 +82,7 @@ def add_parser(sub) -> None:
     c.add_argument("--beta", type=float, default=0.05, metavar="P", help="false negative rate (0.05)")
     c.add_argument("--max-pairs", type=int, default=200, metavar="N", help="stop undecided after N pairs (200)")
     c.add_argument("--first-seed", type=int, default=0, metavar="S", help="pairs play seeds S, S+1, ... (0)")
-    c.add_argument("--config", dest="config_file", metavar="FILE.toml", help="every match's configuration file")
-    c.add_argument("--half-time", type=float, default=None, metavar="SECONDS", help="simulated half length [s]")
-    c.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team (3)")
-    c.add_argument("--link", default=None, metavar="PRESET", help="link preset (ideal)")
-    c.add_argument(
-        "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
-    )
-    c.add_argument("--perception-latency", type=int, default=None, metavar="TICKS", help="every match's (3)")
+    add_match_flags(c, seed=False, teams=False, config=True)  # every match's: --config, --half-time, links, ...
     c.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     _ray_flag(c)
     c.add_argument("--json", action="store_true", help="print the result as one JSON object")
@@ -135,9 +129,6 @@ def _compare(args: argparse.Namespace) -> int:
     from arena.experiments import compare
     from arena.strategies import registry
 
-    if args.half_time is not None and not 0 < args.half_time <= 3600:
-        raise ConfigError(f"--half-time must be in (0, 3600] s, got {args.half_time}")
-    args.home = args.away = None
     base = match_config(args, seed=False)
     opponents = [registry.resolve_name(o) for o in args.opponents.split(",") if o.strip()]
     opts = compare.CompareOptions(
