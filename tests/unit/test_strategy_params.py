@@ -190,3 +190,14 @@ def test_a_value_given_changes_the_digest_and_none_given_keeps_it():
     assert slower.digest != plain.digest
     assert slower.params == {"a": {"kick_speed": 6.0}} and plain.params == {}
     assert json.loads(json.dumps(slower.to_dict()))["params"] == {"a": {"kick_speed": 6.0}}
+
+
+def test_the_recording_says_which_values_played(tmp_path):
+    from mcap.reader import make_reader
+
+    path = tmp_path / "m.mcap"
+    cfg = MatchConfig(home="advance-dynamic", half_time=1.0, params={"a": {"kick_speed": 6.5}})
+    play(cfg, record=str(path))
+    with open(path, "rb") as fh:
+        configs = [json.loads(m.metadata["config"]) for m in make_reader(fh).iter_metadata() if "config" in m.metadata]
+    assert configs and configs[0]["params"] == {"a": {"kick_speed": 6.5}}
