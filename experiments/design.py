@@ -9,7 +9,8 @@ a file too large or not a regular file) is a `ConfigError` of one line that name
 
 A factor's path is spelled as in a match configuration file (`arena config --print`):
 `home`, `half_time`, `links.preset`, `links.wifi.latency_ms`, `rules.setpiece_distance`,
-`timing.perception_latency`, `params.a.<name>`. It is set on the configuration's dictionary
+`timing.perception_latency`, `params.a.<name>` (`params.*.<name>`: both teams, a parameter of the model
+every strategy shares). It is set on the configuration's dictionary
 (`MatchConfig.to_dict()`) before `MatchConfig.from_dict` validates it, so a field added to
 `MatchConfig` is a factor without a change here; a dictionary-valued field (`link_overrides`,
 `params`) takes new keys as deep as its type nests.
@@ -189,12 +190,30 @@ def load(path: str) -> Experiment:
     )
     exp.cells = cells(exp)
     exp.configs = [cell_config(base, cell, f"{path}: cell {i}") for i, cell in enumerate(exp.cells)]
+    _check_params(exp, path)
     total = len(exp.matches())
     if total == 0:
         raise ConfigError(f"{path}: no match to play (every opponent is the cell's own strategy)")
     if total > MAX_MATCHES:
         raise ConfigError(f"{path}: {total} matches; an experiment plays at most {MAX_MATCHES}")
     return exp
+
+
+def _check_params(exp: Experiment, path: str) -> None:
+    """Every strategy parameter a cell sets is one its strategy declares, of its type and range (on
+    each side it plays, against each opponent): said before a match is played, naming the cell."""
+    from arena.strategies import registry
+
+    seen = set()
+    for m in exp.matches():
+        key = (m["cell"], m["opponent"], m["team"])
+        if key in seen or not exp.configs[m["cell"]].params:
+            continue
+        seen.add(key)
+        try:
+            registry.check_params(exp.match_config(m))
+        except ConfigError as exc:
+            raise ConfigError(f"{path}: cell {m['cell']} ({exp.cells[m['cell']]}): {exc}") from None
 
 
 def _table(data: dict, key: str, path: str) -> dict:
@@ -309,6 +328,10 @@ def _resolve(path_text: str, tree: dict, where: str) -> tuple[list[str], bool]:
 def set_path(tree: dict, path_text: str, value: Any, where: str) -> None:
     """Set `path_text` (as the file spells it) to `value` in a `MatchConfig.to_dict()` tree, type-checked."""
     parts, is_open = _resolve(path_text, tree, where)
+    if parts[0] == "params" and parts[1] == "*":  # the model's: both teams
+        for team in ("a", "b"):
+            set_path(tree, f"params.{team}.{parts[2]}", value, where)
+        return
     node = tree
     for p in parts[:-1]:
         node = node.setdefault(p, {})

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arena.experiments import experiment_standings
 from arena.experiments.design import Experiment
 from arena.experiments.fixtures import write_atomic
 
@@ -111,10 +112,15 @@ def write(exp: Experiment, rows: list[dict], out: Path) -> dict:
     (out / "rows.csv.tmp").replace(out / "rows.csv")
     write_atomic(out / "rows.json", json.dumps(rows, indent=1))
     summary = summarise(exp, rows)
+    rounds = experiment_standings.build(exp, rows)  # a round robin per setting: Table 2
+    if rounds:
+        summary["standings"] = rounds
     write_atomic(out / "summary.json", json.dumps(summary, indent=1))
     plots = plot_all(exp, summary, out / "plots") if rows else []
-    write_atomic(out / "report.md", report(exp, summary, plots))
-    summary["plots"] = [str(p) for p in plots]
+    text = report(exp, summary, plots) + "\n".join(experiment_standings.markdown(rounds)) + ("\n" if rounds else "")
+    write_atomic(out / "report.md", text)
+    table2 = experiment_standings.plot(rounds, out / "plots")
+    summary["plots"] = [str(p) for p in plots] + ([str(table2)] if table2 else [])
     return summary
 
 

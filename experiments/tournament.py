@@ -39,10 +39,11 @@ BINDING = (
     "link_overrides",
     "perception_latency",
     "config",
+    "params",
     "seed",
 )
 # What a settings.json written before a binding setting existed was played with.
-LEGACY = {"perception_latency": 0, "config": {}}
+LEGACY = {"perception_latency": 0, "config": {}, "params": {}}
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,7 @@ class TournamentOptions:
 
     strategies: tuple[str, ...]  # resolved names, in the order given
     base: MatchConfig = field(default_factory=MatchConfig)
+    params: tuple[tuple[str, str, object], ...] = ()  # (strategy, name, value), checked: --param STRATEGY.NAME=V
     legs: int = 10
     seed: int = 0  # the tournament's: the matches' seeds derive from it
     jobs: int = 0  # 0: one per core
@@ -63,8 +65,18 @@ class TournamentOptions:
     ray_runtime_env: str | None = None  # JSON text
 
     def match_config(self, seed: int, home: str, away: str) -> MatchConfig:
-        """One fixture's match: the base configuration with its seed and teams."""
-        return self.base.replace(seed=seed, home=home, away=away)
+        """One fixture's match: the base configuration with its seed and teams, each team the parameter
+        values of the strategy it plays."""
+        by = self.params_by_strategy()
+        params = {**self.base.params, **{t: dict(by[s]) for t, s in (("a", home), ("b", away)) if s in by}}
+        return self.base.replace(seed=seed, home=home, away=away, params=params)
+
+    def params_by_strategy(self) -> dict[str, dict[str, object]]:
+        """Strategy -> its parameter values (--param), whichever side it plays."""
+        out: dict[str, dict[str, object]] = {}
+        for strategy, name, value in self.params:
+            out.setdefault(strategy, {})[name] = value
+        return out
 
 
 # Set per fixture, or recorded by settings() on their own: not part of its "config".
@@ -106,6 +118,7 @@ def settings(opts: TournamentOptions) -> dict:
         "link_overrides": base.link_overrides,
         "perception_latency": base.timing.perception_latency,
         "config": config_changes(base),
+        "params": opts.params_by_strategy(),
         "seed": opts.seed,
         "engine": opts.engine,
         "version": package_version(),
@@ -127,7 +140,12 @@ def check_resume(out: Path, now: dict) -> None:
         before = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--resume: cannot read {path}: {exc}") from None
-    flag = {"link_overrides": "link-param", "half_time": "half-time", "perception_latency": "perception-latency"}
+    flag = {
+        "link_overrides": "link-param",
+        "half_time": "half-time",
+        "perception_latency": "perception-latency",
+        "params": "param",
+    }
     diffs = [
         f"--{flag.get(k, k)} {show_value(before.get(k, LEGACY.get(k)))} there, {show_value(now[k])} now"
         for k in BINDING

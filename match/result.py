@@ -121,6 +121,7 @@ class MatchResult(msgspec.Struct, kw_only=True):
     half_time: float
     link: str
     realtime: bool
+    params: dict[str, dict[str, Any]]  # the strategy parameters each team was given (MatchConfig.params)
     engine: str  # processes | inprocess
     ticks: int
     sim_seconds: float
@@ -258,6 +259,7 @@ def assemble(
         half_time=cfg.half_time,
         link=cfg.link,
         realtime=cfg.realtime,
+        params=cfg.params,
         engine="processes",  # match/inprocess.py says "inprocess"
         ticks=ticks,
         sim_seconds=round(sim_seconds, 3),

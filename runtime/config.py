@@ -30,6 +30,7 @@ MAX_DT = 0.1  # [s] a control tick of at most 100 ms (10 Hz): slower is no robot
 MAX_SUBSTEPS = 100  # physics steps per tick
 MAX_PERIOD_S = 1.0  # [s] the Wi-Fi, referee and world periods: slower plays no recognisable match
 MIN_LEASE, MAX_LEASE = 0.5, 600.0  # [s] zenoh's keep-alive goes out every quarter lease: not faster than 125 ms
+ParamValue = bool | int | float | str  # a strategy parameter's value (MatchConfig.params)
 KINDS = ("engine", "referee", "basestation", "robot", "recorder", "refbox", "viewer")
 
 
@@ -264,6 +265,9 @@ class MatchConfig:
     tap: bool = False  # the match records: every process taps what it sends (the MCAP path is the recorder's own)
     live: int = -1  # [-] TCP port of the live viewer's Foxglove server (processes/viewer.py); -1: no viewer, 0: any
     pace: float = 0.0  # [-] lockstep with a viewer: simulated seconds per wall second; 0: as fast as it goes
+    # Strategy parameters per team ("a", "b"): name -> value, over the strategy's declared defaults
+    # (strategies/base.py `Param`; `arena strategies --params NAME`). Empty: every default, as before.
+    params: dict[str, dict[str, ParamValue]] = field(default_factory=dict)
     field: FieldParams = FieldParams()
     robot: RobotParams = RobotParams()
     ball: BallParams = BallParams()
@@ -408,10 +412,25 @@ class MatchConfig:
             raise ConfigError(f"--pace must be between 0 (unpaced) and 1000, got {self.pace}")
         if self.pace > 0 and (self.live < 0 or self.realtime):
             raise ConfigError("--pace applies to a lockstep match with --live only")
+        self._validate_params()
         for ext in self.external:
             pid = ProcessId.parse(ext)
             if pid not in self.processes():
                 raise ConfigError(f"--external {ext}: no such process in this match")
+
+    def _validate_params(self) -> None:
+        """The shape of `params`: teams a and b, names, finite scalar values. Whether the strategy declares
+        a name, its type and range are checked where strategies are known (strategies/params.py `check`)."""
+        for team, values in self.params.items():
+            if team not in TEAMS or not isinstance(values, dict):
+                raise ConfigError(f"params: {team!r} is no team; use params.a or params.b (name = value)")
+            for name, value in values.items():
+                if not isinstance(name, str) or not name.isidentifier():
+                    raise ConfigError(f"params.{team}: {name!r} is no parameter name")
+                if isinstance(value, float) and not math.isfinite(value):
+                    raise ConfigError(f"params.{team}.{name} must be finite, got {value}")
+                if not isinstance(value, bool | int | float | str):
+                    raise ConfigError(f"params.{team}.{name} must be a number, true/false or a string, got {value!r}")
 
 
 class ConfigError(ValueError):

@@ -2,9 +2,12 @@
 
 The file holds the `MatchConfig` tree a user may want to change: the match
 (seed, strategies, robots, half time), `[links]` (the preset and per-class
-overrides), and `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and
-`[timing]`. Every key is optional; a missing one keeps its default. An unknown
-key, a wrong type or a value out of range is a `ConfigError` that names the key
+overrides), `[field]`, `[robot]`, `[ball]`, `[sensor]`, `[rules]` and
+`[timing]`, and `[params.a]`/`[params.b]` (each team's strategy parameters;
+which names, types and ranges a strategy takes is checked where the
+strategies are known, `registry.check_params`). Every key is optional; a
+missing one keeps its default. An unknown key, a wrong type or a value out of
+range is a `ConfigError` that names the key
 (`field.lenght`, `robot.mass`). `dump()` writes the defaults with each key's
 unit and meaning taken from the comments in runtime/config.py, so the printed
 file documents itself. Deployment matters (real time, --external, --record,
@@ -70,7 +73,7 @@ def _known(section: str) -> dict[str, Any]:
 
 
 def _check_keys(data: dict[str, Any], where: str) -> None:
-    allowed_top = set(TOP) | set(SECTIONS) | {"links"}
+    allowed_top = set(TOP) | set(SECTIONS) | {"links", "params"}
     for key in data:
         if key not in allowed_top:
             raise ConfigError(f"{where}: unknown key {key!r} (known: {', '.join(sorted(allowed_top))})")
@@ -128,6 +131,11 @@ def to_dict(data: dict[str, Any], where: str) -> dict[str, Any]:
             raise ConfigError(f"{where}: unknown key links.{cls} (known: preset, and one table per link class)")
     if overrides:
         out["link_overrides"] = overrides
+    params = data.get("params", {})
+    if not isinstance(params, dict) or not all(isinstance(v, dict) for v in params.values()):
+        raise ConfigError(f"{where}: params must hold one table per team: [params.a] kick_speed = 7.0")
+    if params:
+        out["params"] = {team: dict(values) for team, values in params.items()}
     return out
 
 
@@ -189,6 +197,13 @@ def dump(cfg: MatchConfig | None = None) -> str:
     )
     for cls, params in sorted(cfg.link_overrides.items()):
         lines += ["", f"[links.{cls}]"] + [f"{p} = {_toml_value(v)}" for p, v in sorted(params.items())]
+    lines += [
+        "",
+        "# strategy parameters per team over the strategy's defaults (arena strategies --params NAME),",
+        "# e.g. [params.a] kick_speed = 7.0 (arena match --param a.kick_speed=7.0)",
+    ]
+    for team, values in sorted(cfg.params.items()):
+        lines += ["", f"[params.{team}]"] + [f"{p} = {_toml_value(v)}" for p, v in sorted(values.items())]
     for section in SECTIONS:
         params = getattr(cfg, section)
         notes = _comments(type(params))

@@ -19,7 +19,12 @@ robots fed synthetic senses and the team's orders.
 * `check_stop`: under STOP (and HALT-like commands) robots do not move;
 * `check_missing_inputs`: sense=None and order=None are handled;
 * `check_deterministic`: two instances built with the same seed produce the
-  same orders and commands at every step (the failure names the first step).
+  same orders and commands at every step (the failure names the first step);
+* `check_params`: the declared parameters (`Strategy.params`) are well formed
+  (unique names, a type of bool, int, float or str, the default within the
+  range), every default given explicitly plays as giving none, and with every
+  parameter at the bottom and then at the top of its range the commands are
+  still valid (`check_commands`).
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ import msgspec
 
 from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, decoder, encode
-from arena.strategies.base import RobotContext, Strategy, TeamContext
+from arena.strategies.base import Param, RobotContext, Strategy, TeamContext
 
 STOP_LIKE = ("STOP", "HALT", "END_GAME", "HALF_TIME")
 STEPS = 60  # [ticks] of the scripted match
@@ -178,7 +183,65 @@ def check_deterministic(strategy: Strategy, cfg: MatchConfig, seed: int = 1) -> 
             assert ex == ey, f"tick {k}: {name} differ between two runs with seed {seed}"
 
 
-CHECKS = (check_orders, check_commands, check_reports, check_stop, check_missing_inputs, check_deterministic)
+def _declaration(p: Param) -> None:
+    where = f"parameter {p.name!r}"
+    assert isinstance(p, Param), f"{where} is a {type(p).__name__}, not an arena Param"
+    assert p.name.isidentifier(), f"{where}: the name must be an identifier (a TOML key)"
+    assert p.type in ("bool", "int", "float", "str"), f"{where}: default {p.default!r} is not bool, int, float or str"
+    assert p.meaning, f"{where}: no meaning given"
+    if p.type in ("int", "float"):
+        assert p.low is not None and p.high is not None, f"{where}: a number needs low and high"
+        assert p.low <= p.default <= p.high, f"{where}: default {p.default} outside {p.low}..{p.high}"  # type: ignore[operator]
+    else:
+        assert p.low is None and p.high is None, f"{where}: only numbers have low and high"
+    if p.choices:
+        assert p.type == "str" and p.default in p.choices, f"{where}: default {p.default!r} not in {p.choices}"
+
+
+def _extreme(p: Param, top: bool):
+    if p.type == "int":
+        return int(p.high if top else p.low)  # type: ignore[arg-type]
+    if p.type == "float":
+        return float(p.high if top else p.low)  # type: ignore[arg-type]
+    if p.type == "bool":
+        return top
+    return p.choices[-1 if top else 0] if p.choices else p.default
+
+
+def check_params(strategy: Strategy, cfg: MatchConfig, seed: int = 1) -> None:
+    names = [p.name for p in strategy.params]
+    assert len(set(names)) == len(names), (
+        f"parameters declared twice: {sorted({n for n in names if names.count(n) > 1})}"
+    )
+    for p in strategy.params:
+        _declaration(p)
+    if not strategy.params:
+        return
+    defaults = {p.name: p.default for p in strategy.params}
+    plain = run_script(strategy, cfg, seed)
+    given = run_script(strategy, cfg.replace(params={"a": defaults, "b": defaults}), seed)
+    for (k, o1, c1, _), (_, o2, c2, _) in zip(plain, given):
+        for name, x, y in (("orders", o1, o2), ("commands", c1, c2)):
+            ex = {t: {n: encode(m) for n, m in v.items()} for t, v in x.items()}
+            ey = {t: {n: encode(m) for n, m in v.items()} for t, v in y.items()}
+            assert ex == ey, f"tick {k}: {name} differ with every parameter given its default and with none given"
+    for top in (False, True):
+        values = {p.name: _extreme(p, top) for p in strategy.params}
+        try:
+            check_commands(strategy, cfg.replace(params={"a": values, "b": values}), seed)
+        except AssertionError as exc:
+            raise AssertionError(f"every parameter at the {'top' if top else 'bottom'} of its range: {exc}") from None
+
+
+CHECKS = (
+    check_orders,
+    check_commands,
+    check_reports,
+    check_stop,
+    check_missing_inputs,
+    check_deterministic,
+    check_params,
+)
 
 
 def check_all(strategy: Strategy, cfg: MatchConfig | None = None, seed: int = 1) -> None:

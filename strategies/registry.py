@@ -5,9 +5,9 @@ from __future__ import annotations
 from functools import cache
 from pathlib import Path
 
-from arena.runtime.config import ConfigError
+from arena.runtime.config import ConfigError, MatchConfig, ParamValue
 from arena.strategies import learned, policy_file
-from arena.strategies.base import Strategy
+from arena.strategies.base import Strategy, check_values
 
 GROUP = "soccer_arena.strategies"
 
@@ -116,3 +116,43 @@ def get(name: str) -> Strategy:
         return policy_file.policy_strategy(name)
     canonical = resolve_name(name)
     return builtin_strategies().get(canonical) or all_strategies()[canonical]
+
+
+def check_params(cfg: MatchConfig) -> MatchConfig:
+    """`cfg` with its `params` checked against each team's strategy (`Strategy.params`): ConfigError, one
+    line naming the strategy's parameters, for an unknown name, a wrong type or a value out of range.
+    Returns `cfg` with each value as its parameter's type (an int given for a float is that float)."""
+    if not cfg.params:
+        return cfg
+    out = {}
+    for team, given in sorted(cfg.params.items()):
+        strategy = get(cfg.strategy_of(team))
+        try:
+            out[team] = check_values(strategy.name, strategy.params, given)
+        except ConfigError as exc:
+            raise ConfigError(f"params.{team}: {exc}") from None
+    return cfg if out == cfg.params and _same_types(out, cfg.params) else cfg.replace(params=out)
+
+
+def _same_types(a: dict, b: dict) -> bool:
+    return all(type(v) is type(b[t][k]) for t, vs in a.items() for k, v in vs.items())
+
+
+def parse_param(text: str, teams: tuple[str, ...] = ("a", "b")) -> tuple[str, str, ParamValue]:
+    """`a.kick_speed=7.0` (`--param`) as (team, name, value); the value a TOML scalar (7, 7.0, true, "f-sfm",
+    or a bare word as a string). `teams`: the prefixes accepted (a tournament takes strategy names)."""
+    import tomllib
+
+    head, sep, raw = text.partition("=")
+    team, dot, name = head.strip().partition(".")
+    if not sep or not dot or not name or not raw.strip():
+        raise ConfigError(f"--param {text!r}: use TEAM.NAME=VALUE, e.g. a.kick_speed=7.0")
+    if teams and team not in teams:
+        raise ConfigError(f"--param {text!r}: {team!r} is not one of {', '.join(teams)}")
+    try:
+        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    if not isinstance(value, bool | int | float | str):
+        raise ConfigError(f"--param {text!r}: the value must be a number, true/false or a word")
+    return team, name.strip(), value

@@ -64,6 +64,15 @@ def add_match_flags(
         metavar="CLASS.PARAM=V",
         help="override one link parameter, e.g. wifi.latency_ms=12 (repeatable)",
     )
+    if teams:  # a command without --home/--away sets a strategy's parameters its own way (tournament)
+        p.add_argument(
+            "--param",
+            action="append",
+            default=[],
+            metavar="TEAM.NAME=V",
+            help="set one of team a's or b's strategy parameters, e.g. a.kick_speed=7.0 (repeatable; "
+            "arena strategies --params NAME lists them)",
+        )
     p.add_argument(
         "--perception-latency",
         type=int,
@@ -108,9 +117,10 @@ def match_config(
     args: argparse.Namespace, realtime: bool = False, external=(), tap: bool = False, refbox=None, seed: bool = True
 ) -> MatchConfig:
     """The one place flags become a `MatchConfig`: the match flags a command has (`--home`, `--away`,
-    `--robots`, `--half-time`, `--seed`, `--link`, `--link-param`, `--perception-latency`, `--batch`,
+    `--robots`, `--half-time`, `--seed`, `--link`, `--link-param`, `--param`, `--perception-latency`, `--batch`,
     `--config FILE`) over the file's values, over the command's own defaults (`add_match_flags`) or the
-    match's, every range checked by `MatchConfig.validate`.
+    match's, every range checked by `MatchConfig.validate`, the strategy parameters by the strategies'
+    declarations (`registry.check_params`).
     A command that plays many matches gets the one they share (`seed=False`: its --seed is not a match's)."""
     from arena.runtime.links import parse_overrides, resolve
     from arena.strategies import registry
@@ -134,6 +144,10 @@ def match_config(
             merged.setdefault(cls, {}).update(ps)
         overrides = merged
     resolve(link, overrides)  # validates preset, classes and values
+    params = {team: dict(values) for team, values in base.params.items()}  # the file's, then the flags'
+    for text in given("param") or ():
+        team, name, value = registry.parse_param(text)
+        params.setdefault(team, {})[name] = value
     timing = base.timing
     if given("perception_latency") is not None:
         timing = dataclasses.replace(timing, perception_latency=args.perception_latency)
@@ -148,6 +162,7 @@ def match_config(
         half_time=given("half_time") if given("half_time") is not None else base.half_time,
         link=link,
         link_overrides=overrides,
+        params=params,
         realtime=realtime,
         tap=tap,
         **({"refbox": refbox} if refbox is not None else {}),
@@ -157,4 +172,4 @@ def match_config(
         ),
     )
     cfg.validate()
-    return cfg
+    return registry.check_params(cfg)

@@ -1,5 +1,6 @@
-"""`arena experiment`: sweeps over any match setting (`run FILE`) and "is my change better?"
-(`compare`, paired matches and a sequential test); docs/experiments.md."""
+"""`arena experiment`: sweeps over any match setting (`run FILE`), "is my change better?"
+(`compare`, paired matches and a sequential test; docs/experiments.md) and the search of a
+strategy's parameters (`tune`, arena/commands/_tune.py; docs/strategies.md, "Tuning")."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import sys
 
 from arena.commands._common import add_command
 from arena.commands._match_flags import add_match_flags
+from arena.commands._tune import add_tune_parser, run_tune
 from arena.runtime.config import ConfigError
 
 EXAMPLES = """examples:
@@ -18,6 +20,7 @@ EXAMPLES = """examples:
   arena experiment run sweep.toml --ray auto --json                         # join this node's Ray cluster
   arena experiment compare --candidate AD --baseline BS --half-time 30 --elo1 50   # SPRT: is AD better?
   arena experiment compare --candidate AD --baseline AS --opponents BD,BS --elo0 0 --elo1 10 --max-pairs 200
+  arena experiment tune --strategy AD --opponents AS,BS --params kick_speed,keeper_gain --out runs/tune-ad
 (docs/experiments.md: the experiment file key by key, and what compare prints)"""
 
 RUN_EXAMPLES = """examples:
@@ -50,8 +53,8 @@ def _ray_flag(p: argparse.ArgumentParser) -> None:
 
 
 def add_parser(sub) -> None:
-    ex = add_command(sub, "experiment", "sweeps over any match setting, and paired tests of a change", EXAMPLES)
-    what = ex.add_subparsers(dest="experiment", required=True, metavar="{run,compare}")
+    ex = add_command(sub, "experiment", "sweeps over any match setting, paired tests of a change, tuning", EXAMPLES)
+    what = ex.add_subparsers(dest="experiment", required=True, metavar="{run,compare,tune}")
     r = add_command(
         what, "run", "play an experiment file: every cell, seed and end; rows, intervals, plots", RUN_EXAMPLES
     )
@@ -83,9 +86,12 @@ def add_parser(sub) -> None:
     c.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     _ray_flag(c)
     c.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    add_tune_parser(what)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.experiment == "tune":
+        return run_tune(args)
     if args.jobs < 0:
         raise ConfigError(f"--jobs must be 0 (one per core) or more, got {args.jobs}")
     if args.ray is not None:

@@ -12,6 +12,7 @@ Fig. 6).
 One module per concern:
 
 * `params.py`: `IrisParams`, every number with its unit and reason;
+* `tunable.py`: the numbers a team may set per match (`Strategy.params`);
 * `team.py`: the base station brain `IrisTeam` (fusion, S1/S2/S3, roles);
 * `robot.py`: the robot brain `IrisRobot`, its memory and the per-order plan,
   assembled from one mixin per concern:
@@ -35,21 +36,25 @@ from arena.strategies.base import Strategy
 from arena.strategies.iris.params import IrisParams
 from arena.strategies.iris.robot import IrisRobot
 from arena.strategies.iris.team import IrisTeam
+from arena.strategies.iris.tunable import params_for, tuned
 
 __all__ = ["STRATEGIES", "IrisParams", "IrisRobot", "IrisTeam"]
 
 
 def _make(name: str, alias: str, advance: bool, dynamic: bool) -> Strategy:
     params = IrisParams(advance=advance, dynamic=dynamic)
+    declared = params_for(advance)
     kind = (
         ("advance" if advance else "basic") + " attack and defense, " + ("dynamic" if dynamic else "static") + " roles"
     )
+    # A team given no values plays `params` itself; given some, `tuned` checks them (ConfigError) and replaces.
     return Strategy(
         name=name,
-        make_team=lambda ctx: IrisTeam(ctx, params),
-        make_robot=lambda ctx: IrisRobot(ctx, params),
+        make_team=lambda ctx: IrisTeam(ctx, tuned(params, ctx.param_values(declared) if ctx.params else {})),
+        make_robot=lambda ctx: IrisRobot(ctx, tuned(params, ctx.param_values(declared) if ctx.params else {})),
         aliases=(alias,),
         description=f"{kind} (paper 2)",
+        params=declared,
     )
 
 

@@ -36,7 +36,15 @@ class KeeperMixin:
             if d_ball < (opp if opp < 1.5 else 1.5):  # min(1.5, opp)
                 return self.get_ball(tick, ball, self.goal(order))
         target, _ = S.keeper_target(ball, view.ball_vel, own_x, self.goal_half, self.p.skills)
-        return self.drive(tick, target, math.atan2(by - y, bx - x), self.p.cruise, dribbler=d_ball < 1.0, avoid=False)
+        return self.drive(
+            tick,
+            target,
+            math.atan2(by - y, bx - x),
+            self.p.cruise,
+            dribbler=d_ball < 1.0,
+            avoid=False,
+            gain=self.p.keeper_gain,
+        )
 
     def clear(self, tick: int, order: Order, ball: Vec) -> Cmd:
         """Goalkeeper or cornered defender with the ball: pass to a free teammate, else kick upfield."""

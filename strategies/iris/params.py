@@ -88,6 +88,9 @@ class IrisParams:
     skills: S.SkillParams = S.SkillParams()
     fusion: FusionParams = FusionParams()
     overlap: float = 1.0  # [m] defender/attacker areas overlap (paper 2)
+    # [1/s] the goalkeeper drives straight to its stand point at min(cruise, keeper_gain * distance);
+    # 0: at 1 m/s per metre to go (`drive` without a gain)
+    keeper_gain: float = 0.0
 
     def nav_params(self):
         if self.navigator == "f-sfm":
