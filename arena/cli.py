@@ -20,7 +20,7 @@ import sys
 
 from arena.commands import names
 from arena.commands._common import Parser
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 from arena.runtime.version import package_version
 
 _PARSERS: dict[str | None, Parser] = {}

@@ -15,9 +15,9 @@ from pathlib import Path
 from rich.markup import escape
 from rich.table import Table
 
+from arena.config import MatchConfig
 from arena.match import play, zygote
 from arena.review.console import console as make_console
-from arena.runtime.config import MatchConfig
 
 
 def bench_match(base: MatchConfig, runs: int = 3, as_json: bool = False) -> int:

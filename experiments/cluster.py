@@ -38,7 +38,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 from arena.runtime.version import PACKAGES
 
 if TYPE_CHECKING:

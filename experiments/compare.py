@@ -21,9 +21,9 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from arena.config import ConfigError, MatchConfig
 from arena.experiments.experiment import team_view
 from arena.experiments.sprt import Sprt, normalized_elo
-from arena.runtime.config import ConfigError, MatchConfig
 
 EXIT = {"accepted": 0, "rejected": 1, "": 3}
 MAX_PAIRS = 100_000

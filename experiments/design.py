@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from arena.config import ConfigError, MatchConfig
 from arena.runtime import matchfile
-from arena.runtime.config import ConfigError, MatchConfig
 
 MAX_FILE_BYTES = 1 << 20  # an experiment or base file larger than 1 MiB is refused unread
 MAX_LEVELS = 1000  # levels of one factor

@@ -21,10 +21,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from arena.config import ConfigError, MatchConfig
 from arena.experiments.design import COVERAGE, Experiment
 from arena.experiments.fixtures import write_atomic
 from arena.runtime import matchfile
-from arena.runtime.config import ConfigError, MatchConfig
 
 if TYPE_CHECKING:
     from arena.match import MatchResult

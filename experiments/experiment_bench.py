@@ -18,9 +18,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from arena.config import MatchConfig
 from arena.experiments.bench import print_metrics
 from arena.review.console import console as make_console
-from arena.runtime.config import MatchConfig
 
 TARGET = 0.05  # the runner may add at most 5 % to the matches' CPU time
 

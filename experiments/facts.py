@@ -25,10 +25,10 @@ from itertools import combinations
 
 import msgspec
 
+from arena.config import ConfigError, MatchConfig
 from arena.experiments import facts_table, pools
 from arena.match import play
 from arena.recording.analysis.facts import MatchFacts, measure
-from arena.runtime.config import ConfigError, MatchConfig
 from arena.schemas.messages import Referee, World
 
 

@@ -21,9 +21,9 @@ from arena.experiments.fixtures import Fixture, Result, void_reason, write_atomi
 from arena.match import child
 
 if TYPE_CHECKING:
+    from arena.config import MatchConfig
     from arena.experiments.tournament import TournamentOptions
     from arena.match import MatchResult
-    from arena.runtime.config import MatchConfig
 
 
 class Runner:

@@ -45,7 +45,7 @@ from arena.match import child
 from arena.review.console import console as make_console
 
 if TYPE_CHECKING:
-    from arena.runtime.config import MatchConfig
+    from arena.config import MatchConfig
 
 ENGINES = ("processes", "inprocess")
 RSOCCER = (

@@ -24,10 +24,10 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from arena.config import MatchConfig
 from arena.experiments.fixtures import Result, load_results, schedule, short, write_atomic
 from arena.experiments.matches import Runner, play_local
 from arena.experiments.tournament_report import report, show_value
-from arena.runtime.config import MatchConfig
 
 # Settings that decide what a match is: --resume refuses to mix results played with other values.
 BINDING = (
@@ -127,7 +127,7 @@ def settings(opts: TournamentOptions) -> dict:
 
 def check_resume(out: Path, now: dict) -> None:
     """ConfigError naming every setting that differs from the ones `out` was played with."""
-    from arena.runtime.config import ConfigError
+    from arena.config import ConfigError
 
     if not (out / "settings.json").exists() and not (out / "matches").is_dir():
         # Starting the whole tournament from nothing is what a mistyped --out would do without a word.

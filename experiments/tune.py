@@ -33,9 +33,9 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from arena.config import ConfigError, MatchConfig
 from arena.experiments.fixtures import write_atomic
 from arena.experiments.spsa import Gains, Space, delta, perturbed, step
-from arena.runtime.config import ConfigError, MatchConfig
 
 REMEASURE_FROM = 1_000_000  # the re-measurement's seeds start here; tuning seeds stay below
 BOOT = 2000  # bootstrap resamples of the gain's interval

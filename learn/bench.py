@@ -25,11 +25,11 @@ from pathlib import Path
 import gymnasium
 import numpy as np
 
+from arena.config import MatchConfig
 from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.single import SoccerEnv, make_vector_env
 from arena.match import play
 from arena.review.console import console as make_console
-from arena.runtime.config import MatchConfig
 
 ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  # cycled: no draw in the loop
 

@@ -21,8 +21,8 @@ from typing import Any
 
 import msgspec
 
+from arena.config import MatchConfig, ProcessId
 from arena.match import InProcess
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.coop import Task
 from arena.schemas.messages import Order, Referee, Sense, World
 from arena.strategies.base import RobotContext

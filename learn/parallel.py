@@ -39,10 +39,10 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
+from arena.config import MAX_HALF_TIME, MatchConfig, ProcessId
 from arena.learn.match import SteppedMatch
 from arena.learn.rewards import GoalReward, Outcome
 from arena.learn.views import Renderer, action_mask, state, state_space
-from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
 from arena.strategies import registry
 from arena.strategies.learned import DISCRETE, View, discrete_index, obs_fields, observe
 from arena.strategies.policy_file import save_recorded

@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from arena.config import MatchConfig
 from arena.learn.match import SteppedMatch
-from arena.runtime.config import MatchConfig
 from arena.strategies.learned import DISCRETE
 
 BALL_SPEED = 10.0  # [m/s] ball velocities are divided by this

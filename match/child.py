@@ -20,8 +20,8 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from arena.config import MatchConfig
     from arena.match.result import MatchResult
-    from arena.runtime.config import MatchConfig
 
 
 def argv(engine: str) -> list[str]:
@@ -49,9 +49,9 @@ def decode(out: str) -> MatchResult:
 
 
 def main(args: list[str] | None = None) -> int:
+    from arena.config import ConfigError, MatchConfig
     from arena.match import MatchError, faults, play
     from arena.match.engines import ENGINES
-    from arena.runtime.config import ConfigError, MatchConfig
 
     p = argparse.ArgumentParser(prog="python -m arena.match", description=__doc__.splitlines()[0])
     p.add_argument("--engine", choices=ENGINES, default="processes")

@@ -13,9 +13,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from arena.config import ProcessId
 from arena.match.result import JoinError, MatchError
 from arena.match.run import Job
-from arena.runtime.config import ProcessId
 
 __all__ = ["Child", "JoinError", "MatchError", "run_argv", "spawn", "stop_all", "stopped_on_error"]
 

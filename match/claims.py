@@ -27,7 +27,7 @@ import time
 
 import zenoh
 
-from arena.runtime.config import ConfigError, ProcessId
+from arena.config import ConfigError, ProcessId
 from arena.runtime.mac import Keyring
 from arena.schemas.keys import Keys
 

@@ -22,18 +22,18 @@ from pathlib import Path
 
 import yaml
 
+from arena.config import ConfigError, MatchConfig, ProcessId
 from arena.match import launcher
 from arena.match.children import Child, MatchError, spawn, stop_all
 from arena.match.result import MatchResult, assemble
 from arena.match.run import load_credentials
 from arena.match.supervise import Progress, open_collector, supervise
-from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.credentials import COLLECTOR_PRINCIPAL, OWNER, match_directory
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import Keys, check_match_id, process_names
 
-MAX_ROBOTS = 6  # robots per team a configuration may ask for (runtime/config.py)
+MAX_ROBOTS = 6  # robots per team a configuration may ask for (config/__init__.py)
 
 _VAR = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)(?::?-([^}]*))?\}")
 

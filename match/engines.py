@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
 if TYPE_CHECKING:
+    from arena.config import MatchConfig, ProcessId
     from arena.match.inprocess import Stepped
     from arena.match.result import MatchResult
-    from arena.runtime.config import MatchConfig, ProcessId
 
 ENGINES = ("processes", "inprocess")
 

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:

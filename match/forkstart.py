@@ -85,7 +85,7 @@ def warm() -> None:
     import msgspec
     import numpy.random  # noqa: F401
 
-    from arena.runtime.config import MatchConfig
+    from arena.config import MatchConfig
     from arena.schemas import messages
 
     try:  # only ever a head start: whatever fails here, each child does again (and reports) itself

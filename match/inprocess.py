@@ -21,10 +21,10 @@ import os
 import time
 from typing import TYPE_CHECKING
 
+from arena.config import MatchConfig, ProcessId
 from arena.match.result import MatchError
 from arena.processes import node_class
 from arena.runtime import coop
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.coop import CoopBus, NodeFailed, Task
 from arena.runtime.node import killed_at, match_heap
 from arena.runtime.transport import MemoryTransport

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import zenoh
 
+from arena.config import ProcessId
 from arena.match.children import Child, JoinError
 from arena.match.run import run_job
-from arena.runtime.config import ProcessId
 from arena.schemas.keys import Keys
 
 

@@ -21,6 +21,7 @@ import sys
 import time
 from pathlib import Path
 
+from arena.config import MatchConfig, ProcessId
 from arena.match import forkstart
 from arena.match.children import Child, MatchError, run_argv, spawn, stop_all, stopped_on_error
 from arena.match.claims import Claims
@@ -30,7 +31,6 @@ from arena.match.run import run_job
 from arena.match.supervise import Progress, open_collector, supervise, watch_spoofing
 from arena.match.witness import Witness
 from arena.runtime.acl import user_of
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.credentials import (
     OWNER,
     Secrets,

@@ -15,9 +15,9 @@ from typing import Any
 import msgspec
 from msgspec import UNSET, UnsetType
 
+from arena.config import MatchConfig, ProcessId
 from arena.match.faults import Fault
 from arena.match.faults import outcome as match_outcome
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.stats import percentile
 from arena.schemas.messages import Referee, Summary
 

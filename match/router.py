@@ -12,8 +12,8 @@ from pathlib import Path
 
 import zenoh
 
+from arena.config import ConfigError
 from arena.match.claims import Claims
-from arena.runtime.config import ConfigError
 from arena.runtime.credentials import COLLECTOR_PRINCIPAL, match_directory, secure_endpoint
 from arena.runtime.mac import Keyring
 from arena.runtime.provision import load, provision

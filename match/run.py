@@ -28,11 +28,11 @@ from pathlib import Path
 import msgspec
 import zenoh
 
+from arena.config import ConfigError, MatchConfig, ProcessId
 from arena.match.claims import hold_identity
 from arena.match.connect import why_refused
 from arena.processes import OBSERVERS, node_class
 from arena.runtime.acl import user_of
-from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.credentials import load_fragment
 from arena.runtime.drivers import Driver, Pull, WaitBoard
 from arena.runtime.mac import Keyring

@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import msgspec
 
+from arena.config import MatchConfig
 from arena.match.children import Child, MatchError
 from arena.match.faults import VOIDING, exit_reason, lapses
 from arena.match.result import Collected
 from arena.match.witness import Witness
-from arena.runtime.config import MatchConfig
 from arena.runtime.transport import ZenohTransport
 from arena.schemas.keys import SPOOFING, Keys
 from arena.schemas.messages import Referee, Summary

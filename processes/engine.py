@@ -41,10 +41,10 @@ import time
 
 import numpy as np
 
+from arena.config import TEAMS
 from arena.rules.referee_box import check_referee
 from arena.rules.setpieces import Restarts
 from arena.runtime import seeds
-from arena.runtime.config import TEAMS
 from arena.runtime.drivers import Reactor
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node, killed_at
@@ -101,7 +101,7 @@ class EngineNode(Node):
         self.ref_in = self.inp("referee", check=check_referee)
         self.sense_out = {(team, n): self.out("sense", team, n) for team, n in self.robots}
         self.sense_plan = [(r, self.sensor_rng[r]) for r in self.sense_out]
-        for ob in self.sense_out.values():  # L ticks of senses per message (runtime/config.py `frames_per_message`)
+        for ob in self.sense_out.values():  # L ticks of senses per message (config/__init__.py `frames_per_message`)
             ob.batch(cfg.timing.frames_per_message(cfg.realtime), cfg.total_ticks)
         for ib in self.cmd_in.values():
             ib.paired = True  # the robots batch their cmds on the same grid (runtime/lockstep.py `Outbound`)

@@ -47,8 +47,8 @@ from pathlib import Path
 
 import msgspec
 
+from arena.config import TEAMS, ConfigError
 from arena.recording import scene
-from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Observer
 from arena.schemas.keys import KEYS, routes, spec_of
 from arena.schemas.messages import EngineEvents, Referee, Summary, TapBatch, World

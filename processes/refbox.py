@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import time
 
+from arena.config import TEAMS
 from arena.refbox.server import BridgeServer
 from arena.rules import refbox_protocol as rp
 from arena.rules.referee_box import check_referee
-from arena.runtime.config import TEAMS
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node, StartupError
 from arena.schemas.messages import Worldstate

@@ -53,8 +53,8 @@ import msgspec
 from foxglove.messages import Log, SceneUpdate
 from foxglove.websocket import Capability, Parameter, ServerListener
 
+from arena.config import TEAMS, ConfigError
 from arena.recording import scene
-from arena.runtime.config import TEAMS, ConfigError
 from arena.runtime.node import Observer
 from arena.schemas.keys import OPERATOR_PRINCIPAL
 from arena.schemas.messages import (

@@ -21,7 +21,7 @@ from mcap.exceptions import InvalidMagic, McapError
 from mcap.records import Channel, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.config import ConfigError, MatchConfig
 from arena.runtime.userfile import json_nesting
 from arena.schemas.messages import Summary
 from arena.schemas.validate import first_problem, nonfinite

@@ -39,7 +39,7 @@ from foxglove.messages import (
     Vector3,
 )
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import EngineEvents, Referee, World
 
 SCENE_TOPIC = "/scene"

@@ -13,10 +13,10 @@ from __future__ import annotations
 import json
 import logging
 
+from arena.config import RefboxTeam
 from arena.refbox.client import RefboxClient
 from arena.rules import refbox_protocol as rp
 from arena.rules.refbox_follow import end_of_match, follow
-from arena.runtime.config import RefboxTeam
 
 
 class Follower:

@@ -34,9 +34,9 @@ import time
 from collections import Counter
 from dataclasses import dataclass, field
 
+from arena.config import RefboxParams
 from arena.refbox.follow import VIA_TEAMS
 from arena.rules import refbox_protocol as rp
-from arena.runtime.config import RefboxParams
 
 MAX_QUEUED = 1 << 20  # [bytes] per client: beyond this the client is disconnected
 MAX_ERRORS = 1000  # bad messages from one connection: then it is disconnected

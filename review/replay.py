@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 
 import msgspec
 
+from arena.config import ConfigError, ProcessId
 from arena.match import InProcess, counted
 from arena.recording.reader import Recording, RecordingError, load
-from arena.runtime.config import ConfigError, ProcessId
 from arena.runtime.coop import NodeFailed
 from arena.runtime.lockstep import BATCH_HEADS, decode_batch
 from arena.schemas.messages import KillProcess

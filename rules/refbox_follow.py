@@ -26,10 +26,10 @@ from __future__ import annotations
 
 import dataclasses
 
+from arena.config import RefboxParams
 from arena.rules import refbox_protocol as rp
 from arena.rules import setpieces as sp
 from arena.rules.referee_box import MSL_COMMANDS, TEAM_COMMANDS, RefereeState, Result, Rules, issue
-from arena.runtime.config import RefboxParams
 from arena.schemas.vocabulary import ROBOT_COMMANDS
 
 

@@ -36,8 +36,8 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from arena.runtime.config import ConfigError
-from arena.runtime.config import RefboxTeam as TeamEntry
+from arena.config import ConfigError
+from arena.config import RefboxTeam as TeamEntry
 from arena.runtime.userfile import json_nesting
 
 PORT = 28097  # the RefBox's base-station port

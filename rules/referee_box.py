@@ -43,8 +43,8 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from arena.config import TEAMS, MatchConfig
 from arena.rules import setpieces as sp
-from arena.runtime.config import TEAMS, MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee, RefereeOverride
 from arena.schemas.vocabulary import REF_COMMANDS, ROBOT_COMMANDS, SEND_OFF, SET_PIECES, STAGES, other_team
 

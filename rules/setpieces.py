@@ -4,7 +4,7 @@ robot that did not is put.
 The referee box (`referee_box.py`) takes the ball spots from here, the engine
 (`engine.py`) the distance rule and the placement, the simple strategy the
 distances. Everything is a pure function of positions and the configuration;
-the numbers are in `RulesParams` and `FieldParams` (runtime/config.py) and
+the numbers are in `RulesParams` and `FieldParams` (config/__init__.py) and
 the table of rules is docs/rules.md.
 
 Ball spots (field frame, SI units; L, W the field's length and width):
@@ -50,7 +50,7 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
-from arena.runtime.config import TEAMS, MatchConfig
+from arena.config import TEAMS, MatchConfig
 from arena.schemas.messages import RefCommand, Referee
 from arena.schemas.vocabulary import SEND_OFF, SET_PIECES, other_team
 

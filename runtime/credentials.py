@@ -223,7 +223,7 @@ def write_private(path: Path, text: str) -> None:
 
 def private_directory(directory: Path, create: bool = False) -> None:
     """`directory` must be ours and writable by nobody else (mode 0700 when made here); ConfigError if not."""
-    from arena.runtime.config import ConfigError
+    from arena.config import ConfigError
 
     try:
         if create and not directory.exists():

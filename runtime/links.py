@@ -28,7 +28,7 @@ import dataclasses
 import random
 from dataclasses import dataclass
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 LINK_CLASSES = ("sensor", "wifi", "wired")
 

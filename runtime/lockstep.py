@@ -227,7 +227,7 @@ class Outbound(Generic[M]):
     tick 1, the robot for an `order` of tick 7). A `paired` link is the other
     half of the same aligned grid (the engine's `cmd` from a robot, a robot's
     `sense`): with n <= L, nothing held on one half is due on the other
-    (runtime/config.py `frames_per_message`), and flushing there too cost
+    (config/__init__.py `frames_per_message`), and flushing there too cost
     ~5 % of a batched distributed match.
     """
 

@@ -9,7 +9,7 @@ strategies are known, `registry.check_params`). Every key is optional; a
 missing one keeps its default. An unknown key, a wrong type or a value out of
 range is a `ConfigError` that names the key
 (`field.lenght`, `robot.mass`). `dump()` writes the defaults with each key's
-unit and meaning taken from the comments in runtime/config.py, so the printed
+unit and meaning taken from the comments in config/__init__.py, so the printed
 file documents itself. Deployment matters (real time, --external, --record,
 the RefBox bridge) stay command-line flags.
 """
@@ -22,8 +22,8 @@ import math
 import re
 from typing import Any
 
+from arena.config import ConfigError, MatchConfig
 from arena.runtime import userfile
-from arena.runtime.config import ConfigError, MatchConfig
 
 TOP = ("seed", "home", "away", "robots", "half_time")
 SECTIONS = ("field", "robot", "ball", "sensor", "rules", "timing")

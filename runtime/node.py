@@ -31,9 +31,9 @@ import time
 from collections.abc import Callable, Generator, Iterator
 from typing import Any, TypeVar
 
+from arena.config import MatchConfig, ProcessId
 from arena.runtime import seeds
 from arena.runtime.clock import MONOTONIC, Clock
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.drivers import Driver, Pull, Reactor, Wait, own_cpu_s
 from arena.runtime.links import IDEAL, LinkEmulator, resolve, scheduled
 from arena.runtime.lockstep import Inbound, Latest, Outbound, Rejections, Schedule, Waits

@@ -24,8 +24,8 @@ import json
 import secrets
 from pathlib import Path
 
+from arena.config import ConfigError
 from arena.runtime.acl import principals, user_of
-from arena.runtime.config import ConfigError
 from arena.runtime.credentials import Secrets, make_tls, new_zid, private_directory, write_private
 from arena.runtime.mac import KEY_BYTES, new_key
 

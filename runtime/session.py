@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import zenoh
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 _PROTOCOLS = ("tcp", "udp", "tls", "quic", "ws", "unixsock-stream", "unixpipe", "vsock")
 

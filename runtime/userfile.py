@@ -12,7 +12,7 @@ import os
 import stat
 from itertools import accumulate
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 MAX_BYTES = 1 << 20  # [bytes] a configuration file is a few kB
 MAX_DEPTH = 16  # [levels] tables and arrays inside one another (a match configuration uses 3)

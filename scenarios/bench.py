@@ -18,9 +18,9 @@ from multiprocessing import get_context
 
 import msgspec
 
+from arena.config import ScenarioParams
 from arena.experiments.bench import print_metrics
 from arena.match import play
-from arena.runtime.config import ScenarioParams
 from arena.scenarios.library import BEHAVIOUR
 from arena.scenarios.model import build, load
 from arena.scenarios.runner import run_one

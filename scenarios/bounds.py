@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 
 MAX_TIME_LIMIT = 3600.0  # [s] simulated, one run; a match is 2 x 300 s
 MAX_BALL_SPEED = 20.0  # [m/s] horizontal, a teleported ball; the kicker's flat kick is 8 m/s

@@ -21,7 +21,7 @@ from pathlib import Path
 import msgspec
 from msgspec import Struct
 
-from arena.runtime.config import (
+from arena.config import (
     DEFAULT_PERCEPTION_LATENCY,
     ConfigError,
     MatchConfig,

@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from arena.config import ConfigError, MatchConfig, ProcessId
 from arena.rules.referee_box import TEAM_COMMANDS
-from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime.links import resolve
 from arena.scenarios.bounds import check_ball, check_control, check_region, check_robot, check_spot
 from arena.schemas.messages import (

@@ -23,7 +23,7 @@ def check_match_id(match: str) -> str:
 
 
 # The match's periods in ticks, by name. Each link's schedule names one of them;
-# the values are the defaults of runtime.config.TimingParams (which reads them
+# the values are the defaults of config.TimingParams (which reads them
 # from here), and a match's own values come from its configuration.
 DEFAULT_PERIODS: dict[str, int] = {"tick": 1, "comm": 5, "referee": 5, "world": 1}
 

@@ -29,7 +29,7 @@ from collections.abc import Callable
 
 import msgspec
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.keys import MAX_FRAME_BYTES, OPERATOR_PRINCIPAL
 from arena.schemas.messages import (
     Cmd,

@@ -37,9 +37,9 @@ from __future__ import annotations
 
 import math
 
+from arena.config import RobotParams
 from arena.navigation import diffdrive, omni3, omni4
 from arena.navigation.saturation import saturation_scale
-from arena.runtime.config import RobotParams
 from arena.schemas.messages import Cmd
 
 Matrix = tuple[tuple[float, ...], ...]

@@ -30,8 +30,8 @@ import math
 
 import numpy as np
 
+from arena.config import SensorParams
 from arena.navigation.frames import TAU
-from arena.runtime.config import SensorParams
 from arena.schemas.messages import BallSeen, Pose, RobotSeen, Sense
 from arena.sim.physics import Physics
 

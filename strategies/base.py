@@ -39,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
-from arena.runtime.config import ConfigError, MatchConfig, ParamValue
+from arena.config import ConfigError, MatchConfig, ParamValue
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, Sense
 
 

@@ -34,7 +34,7 @@ import random
 
 import msgspec
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, decoder, encode
 from arena.strategies.base import Param, RobotContext, Strategy, TeamContext
 

@@ -26,7 +26,7 @@ from typing import Any, get_args
 
 import numpy as np
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Report, Sense
 from arena.schemas.vocabulary import RefCommandName
 from arena.strategies.base import RobotContext, report_of

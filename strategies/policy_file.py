@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.config import ConfigError, MatchConfig
 from arena.strategies.base import RobotContext, Strategy, TeamContext
 from arena.strategies.learned import (
     DISCRETE,

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 from arena.strategies.learned import DISCRETE, MLPPolicy, View
 
 OPSET = 17
@@ -22,7 +22,7 @@ INSTALL = "pip install 'soccer-arena[onnx]'"
 
 def obs_size_for(robots: int) -> int:
     """The flat observation's length for a team of `robots` (schemas/README.md)."""
-    from arena.runtime.config import MatchConfig
+    from arena.config import MatchConfig
 
     return View.of(MatchConfig(robots=robots), "a", robots).size
 

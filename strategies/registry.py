@@ -5,7 +5,7 @@ from __future__ import annotations
 from functools import cache
 from pathlib import Path
 
-from arena.runtime.config import ConfigError, MatchConfig, ParamValue
+from arena.config import ConfigError, MatchConfig, ParamValue
 from arena.strategies import learned, policy_file
 from arena.strategies.base import Strategy, check_values
 

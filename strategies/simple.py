@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import math
 
+from arena.config import MatchConfig
 from arena.navigation.frames import wrap_angle
 from arena.rules import setpieces
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.schemas.vocabulary import other_team
 from arena.strategies.base import RobotContext, Strategy, TeamContext, report_of

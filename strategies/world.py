@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arena.runtime.config import SensorParams
+from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.config import ConfigError, MatchConfig
 
 
 def full_config(args: argparse.Namespace) -> tuple[MatchConfig, str]:

@@ -7,9 +7,9 @@ import argparse
 import dataclasses
 
 from arena.commands._common import seconds
-from arena.runtime.config import MAX_HALF_TIME, MatchConfig, ProcessId
+from arena.config import MAX_HALF_TIME, MatchConfig, ProcessId
 
-# The match flags' defaults where a command gives none of its own: the match's (runtime/config.py).
+# The match flags' defaults where a command gives none of its own: the match's (config/__init__.py).
 MATCH_DEFAULTS = {k: getattr(MatchConfig(), k) for k in ("seed", "home", "away", "robots", "half_time", "link")}
 
 

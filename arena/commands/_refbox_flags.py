@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 
 def add_refbox_flags(m: argparse.ArgumentParser) -> None:
@@ -70,8 +70,8 @@ def refbox_params(args: argparse.Namespace):
     """The RefBox flags of `arena match` as `RefboxParams` (None without any); bad values are a ConfigError."""
     from pathlib import Path
 
+    from arena.config import RefboxParams
     from arena.rules import refbox_protocol as rp
-    from arena.runtime.config import RefboxParams
 
     changes: dict[str, object] = {}
     try:

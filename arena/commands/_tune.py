@@ -7,7 +7,7 @@ import json
 import sys
 
 from arena.commands._common import add_command, positive_int, seconds
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 TUNE_EXAMPLES = """examples:
   arena experiment tune --strategy AD --opponents AS,BS --params kick_speed,keeper_gain --out runs/tune-ad

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from arena.commands._common import add_command
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 EXAMPLES = """examples:
   arena credentials init creds/                  # every principal of a match with up to 6 robots a team
@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
 def _principal(name: str) -> str:
     """`a/1` as `robot/a/1`, the short form `--external` takes; a principal that is no process
     (`operator`, `collector`) as given."""
-    from arena.runtime.config import ProcessId
+    from arena.config import ProcessId
 
     try:
         return str(ProcessId.parse(name))

@@ -11,7 +11,7 @@ import sys
 from arena.commands._common import add_command
 from arena.commands._match_flags import add_match_flags
 from arena.commands._tune import add_tune_parser, run_tune
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 EXAMPLES = """examples:
   arena experiment run examples/studies/wifi-latency.toml --out runs/wifi   # every cell, seed and end

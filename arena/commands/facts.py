@@ -6,7 +6,7 @@ import argparse
 
 from arena.commands._common import add_command
 from arena.commands._match_flags import add_match_flags, match_config
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 CATCH_SIGTERM = True
 STOPS_PROCESSES = "every match still playing was stopped, its worker with it"  # several matches, not one

@@ -10,7 +10,7 @@ from arena.commands._common import ENGINE_FLAG, add_command, emit_match, one_lin
 from arena.commands._live import add_live_flags, full_config
 from arena.commands._match_flags import add_match_flags, allow_pickle_flag
 from arena.commands._refbox_flags import add_refbox_flags, warn_unreachable_refbox
-from arena.runtime.config import ConfigError, MatchConfig
+from arena.config import ConfigError, MatchConfig
 
 CATCH_SIGTERM = True  # SIGTERM stops it as Ctrl-C does (exit 143)
 STOPS_PROCESSES = True  # an interruption says every process of the match was stopped

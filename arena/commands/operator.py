@@ -84,7 +84,7 @@ def _open(net, credentials: str | None):
 
 
 def run(args: argparse.Namespace) -> int:
-    from arena.runtime.config import ConfigError
+    from arena.config import ConfigError
     from arena.runtime.session import NetConfig
     from arena.schemas.keys import OPERATOR_PRINCIPAL, Keys
     from arena.schemas.messages import Operator, encode

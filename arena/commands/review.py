@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from arena.commands._common import add_command
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 CATCH_SIGTERM = True
 

@@ -7,7 +7,7 @@ import sys
 
 from arena.commands._common import add_command, seconds
 from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
-from arena.runtime.config import KINDS, ConfigError
+from arena.config import KINDS, ConfigError
 
 EXAMPLES = """examples:
   # the rest of the match was started with: arena match ... --listen tcp/0.0.0.0:7447 --no-secure --external a/1

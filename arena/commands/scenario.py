@@ -122,8 +122,8 @@ def chosen(args: argparse.Namespace) -> tuple[list, list[int]]:
     if args.record and (len(scenarios) != 1 or len(seeds) != 1):
         raise ScenarioError("--record needs one scenario (--name) and one seed (--seed)")
     if args.record:  # as arena match --record: a new file, never an existing recording overwritten
+        from arena.config import ConfigError
         from arena.match.run import record_path
-        from arena.runtime.config import ConfigError
 
         try:
             Path(args.record).expanduser().parent.mkdir(parents=True, exist_ok=True)

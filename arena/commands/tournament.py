@@ -8,7 +8,7 @@ import sys
 
 from arena.commands._common import ENGINE_FLAG, add_command, positive_int
 from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 
 EXAMPLES = """examples:
   arena tournament                                  # the paper's experiment: 4 strategies x 10 legs = 60 matches

@@ -6,9 +6,9 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from arena import config as runtime_config
+from arena.config import RobotParams
 from arena.experiments.navbench.spec import ScenarioError
-from arena.runtime import config as runtime_config
-from arena.runtime.config import RobotParams
 from arena.sim.drive import Drive
 
 
@@ -16,7 +16,7 @@ def _robot(preset: str, overrides: dict[str, Any], where: str) -> RobotParams:
     rp = getattr(runtime_config, preset, None)
     if not isinstance(rp, RobotParams):
         known = [k for k, v in vars(runtime_config).items() if isinstance(v, RobotParams)]
-        raise ScenarioError(f"{where}: unknown robot {preset!r} (presets in arena.runtime.config: {', '.join(known)})")
+        raise ScenarioError(f"{where}: unknown robot {preset!r} (presets in arena.config: {', '.join(known)})")
     rp = _override(rp, overrides, f"{where}: robot_params")
     if not (rp.size > 0 and rp.mass > 0 and rp.max_accel > 0 and rp.max_alpha > 0 and rp.max_wheel_speed > 0):
         raise ScenarioError(f"{where}: robot size, mass, max_accel, max_alpha and max_wheel_speed must be > 0")

@@ -8,6 +8,7 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from arena.config import ConfigError
 from arena.experiments.navbench.console import print_report
 from arena.experiments.navbench.loader import load
 from arena.experiments.navbench.minima import run_local_minimum
@@ -15,7 +16,6 @@ from arena.experiments.navbench.plots import write_plots
 from arena.experiments.navbench.report import Report
 from arena.experiments.navbench.spec import BenchSpec, Clock
 from arena.experiments.navbench.trials import Trial, run_trial
-from arena.runtime.config import ConfigError
 
 
 def run_bench(

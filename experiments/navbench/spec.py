@@ -8,7 +8,7 @@ from typing import Any, Literal
 
 import msgspec
 
-from arena.runtime.config import ConfigError, RobotParams
+from arena.config import ConfigError, RobotParams
 
 BUILTIN = "navbench.toml"  # package data of arena.experiments.navbench
 

@@ -10,10 +10,10 @@ from typing import Any
 
 import numpy as np
 
+from arena.config import MatchConfig, RobotParams, RulesParams, SensorParams, TimingParams
 from arena.experiments.navbench.spec import PARK_Y, Clock, Scenario, Scheme
 from arena.navigation import NAVIGATORS, pid
 from arena.navigation.frames import field_to_robot, robot_to_field
-from arena.runtime.config import MatchConfig, RobotParams, RulesParams, SensorParams, TimingParams
 from arena.runtime.seeds import derive
 from arena.schemas.messages import Cmd
 from arena.sim.drive import Drive

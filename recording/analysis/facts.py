@@ -48,9 +48,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from arena.config import MatchConfig
 from arena.recording.analysis import workload
 from arena.recording.analysis.geometry import crossing_y, footprint_overlap
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Referee, World
 from arena.schemas.vocabulary import TEAMS, other_team
 

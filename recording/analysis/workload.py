@@ -38,8 +38,8 @@ from __future__ import annotations
 
 import math
 
+from arena.config import MatchConfig
 from arena.recording.analysis.geometry import footprint_overlap
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Referee, World
 from arena.schemas.vocabulary import SEND_OFF, TEAMS
 

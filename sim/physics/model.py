@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import BallEvent, Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics.ball import BallFlight

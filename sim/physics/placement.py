@@ -6,7 +6,7 @@ import math
 
 import pymunk
 
-from arena.runtime.config import TEAMS
+from arena.config import TEAMS
 from arena.sim.physics.bodies import FENCE_RADIUS
 
 PARK_GAP = 1.0  # [m] a parked robot's centre beyond the fence

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import BallEvent
 
 DRIVEN_SPEED = 0.1  # [m/s] commanded linear speed above which a robot is trying to move

@@ -21,7 +21,7 @@ from __future__ import annotations
 import pymunk
 from pymunk import batch as pmbatch
 
-from arena.runtime.config import TEAMS, BallParams, FieldParams, RobotParams
+from arena.config import TEAMS, BallParams, FieldParams, RobotParams
 from arena.sim.physics.bodies import (
     _BALL_TYPE,
     _CAT_BALL,

@@ -13,8 +13,8 @@ import json
 import sys
 from pathlib import Path
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import MatchConfig
 
 HERE = Path(__file__).resolve().parent
 STRATS = ("basic-static", "basic-dynamic", "advance-static", "advance-dynamic", "chase")

@@ -23,8 +23,8 @@ import msgspec
 import pytest
 import zenoh
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_match
-from arena.runtime.config import MatchConfig
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
 from tests.integration.helpers import spawn, wait_for

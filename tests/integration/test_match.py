@@ -7,8 +7,8 @@ import time
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import MatchConfig
 from arena.runtime.links import PRESETS
 from tests.integration.helpers import arena_json, cmdline, descendants, spawn, wait_for
 

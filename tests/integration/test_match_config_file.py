@@ -6,8 +6,8 @@ import subprocess
 
 import pytest
 
+from arena.config import ConfigError, MatchConfig
 from arena.runtime import matchfile
-from arena.runtime.config import ConfigError, MatchConfig
 from tests.integration.helpers import ARENA, arena_in_process, arena_json
 
 

@@ -17,10 +17,10 @@ import subprocess
 import pytest
 from mcap.reader import make_reader
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_in_process
 from arena.processes.recorder import data_topics
 from arena.recording.reader import load
-from arena.runtime.config import MatchConfig
 from tests.integration.helpers import ARENA, alive, arena_json, cmdline, descendants, spawn, wait_for
 from tests.unit.test_recording import check_mismatch_at, records_in_file_order
 

@@ -32,9 +32,9 @@ import threading
 import pytest
 import zenoh
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_match
 from arena.recording.reader import load
-from arena.runtime.config import MatchConfig
 from arena.runtime.session import NetConfig, open_session
 from arena.schemas import messages as m
 from tests.integration.helpers import ARENA, descendants, free_port, wait_for

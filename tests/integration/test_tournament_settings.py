@@ -8,10 +8,10 @@ import subprocess
 
 import pytest
 
+from arena.config import ConfigError
 from arena.experiments.fixtures import Result
 from arena.experiments.tournament import TournamentOptions, check_resume, settings
 from arena.experiments.tournament_report import report
-from arena.runtime.config import ConfigError
 from tests.integration.helpers import ARENA
 
 ARGS = ("tournament", "--strategies", "BS,AD", "--legs", "1", "--half-time", "2", "--seed", "5", "--jobs", "1")

@@ -147,8 +147,8 @@ def test_a_process_with_the_engines_key_never_takes_a_strangers_configuration(tm
     """Only strangers answer: the process gives up, and says how many answers it ignored and why."""
     import pytest
 
+    from arena.config import MatchConfig
     from arena.match.run import fetch_config
-    from arena.runtime.config import MatchConfig
     from arena.runtime.mac import Keyring, new_key
     from arena.runtime.node import StartupError
     from arena.schemas.keys import Keys

@@ -14,7 +14,7 @@ from tests.integration.helpers import alive, wait_for
 PLAYER = textwrap.dedent(
     """
     import json, os, sys
-    from arena.runtime.config import MatchConfig
+    from arena.config import MatchConfig
     from arena.match import launcher, zygote
 
     z = zygote.start(ready=10)

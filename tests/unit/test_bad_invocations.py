@@ -423,8 +423,8 @@ def test_a_jobs_of_0_is_said_to_mean_the_default(capfd):
 
 def test_a_malformed_listen_is_said_before_a_process_is_forked(monkeypatch):
     """`arena match --listen foo` forked the match's ten processes, then refused the endpoint."""
+    from arena.config import MatchConfig
     from arena.match import forkstart, launcher
-    from arena.runtime.config import MatchConfig
     from arena.runtime.session import EndpointError
 
     monkeypatch.setattr(forkstart, "starter", lambda *args: pytest.fail("forked before the endpoint was checked"))

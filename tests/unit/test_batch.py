@@ -15,8 +15,8 @@ import hashlib
 import msgpack
 import pytest
 
+from arena.config import ConfigError, MatchConfig
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import ConfigError, MatchConfig
 from arena.runtime.lockstep import MAX_BATCH, Outbound
 from arena.schemas.messages import Cmd, encode
 from tests.unit.test_lockstep import KEY, Harness

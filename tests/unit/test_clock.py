@@ -69,8 +69,8 @@ def test_the_real_clock_is_time_monotonic():
 
 
 def test_the_start_barrier_gives_up_after_startup_timeout_of_its_clock_and_says_who_is_missing():
+    from arena.config import MatchConfig, ProcessId
     from arena.processes.robot import RobotNode
-    from arena.runtime.config import MatchConfig, ProcessId
     from arena.runtime.coop import Task
     from arena.runtime.node import StartupError
     from arena.runtime.transport import MemoryBus, MemoryTransport

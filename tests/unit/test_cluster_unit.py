@@ -12,9 +12,9 @@ from types import SimpleNamespace
 
 import pytest
 
+from arena.config import ConfigError
 from arena.experiments import cluster
 from arena.experiments.fixtures import Fixture
-from arena.runtime.config import ConfigError
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -70,8 +70,8 @@ def match():
     """A match's result as a task returns it (what it played is the driver's to read, not ours here)."""
     from msgspec.structs import replace
 
+    from arena.config import MatchConfig
     from arena.match import play
-    from arena.runtime.config import MatchConfig
 
     played = play(MatchConfig(half_time=0.2))
     return replace(played, score=[1, 2], distance_m={"a/1": 3.0}, rtf=20.0, digest="d" * 32, engine="processes")
@@ -102,8 +102,8 @@ def test_ray_missing_is_refused_before_anything_is_written(tmp_path, monkeypatch
     """`--ray` without Ray failed, but only after logs/, matches/ and settings.json were made."""
     import sys
 
+    from arena.config import ConfigError
     from arena.experiments import tournament
-    from arena.runtime.config import ConfigError
 
     monkeypatch.setitem(sys.modules, "ray", None)  # as if not installed
     out = tmp_path / "t"

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import ConfigError, MatchConfig, ProcessId
 from arena.runtime import seeds
-from arena.runtime.config import ConfigError, MatchConfig, ProcessId
 from arena.schemas import contract
 from arena.schemas.keys import KEYS, Keys
 from arena.strategies import registry
@@ -103,7 +103,7 @@ def test_link_timing_is_data_the_contract_and_the_nodes_read():
     """Schedules and lags live in KeySpec.timing; the contract renders them, the periods come from the config."""
     from pathlib import Path
 
-    from arena.runtime.config import TimingParams
+    from arena.config import TimingParams
     from arena.schemas.keys import KEY_BY_NAME
 
     assert TimingParams().periods() == {"tick": 1, "comm": 5, "referee": 5, "world": 1}

@@ -7,10 +7,10 @@ import threading
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.match import inprocess
 from arena.processes import node_class
 from arena.processes.robot import RobotNode
-from arena.runtime.config import MatchConfig
 
 
 class QuitsAtTick20(RobotNode):
@@ -36,7 +36,7 @@ def test_a_node_that_stops_sending_is_a_detected_deadlock_and_the_match_goes_on(
 def test_a_process_a_scenario_kills_is_dead_quietly_not_a_deadlock(caplog):
     """`arena scenario run` of the rule library printed 'deadlock: every unfinished node waits'
     and 'treating robot/a/1 as dead' for the kill step it asked for; --engine processes printed nothing."""
-    from arena.runtime.config import ScenarioParams
+    from arena.config import ScenarioParams
     from arena.schemas.messages import KillProcess, RefereeOverride, Step
 
     steps = (Step(at=0, actions=[RefereeOverride(command="START")]), Step(at=50, actions=[KillProcess("robot/b/1")]))
@@ -70,9 +70,9 @@ def test_observers_are_not_nodes_and_a_node_takes_its_driver():
     """The recorder and viewer are `Observer`s (no lockstep, no driver); a `Node` is driven by what it is given."""
     import gc
 
+    from arena.config import ProcessId
     from arena.match import run
     from arena.processes import OBSERVERS
-    from arena.runtime.config import ProcessId
     from arena.runtime.coop import CoopBus, Task
     from arena.runtime.drivers import Pull, Reactor
     from arena.runtime.node import Node, Observer

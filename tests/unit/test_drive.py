@@ -7,9 +7,9 @@ import random
 
 import pytest
 
+from arena.config import ROBOTINO, RobotParams
 from arena.navigation import omni3, omni4
 from arena.processes.engine import check_cmd
-from arena.runtime.config import ROBOTINO, RobotParams
 from arena.schemas.messages import Cmd
 from arena.sim.drive import Drive
 

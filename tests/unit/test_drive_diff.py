@@ -6,9 +6,9 @@ import math
 
 import pytest
 
+from arena.config import EPUCK, ROBOTINO, MatchConfig, RobotParams
 from arena.navigation import diffdrive
 from arena.processes.engine import check_cmd
-from arena.runtime.config import EPUCK, ROBOTINO, MatchConfig, RobotParams
 from arena.schemas.messages import Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics import Physics

@@ -7,8 +7,8 @@ import os
 
 import pytest
 
+from arena.config import ConfigError, MatchConfig
 from arena.experiments import design
-from arena.runtime.config import ConfigError, MatchConfig
 
 
 def write(tmp_path, text: str, name: str = "exp.toml") -> str:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import ConfigError
 from arena.experiments import design
-from arena.runtime.config import ConfigError
 
 
 def _file(tmp_path, factors: str, extra: str = "") -> str:

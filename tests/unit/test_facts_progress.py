@@ -3,8 +3,8 @@ the workers finish; the results come back in the order asked for."""
 
 from __future__ import annotations
 
+from arena.config import MatchConfig
 from arena.experiments.facts import many
-from arena.runtime.config import MatchConfig
 
 
 def test_one_line_per_match_and_results_in_order(capfd):

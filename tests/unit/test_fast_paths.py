@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 import random
 
+from arena.config import MatchConfig
 from arena.navigation import fsfm, pid
 from arena.navigation.frames import wrap_angle
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
 from arena.strategies.world import FusionParams, RobotView
 

@@ -7,8 +7,8 @@ import math
 import msgspec
 import pytest
 
+from arena.config import MatchConfig
 from arena.match.faults import Fault, blame, lapses, outcome
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
 from arena.schemas.validate import nonfinite, safe_default, suspect
 from arena.sim.physics import Physics

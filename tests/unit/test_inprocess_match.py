@@ -5,8 +5,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import World
 
 decode_world = msgspec.msgpack.Decoder(World).decode

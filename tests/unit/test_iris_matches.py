@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import MatchConfig
 
 
 @pytest.mark.slow

@@ -11,20 +11,21 @@ ROOT = Path(__file__).resolve().parents[2]
 
 RANK = {
     "schemas": 0,
-    "runtime": 1,
+    "config": 1,  # the match configuration, what every process plays by: over the wire's vocabulary only
     "navigation": 1,
-    "sim": 2,
-    "rules": 2,
-    "recording": 2,
-    "strategies": 3,
-    "refbox": 3,  # the RefBox protocol's sockets and threads, over the pure rules
-    "processes": 4,
-    "match": 5,  # the one way to play a match, both engines (the launcher, the in-process engine)
-    "review": 6,  # looking back at a match: review, replay, the text report, the console
-    "experiments": 7,  # many matches or measurements: tournaments, cluster, facts, benchmarks
-    "scenarios": 8,  # the scenario file, runner, pytest plugin and library: may use experiments' bench
-    "learn": 9,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
-    "arena": 10,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
+    "runtime": 2,
+    "sim": 3,
+    "rules": 3,
+    "recording": 3,
+    "strategies": 4,
+    "refbox": 4,  # the RefBox protocol's sockets and threads, over the pure rules
+    "processes": 5,
+    "match": 6,  # the one way to play a match, both engines (the launcher, the in-process engine)
+    "review": 7,  # looking back at a match: review, replay, the text report, the console
+    "experiments": 8,  # many matches or measurements: tournaments, cluster, facts, benchmarks
+    "scenarios": 9,  # the scenario file, runner, pytest plugin and library: may use experiments' bench
+    "learn": 10,  # arena.learn: the learning environments, over the in-process engine; resets from scenarios
+    "arena": 11,  # arena/cli.py, arena/commands/ and arena/__main__.py: the command line, above everything
 }
 # arena's own modules: the command line. Nothing outside arena/ may import them.
 COMMAND_LINE = {"cli", "commands", "__main__"}
@@ -102,7 +103,7 @@ def test_the_check_fails_on_a_planted_upward_import(tmp_path):
     fine = {
         "review/ok.py": "from arena.match import launcher\nfrom arena import __version__\n",
         "arena/commands/ok.py": "from arena.experiments import tournament\nfrom arena.commands import _common\n",
-        "match/same.py": "from arena.match import run\nfrom arena.runtime.config import MatchConfig\n",
+        "match/same.py": "from arena.match import run\nfrom arena.config import MatchConfig\n",
         "match/ok.py": "from arena.processes import node_class\nfrom arena.match import engines\n",
         "experiments/ok.py": "from arena.match import play\nfrom arena.review.console import console\n",
         "sim/director.py": "from arena.sim.physics import Physics\nfrom arena.schemas import messages\n",

@@ -15,9 +15,9 @@ pytest.importorskip("pettingzoo")
 from gymnasium.utils.env_checker import check_env
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
+from arena.config import ConfigError, MatchConfig
 from arena.learn import SoccerEnv, SoccerParallelEnv, make_vector_env
 from arena.match.inprocess import play_in_process
-from arena.runtime.config import ConfigError, MatchConfig
 from arena.strategies import registry
 
 SHORT = dict(home="AD", away="BS", half_time=0.6)  # 61 ticks: fast, and the kick-off is played

@@ -7,7 +7,7 @@ import statistics
 
 import pytest
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 from arena.runtime.links import PRESETS, LinkEmulator, LinkModel, parse_override, resolve
 
 

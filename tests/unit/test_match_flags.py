@@ -7,7 +7,7 @@ import pytest
 
 from arena.cli import parser
 from arena.commands._match_flags import match_config
-from arena.runtime.config import ConfigError, MatchConfig, TimingParams
+from arena.config import ConfigError, MatchConfig, TimingParams
 
 
 def config(*argv: str, seed: bool = True) -> MatchConfig:

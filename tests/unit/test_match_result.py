@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
+from arena.config import MatchConfig
 from arena.match import inprocess
 from arena.match.result import MatchResult
-from arena.runtime.config import MatchConfig
 
 
 def test_the_dict_has_the_fields_in_order_and_leaves_out_what_the_engine_did_not_set():

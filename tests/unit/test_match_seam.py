@@ -6,7 +6,7 @@ import msgspec
 import pytest
 
 from arena import match
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import World
 
 CFG = MatchConfig(seed=3, half_time=1.0)

@@ -9,8 +9,8 @@ import time
 
 import pytest
 
+from arena.config import MatchConfig, ProcessId
 from arena.runtime.clock import ManualClock
-from arena.runtime.config import MatchConfig, ProcessId
 from arena.runtime.coop import Task
 from arena.runtime.transport import MemoryBus, MemoryTransport
 from arena.schemas.keys import Keys

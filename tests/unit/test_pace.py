@@ -8,8 +8,8 @@ import threading
 
 import pytest
 
+from arena.config import ConfigError, MatchConfig
 from arena.runtime.clock import ManualClock
-from arena.runtime.config import ConfigError, MatchConfig
 from arena.runtime.pace import BEHIND_S, Pacer, WireGate
 from arena.schemas.messages import Control, encode
 from tests.integration.helpers import arena_in_process

@@ -7,7 +7,7 @@ import random
 
 import pytest
 
-from arena.runtime.config import ROBOTINO, MatchConfig
+from arena.config import ROBOTINO, MatchConfig
 from arena.schemas.messages import BallEvent, Cmd
 from arena.sim.drive import Drive
 from arena.sim.physics import PIN_TOLERANCE, Physics, wrap_angle

@@ -7,8 +7,8 @@ import math
 import numpy as np
 from matplotlib.colors import to_rgb
 
+from arena.config import MatchConfig
 from arena.review import plots
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RobotState, World
 
 CFG = MatchConfig(half_time=1.0)  # 50 ticks a half

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from arena.runtime.config import ConfigError
+from arena.config import ConfigError
 from arena.runtime.credentials import OWNER, match_directory, sweep, write_private
 from arena.runtime.provision import ROUTER_FILE, provision, rotate, show
 from arena.schemas.keys import process_names

@@ -16,6 +16,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
+from arena.config import MatchConfig
 from arena.experiments import facts
 from arena.match.inprocess import play_in_process
 from arena.processes.recorder import data_topics
@@ -23,7 +24,6 @@ from arena.recording import scene
 from arena.recording.analysis import NEEDED, analyse
 from arena.recording.reader import RecordingError, load
 from arena.review import replay, review
-from arena.runtime.config import MatchConfig
 from arena.runtime.tap import Tap
 from arena.schemas.keys import KEYS
 from arena.schemas.messages import Cmd, TapBatch
@@ -68,8 +68,8 @@ def test_tap_cuts_batches_on_tick_boundaries_with_a_watermark():
 
 @pytest.mark.parametrize("recording", [False, True])
 def test_outbound_taps_only_when_the_match_records(recording):
+    from arena.config import ProcessId
     from arena.processes.robot import RobotNode
-    from arena.runtime.config import ProcessId
     from arena.runtime.lockstep import Outbound
     from arena.runtime.tap import TappedOutbound
     from arena.runtime.transport import MemoryBus, MemoryTransport
@@ -432,9 +432,9 @@ def test_a_crafted_recording_is_a_one_line_error_in_every_review_mode(recorded, 
 def test_the_recorder_waits_for_a_gone_peer_from_when_its_token_vanished(tmp_path):
     """A peer that crashed mid-match gets GONE_GRACE_S from its token's vanishing, not from when every
     peer listed before it had finished: a recorded match with a crash used to end 2 s late."""
+    from arena.config import ProcessId
     from arena.processes import recorder
     from arena.runtime.clock import ManualClock
-    from arena.runtime.config import ProcessId
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
 

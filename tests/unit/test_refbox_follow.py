@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import MatchConfig, RefboxParams
 from arena.rules import refbox_protocol as rp
 from arena.rules.refbox_follow import follow
 from arena.rules.referee_box import RefereeState, Rules
-from arena.runtime.config import MatchConfig, RefboxParams
 
 CFG = MatchConfig(half_time=10.0)
 RULES = Rules.of(CFG)

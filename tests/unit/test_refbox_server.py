@@ -7,9 +7,9 @@ import logging
 import socket
 import time
 
+from arena.config import RefboxParams, RefboxTeam
 from arena.recording.analysis.worldstates import score_team
 from arena.refbox.server import BridgeServer
-from arena.runtime.config import RefboxParams, RefboxTeam
 from arena.schemas.messages import RobotState, World, Worldstate
 
 LOG = logging.getLogger("test.refbox")

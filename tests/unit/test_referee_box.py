@@ -9,6 +9,7 @@ import dataclasses
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.rules.referee_box import (
     Clock,
     Observed,
@@ -18,7 +19,6 @@ from arena.rules.referee_box import (
     check_referee,
     process,
 )
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallEvent, RefCommand, Referee
 
 CFG = MatchConfig(half_time=10.0)  # 500 ticks per half

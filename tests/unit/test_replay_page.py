@@ -7,9 +7,9 @@ import re
 
 import msgspec
 
+from arena.config import MatchConfig
 from arena.recording.reader import Recording
 from arena.review.replay_page import write_page
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
 
 

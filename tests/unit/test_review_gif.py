@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from arena.config import MatchConfig
 from arena.recording.analysis.timeline import last_mark, score_at, timeline
 from arena.review import animation
 from arena.review.plots import robot_colour
 from arena.review.review import _draw_field
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import RefCommand, Referee, RobotState, World
 
 

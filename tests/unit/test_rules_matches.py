@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.experiments.facts import many
-from arena.runtime.config import MatchConfig
 from arena.schemas.vocabulary import RESTARTS
 
 SEEDS = range(20)

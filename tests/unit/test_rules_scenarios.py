@@ -13,9 +13,9 @@ import math
 
 import pytest
 
+from arena.config import MatchConfig, RulesParams
 from arena.rules.referee_box import RefereeBox
 from arena.rules.setpieces import Restarts
-from arena.runtime.config import MatchConfig, RulesParams
 from arena.schemas.messages import BallEvent, Cmd, RefCommand
 from arena.sim.physics import Physics, StuckWatch
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import msgspec
 import pytest
 
+from arena.config import ProcessId
 from arena.match.run import Job, run_job
-from arena.runtime.config import ProcessId
 
 
 def parsed(job: Job) -> Job:

@@ -11,9 +11,9 @@ import math
 import msgspec
 import pytest
 
+from arena.config import ConfigError, MatchConfig, ScenarioParams
 from arena.match.inprocess import play_in_process
 from arena.rules.referee_box import Forced, RefereeState, Rules, process
-from arena.runtime.config import ConfigError, MatchConfig, ScenarioParams
 from arena.schemas.messages import (
     Condition,
     Operator,

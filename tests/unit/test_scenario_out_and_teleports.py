@@ -11,9 +11,9 @@ import math
 import msgspec
 import pytest
 
+from arena.config import MatchConfig, ScenarioParams
 from arena.match.inprocess import play_in_process
 from arena.rules.setpieces import penalty_positions
-from arena.runtime.config import MatchConfig, ScenarioParams
 from arena.scenarios import ScenarioError, load, run_one
 from arena.schemas.messages import ControlRobot, Referee, RefereeOverride, Step, TeleportBall, TeleportRobot, World
 

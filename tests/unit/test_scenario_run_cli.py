@@ -109,8 +109,8 @@ def test_ctrl_c_keeps_the_finished_runs(failing, capsys, monkeypatch):
 
 
 def test_a_substitution_recording_that_ends_mid_run_is_said(tmp_path, capsys):
+    from arena.config import MatchConfig
     from arena.match.inprocess import play_in_process
-    from arena.runtime.config import MatchConfig
 
     play_in_process(MatchConfig(seed=3, robots=2, half_time=1.0), watch=(), record=str(tmp_path / "src.mcap"))
     path = tmp_path / "sub.scenario.toml"

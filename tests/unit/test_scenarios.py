@@ -321,9 +321,9 @@ def test_the_plugin_refuses_a_seed_count_below_one(pytester, seeds):
 def test_a_substituted_team_follows_its_recorded_poses_while_the_rest_plays_live(tmp_path):
     import msgspec
 
+    from arena.config import MatchConfig
     from arena.match.inprocess import play_in_process
     from arena.recording.reader import load as read
-    from arena.runtime.config import MatchConfig
 
     play_in_process(
         MatchConfig(seed=3, home="AD", away="BS", half_time=2.0), watch=(), record=str(tmp_path / "src.mcap")

@@ -143,8 +143,8 @@ def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_
     """A Foxglove client published `/operator` and the viewer put it as is: a stranger's goal counted.
     Only a viewer started for a local operator holds the operator's key (match/launcher.py
     `local_operator`) and signs with it; any other refuses the message, counted."""
+    from arena.config import MatchConfig, ProcessId
     from arena.processes.viewer import ViewerNode
-    from arena.runtime.config import MatchConfig, ProcessId
     from arena.runtime.mac import Keyring, new_key
     from arena.runtime.transport import MemoryBus, MemoryTransport
     from arena.schemas.keys import Keys
@@ -167,8 +167,8 @@ def test_the_viewer_forwards_foxglove_operator_messages_only_with_the_operators_
 
 
 def test_only_a_viewer_started_here_on_loopback_without_secure_is_lent_the_operators_key():
+    from arena.config import MatchConfig, ProcessId
     from arena.match.launcher import local_operator
-    from arena.runtime.config import MatchConfig, ProcessId
 
     live = MatchConfig(live=8765)
     assert local_operator(live, False, "127.0.0.1", set())

@@ -10,7 +10,7 @@ import statistics
 import numpy as np
 import pytest
 
-from arena.runtime.config import MatchConfig
+from arena.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd
 from arena.sim.physics import Physics
 from arena.sim.sensors import sense

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.rules import setpieces as sp
-from arena.runtime.config import MatchConfig
 
 CFG = MatchConfig()
 F, R = CFG.field, CFG.rules

@@ -8,8 +8,8 @@ import subprocess
 import sys
 import time
 
+from arena.config import ProcessId
 from arena.match.children import Child, stop_all, stopped_on_error
-from arena.runtime.config import ProcessId
 
 
 def test_a_stopped_child_ends_on_its_sigterm_at_once_not_at_the_sigkill(tmp_path):

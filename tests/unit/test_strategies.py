@@ -10,7 +10,7 @@ from importlib import metadata
 
 import pytest
 
-from arena.runtime.config import MatchConfig, SensorParams
+from arena.config import MatchConfig, SensorParams
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RefCommand, Referee, Report, RobotSeen, Sense, TeamPose
 from arena.strategies import conformance, registry
 from arena.strategies import roles as R

@@ -10,9 +10,9 @@ import random
 import msgspec
 import pytest
 
+from arena.config import ConfigError, MatchConfig
 from arena.match import play
 from arena.runtime import matchfile
-from arena.runtime.config import ConfigError, MatchConfig
 from arena.strategies import conformance, registry
 from arena.strategies.base import Param, RobotContext, Strategy, TeamContext, check_values
 from arena.strategies.iris import IrisParams, tunable

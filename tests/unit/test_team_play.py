@@ -9,8 +9,8 @@ import random
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.navigation.frames import wrap_angle
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import BallSeen, Cmd, Order, Pose, RobotSeen, Sense, TeamPose
 from arena.sim.physics import NO_CHALLENGE_S, Physics
 from arena.strategies import registry

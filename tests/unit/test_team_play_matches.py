@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.experiments.facts import many
-from arena.runtime.config import MatchConfig
 
 SEEDS = range(10)
 

@@ -10,10 +10,10 @@ import sys
 from msgspec.structs import replace
 from rich.console import Console
 
+from arena.config import MatchConfig
 from arena.match import MatchResult, play
 from arena.match.result import LinkStats
 from arena.review import report
-from arena.runtime.config import MatchConfig
 from tests.integration.helpers import arena_in_process
 
 

@@ -145,10 +145,10 @@ def test_table1_lists_each_pairings_score_first_named_team_first():
 def test_a_void_match_is_no_result_and_a_faulty_one_counts_and_is_listed(tmp_path):
     from msgspec.structs import replace
 
+    from arena.config import MatchConfig
     from arena.experiments.fixtures import void_reason
     from arena.experiments.tournament_report import report
     from arena.match import play
-    from arena.runtime.config import MatchConfig
 
     played = play(MatchConfig(half_time=0.2))
     void = replace(played, outcome="void", void=True, outcome_reasons=["referee exited with code -9 (SIGKILL)"])

@@ -7,11 +7,11 @@ import dataclasses
 
 import pytest
 
+from arena.config import ConfigError, MatchConfig, TimingParams
 from arena.match import run as run_module
 from arena.match.run import Job, start
 from arena.match.supervise import supervision_deadline
 from arena.runtime import matchfile
-from arena.runtime.config import ConfigError, MatchConfig, TimingParams
 from arena.runtime.session import NetConfig
 
 

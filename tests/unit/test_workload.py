@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
+from arena.config import MatchConfig
 from arena.recording.analysis import workload
-from arena.runtime.config import MatchConfig
 from arena.schemas.messages import Referee, RobotState, World
 
 CFG = MatchConfig(robots=2)
