@@ -8,6 +8,9 @@ Field numbers (design.md section 7): a 12 m x 8 m playing area, 1 m run-off
 enclosed by a fence, goals 2 m wide and 1 m high. The MSL rule book's areas
 (22 m x 14 m field) are scaled down and rounded; the chosen values are listed in
 docs/field.md. The game rules' numbers (`RulesParams`) are tabled in docs/rules.md.
+
+The bottom room of the house but for the wire: may import `arena.schemas` only;
+every package above imports it.
 """
 
 from __future__ import annotations

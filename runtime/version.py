@@ -6,6 +6,7 @@ from __future__ import annotations
 # before a match (match/launcher.py) and the source a cluster's version check hashes
 # (experiments/cluster.py) cover them all. learn is hashed by path: its extra need not be installed.
 PACKAGES = (
+    "config",
     "runtime",
     "processes",
     "schemas",
