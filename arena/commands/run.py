@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from arena.commands._common import add_command, seconds
@@ -101,4 +102,16 @@ def run(args: argparse.Namespace) -> int:
         except (ConfigError, ValueError) as exc:
             print(f"arena run: error: {exc}", file=sys.stderr)
             return 2
-    return start(job, cfg)
+    from arena.runtime.session import OPENED
+
+    before, OPENED[0] = OPENED[0], False
+    code = start(job, cfg)
+    opened, OPENED[0] = OPENED[0], before or OPENED[0]
+    if code == 2 and opened:
+        # Refused after a zenoh session was open (a second identity, a wrong match): its one line is
+        # said. Leave now: at the interpreter's teardown zenoh's runtime threads can still panic
+        # ("AccessError"), and their backtrace would stand after that line.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
