@@ -175,7 +175,7 @@ def load_onnx(path, data: bytes):
     try:
         import onnxruntime as ort
     except ImportError:
-        raise ConfigError(f"policy file {path} is an ONNX model, which needs onnxruntime: {INSTALL}") from None
+        raise ConfigError(f"policy file {path}: reading an ONNX policy needs onnxruntime: {INSTALL}") from None
 
     def bad(why: str) -> ConfigError:
         return ConfigError(f"policy file {path}: {why}")
