@@ -41,6 +41,7 @@ DESIGNS = ("grid", "random", "lhs")
 ENGINES = ("inprocess", "processes")
 # Fields an experiment does not vary: the seeds are its own, the rest is deployment (arena match's flags).
 NOT_FACTORS = ("seed", "realtime", "external", "tap", "live", "pace", "refbox", "scenario")
+SWAP = {"a": "b", "b": "a"}  # a team's settings on the swapped match
 MATCH_RESPONSES = ("points", "goal_diff", "win", "draw", "loss", "goals_for", "goals_against")
 FACTS_RESPONSES = ("shots", "on_target", "saves", "blocks")  # the `arena facts` measures: the match is watched
 COVERAGE = "coverage_r"  # coverage_r0 .. coverage_r5: metres each robot of the team covered
@@ -103,11 +104,14 @@ class Experiment:
         return out
 
     def match_config(self, m: dict) -> MatchConfig:
-        """The configuration of one match of `matches()`: the cell's, with its seed and ends."""
+        """The configuration of one match of `matches()`: the cell's, with its seed and ends. With the
+        ends swapped, the team settings (`params.a`, `params.b`) swap too: they follow the strategy."""
         cfg = self.configs[m["cell"]]
         mine = cfg.home
-        home, away = (mine, m["opponent"]) if m["team"] == "a" else (m["opponent"], mine)
-        return cfg.replace(seed=m["seed"], home=home, away=away)
+        if m["team"] == "a":
+            return cfg.replace(seed=m["seed"], home=mine, away=m["opponent"])
+        params = {SWAP[team]: dict(values) for team, values in cfg.params.items()}
+        return cfg.replace(seed=m["seed"], home=m["opponent"], away=mine, params=params)
 
 
 def short_id(name: str) -> str:

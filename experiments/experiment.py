@@ -29,6 +29,7 @@ from arena.runtime import matchfile
 if TYPE_CHECKING:
     from arena.match import MatchResult
 
+SWAPPED = "-ends-swapped"  # cells/c000-ends-swapped.toml: a cell whose team settings swap with the ends
 ATTEMPTS = 2  # a match that fails is played once more, then recorded as failed
 
 
@@ -136,6 +137,9 @@ class Run:
         write_atomic(kept, source)
         for c, cfg in enumerate(self.exp.configs):
             write_atomic(out / "cells" / f"c{c:03d}.toml", matchfile.dump(cfg))
+            swapped = self.exp.match_config({"cell": c, "seed": cfg.seed, "team": "b", "opponent": cfg.away})
+            if swapped.params != cfg.params:  # team settings: on the swapped ends they are the other team's
+                write_atomic(out / "cells" / f"c{c:03d}{SWAPPED}.toml", matchfile.dump(swapped))
         if self.opts.resume:
             for m in self.matches:
                 f = out / "matches" / f"{m['id']}.json"
@@ -149,10 +153,18 @@ class Run:
         row = {"match": m["id"], "cell": f"c{m['cell']:03d}", **cell}
         row |= {"strategy": self.exp.configs[m["cell"]].home, "opponent": m["opponent"], "seed": m["seed"]}
         row |= {"team": m["team"], "team_a": cfg.home, "team_b": cfg.away, "status": "ok" if got else "failed"}
+        row["config"] = self.config_file(m)
         row |= got or {"reason": reason}
         row["attempts"] = attempts
         write_atomic(self.out / "matches" / f"{m['id']}.json", json.dumps(row))
         return row
+
+    def config_file(self, m: dict) -> str:
+        """The file (below `out`) that `arena match --config` plays this match from, with the row's seed
+        and strategies: the cell's, or on the swapped ends with team settings, the cell's swapped."""
+        cfg = self.exp.configs[m["cell"]]
+        swapped = m["team"] == "b" and self.exp.match_config(m).params != cfg.params
+        return f"cells/c{m['cell']:03d}{SWAPPED if swapped else ''}.toml"
 
     def todo(self) -> list[list[dict]]:
         """The matches still to play, grouped by configuration: in a round robin of cells, AD's match
