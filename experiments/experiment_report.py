@@ -1,5 +1,6 @@
 """What `arena experiment run` writes once its matches are in: the tidy rows (rows.csv,
-rows.json), per cell the mean of each response with its 95 % bootstrap interval
+rows.json), per cell the mean of each response with its 95 % bootstrap interval (a
+scenario's `pass`: the pass rate with its Wilson interval, as `arena scenario run` gives it)
 (summary.json), a plot per response (plots/<response>.png) and report.md.
 
 The interval is over seeds: a seed's value is its matches' mean (both ends, every
@@ -21,8 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from arena.experiments import experiment_standings
-from arena.experiments.design import Experiment
+from arena.experiments.design import PASS, Experiment
 from arena.experiments.fixtures import write_atomic
+from arena.experiments.ratings import wilson
 
 RESAMPLES = 2000
 BOOT_SEED = 20_260_101  # the bootstrap's own seed: the same intervals on every rerun
@@ -75,6 +77,9 @@ def summarise(exp: Experiment, rows: list[dict]) -> dict:
             v = np.array([by_seed[s] for s in seeds]) if full else np.array(list(by_seed.values()))
             own_idx = idx if full else rng.integers(0, max(1, len(v)), size=(RESAMPLES, max(1, len(v))))
             mean, lo, hi = bootstrap(v, own_idx)
+            if resp == PASS:  # a pass rate: the Wilson interval over the runs, as arena scenario run's
+                runs = [int(r[resp]) for r in rows if r["cell"] == name and r["status"] == "ok" and resp in r]
+                mean, (lo, hi) = (sum(runs) / len(runs) if runs else float("nan")), wilson(sum(runs), len(runs))
             out[resp] = {"mean": _r(mean), "low": _r(lo), "high": _r(hi), "seeds": len(v)}
             if full:
                 full_values[(c, resp)] = v

@@ -107,8 +107,9 @@ def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from arena.experiments import design, experiment
+    from arena.scenarios.experiment import base as scenario_base
 
-    exp = design.load(args.file)
+    exp = design.load(args.file, scenarios=scenario_base)  # base may be a scenario file
     source = Path(args.file).read_text()
     out = Path(args.out or Path(args.file).name.removesuffix(".toml"))
     opts = experiment.RunOptions(jobs=args.jobs, ray=args.ray, out=out, resume=args.resume)
