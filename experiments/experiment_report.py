@@ -230,17 +230,21 @@ def _short(v) -> str:
 def report(exp: Experiment, summary: dict, plots: list[Path]) -> str:
     """report.md: what was played, the table of means with intervals, the plots."""
     lines = [f"# Experiment {exp.name}", ""]
+    sc = exp.scenario
+    played = f"runs of scenario {sc.name!r} ({sc.path})" if sc is not None else "matches"
+    ends = "one run per cell and seed" if sc is not None else "each played with the ends swapped"
     lines.append(
-        f"`arena experiment run {exp.path}`: {summary['matches']} matches ({summary['failed']} failed), "
+        f"`arena experiment run {exp.path}`: {summary['matches']} {played} ({summary['failed']} failed), "
         f"{len(exp.cells)} cells ({exp.design} design), seeds {exp.seeds[0]}..{exp.seeds[-1]}, "
-        f"each played with the ends swapped; engine {exp.engine}."
+        f"{ends}; engine {exp.engine}."
     )
     if exp.opponents:
         lines.append(f"Opponents: {', '.join(exp.opponents)} (each cell's strategy against each of the others).")
+    wilson_note = "; `pass`: the pass rate with its 95 % Wilson interval" if PASS in exp.responses else ""
     lines += [
         "",
-        "Mean per cell with its 95 % bootstrap interval over seeds; Δ: the difference to the reference cell "
-        "(the first with the same values of every factor but the last), paired by seed.",
+        f"Mean per cell with its 95 % bootstrap interval over seeds{wilson_note}; Δ: the difference to the "
+        "reference cell (the first with the same values of every factor but the last), paired by seed.",
         "",
     ]
     head = ["cell", *[f.path for f in exp.factors], "strategy", "matches", *exp.responses]
