@@ -1,4 +1,5 @@
-"""The experiment file (docs/experiments.md): a base match, factors over any configuration
+"""The experiment file (docs/experiments.md): a base match (or a scenario, through the loader
+the command line hands in: scenarios/experiment.py), factors over any configuration
 field by its dotted path, a design (grid, seeded random, Latin hypercube), seeds, opponents
 and responses; `load(path)` checks every key and builds every cell's `MatchConfig` before a
 match is played.
