@@ -1,4 +1,5 @@
-"""The experiment file (docs/experiments.md): a base match, factors over any configuration
+"""The experiment file (docs/experiments.md): a base match (or a scenario, through the loader
+the command line hands in: scenarios/experiment.py), factors over any configuration
 field by its dotted path, a design (grid, seeded random, Latin hypercube), seeds, opponents
 and responses; `load(path)` checks every key and builds every cell's `MatchConfig` before a
 match is played.
@@ -24,6 +25,7 @@ import math
 import os
 import stat
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,14 +38,17 @@ MAX_LEVELS = 1000  # levels of one factor
 MAX_MATCHES = 100_000  # matches of one experiment
 MAX_SAMPLES = 10_000  # cells of a random or Latin hypercube design
 MAX_SEEDS = 10_000
-TOP_KEYS = ("name", "base", "factors", "design", "seeds", "first_seed", "opponents", "responses", "engine")
+TOP_KEYS = ("name", "base", "scenario", "factors", "design", "seeds", "first_seed", "opponents", "responses", "engine")
 DESIGNS = ("grid", "random", "lhs")
 ENGINES = ("inprocess", "processes")
 # Fields an experiment does not vary: the seeds are its own, the rest is deployment (arena match's flags).
 NOT_FACTORS = ("seed", "realtime", "external", "tap", "live", "pace", "refbox", "scenario")
+SWAP = {"a": "b", "b": "a"}  # a team's settings on the swapped match
 MATCH_RESPONSES = ("points", "goal_diff", "win", "draw", "loss", "goals_for", "goals_against")
 FACTS_RESPONSES = ("shots", "on_target", "saves", "blocks")  # the `arena facts` measures: the match is watched
 COVERAGE = "coverage_r"  # coverage_r0 .. coverage_r5: metres each robot of the team covered
+PASS = "pass"  # a scenario base's: 1 if the run passed, 0 if not
+SCENARIO_SUFFIX = ".scenario.toml"
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,7 @@ class Experiment:
     engine: str
     cells: list[dict[str, Any]] = field(default_factory=list)  # path -> value, per cell
     configs: list[MatchConfig] = field(default_factory=list)  # per cell, seed 0
+    scenario: Any = None  # a scenario base (scenarios/experiment.py ScenarioBase), or None: a match
 
     @property
     def needs_facts(self) -> bool:
@@ -85,6 +91,13 @@ class Experiment:
     def matches(self) -> list[dict]:
         """Every match: cell, opponent, seed, ends; `team` is the side the cell's own strategy plays."""
         out = []
+        if self.scenario is not None:  # a scenario fixes its sides: one run per cell and seed
+            for c, cfg in enumerate(self.configs):
+                out += [
+                    {"id": f"c{c:03d}-s{s}", "cell": c, "opponent": cfg.away, "seed": s, "team": "a"}
+                    for s in self.seeds
+                ]
+            return out
         for c, cfg in enumerate(self.configs):
             for opp in self.opponents or [cfg.away]:
                 if opp == cfg.home and self.opponents:
@@ -103,11 +116,16 @@ class Experiment:
         return out
 
     def match_config(self, m: dict) -> MatchConfig:
-        """The configuration of one match of `matches()`: the cell's, with its seed and ends."""
+        """The configuration of one match of `matches()`: the cell's, with its seed and ends. With the
+        ends swapped, the team settings (`params.a`, `params.b`) swap too: they follow the strategy."""
+        if self.scenario is not None:  # the scenario's draws are the seed's
+            return self.scenario.match(self.cells[m["cell"]], m["seed"])
         cfg = self.configs[m["cell"]]
         mine = cfg.home
-        home, away = (mine, m["opponent"]) if m["team"] == "a" else (m["opponent"], mine)
-        return cfg.replace(seed=m["seed"], home=home, away=away)
+        if m["team"] == "a":
+            return cfg.replace(seed=m["seed"], home=mine, away=m["opponent"])
+        params = {SWAP[team]: dict(values) for team, values in cfg.params.items()}
+        return cfg.replace(seed=m["seed"], home=m["opponent"], away=mine, params=params)
 
 
 def short_id(name: str) -> str:
@@ -150,13 +168,17 @@ def _check_finite(value: Any, where: str, key: str = "") -> None:
             _check_finite(v, where, key)
 
 
-def load(path: str) -> Experiment:
-    """Read, check and expand an experiment file; every cell's configuration is validated here."""
+def load(path: str, scenarios: Callable[[str, str], Any] | None = None) -> Experiment:
+    """Read, check and expand an experiment file; every cell's configuration is validated here.
+
+    `scenarios(file, name)`: a scenario file as the base (scenarios/experiment.py `base`, which the
+    command line hands in: this room does not import the scenarios above it)."""
     data = read_toml(path, "experiment file")
     for key in data:
         if key not in TOP_KEYS:
             raise ConfigError(f"{path}: unknown key {key!r} (known: {', '.join(TOP_KEYS)})")
-    base = _base(data.get("base", {}), path)
+    scenario = _scenario_base(data, path, scenarios)
+    base = scenario.match({}, 0) if scenario is not None else _base(data.get("base", {}), path)
     factors = [_factor(p, spec, path) for p, spec in _table(data, "factors", path).items()]
     design = _table(data, "design", path)
     for key in design:
@@ -185,11 +207,14 @@ def load(path: str) -> Experiment:
         design_seed=_int(design.get("seed", 0), "design.seed", path, 0, 2**63 - 1),
         seeds=list(range(first, first + n_seeds)),
         opponents=[_strategy(o, "opponents", path) for o in _list(data, "opponents", path)],
-        responses=_responses(data, path, base.robots),
+        responses=_responses(data, path, base.robots, scenario is not None),
         engine=engine,
+        scenario=scenario,
     )
+    if scenario is not None:
+        _check_scenario_factors(exp, path)
     exp.cells = cells(exp)
-    exp.configs = [cell_config(base, cell, f"{path}: cell {i}") for i, cell in enumerate(exp.cells)]
+    exp.configs = [_cell(exp, cell, f"{path}: cell {i}") for i, cell in enumerate(exp.cells)]
     _check_params(exp, path)
     total = len(exp.matches())
     if total == 0:
@@ -197,6 +222,43 @@ def load(path: str) -> Experiment:
     if total > MAX_MATCHES:
         raise ConfigError(f"{path}: {total} matches; an experiment plays at most {MAX_MATCHES}")
     return exp
+
+
+def _scenario_base(data: dict, path: str, scenarios: Callable[[str, str], Any] | None) -> Any:
+    """`base = "x.scenario.toml"` (and `scenario = "name"` if the file has several): the scenario base."""
+    value = data.get("base")
+    if not (isinstance(value, str) and value.endswith(SCENARIO_SUFFIX)):
+        if "scenario" in data:
+            raise ConfigError(
+                f"{path}: scenario: names a scenario of a base scenario file (base = 'x{SCENARIO_SUFFIX}')"
+            )
+        return None
+    name = _str(data["scenario"], "scenario", path) if "scenario" in data else ""
+    if scenarios is None:
+        raise ConfigError(f"{path}: base: a scenario file is a base for arena experiment run")
+    try:
+        return scenarios(str(Path(path).parent / value), name)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
+
+
+def _check_scenario_factors(exp: Experiment, path: str) -> None:
+    if exp.opponents:
+        raise ConfigError(f"{path}: opponents: a scenario fixes its sides; vary home or away as factors")
+    for f in exp.factors:
+        why = exp.scenario.check_factor(f.path)
+        if why:
+            raise ConfigError(f"{path}: factors.{f.path}: not over a scenario: {why}")
+
+
+def _cell(exp: Experiment, cell: dict[str, Any], where: str) -> MatchConfig:
+    """A cell's configuration at seed 0: the base's with the cell's values, or the scenario's."""
+    if exp.scenario is None:
+        return cell_config(exp.base, cell, where)
+    try:
+        return exp.scenario.match(cell, 0)
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
 
 
 def _check_params(exp: Experiment, path: str) -> None:
@@ -251,12 +313,18 @@ def _strategy(value: Any, key: str, path: str) -> str:
         raise ConfigError(f"{path}: {key}: {exc}") from None
 
 
-def _responses(data: dict, path: str, robots: int) -> list[str]:
-    known = [*MATCH_RESPONSES, *FACTS_RESPONSES, *(f"{COVERAGE}{n}" for n in range(6))]
-    given = _list(data, "responses", path) or list(MATCH_RESPONSES)
+def _responses(data: dict, path: str, robots: int, scenario: bool) -> list[str]:
+    """The responses asked for; a scenario base's are its pass and team a's score (default: pass)."""
+    if scenario:
+        known = [PASS, *MATCH_RESPONSES]
+        given = _list(data, "responses", path) or [PASS]
+    else:
+        known = [*MATCH_RESPONSES, *FACTS_RESPONSES, *(f"{COVERAGE}{n}" for n in range(6))]
+        given = _list(data, "responses", path) or list(MATCH_RESPONSES)
     for r in given:
         if r not in known:
-            raise ConfigError(f"{path}: unknown response {r!r} (known: {', '.join(known)})")
+            what = "over a scenario base " if scenario else "" if r != PASS else "(pass is a scenario base's) "
+            raise ConfigError(f"{path}: unknown response {r!r} {what}(known: {', '.join(known)})")
         if r.startswith(COVERAGE) and int(r[len(COVERAGE) :]) >= robots:
             raise ConfigError(f"{path}: response {r}: the teams have {robots} robots (0..{robots - 1})")
     return list(dict.fromkeys(given))

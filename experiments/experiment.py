@@ -17,6 +17,7 @@ import json
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -29,6 +30,7 @@ from arena.runtime import matchfile
 if TYPE_CHECKING:
     from arena.match import MatchResult
 
+SWAPPED = "-ends-swapped"  # cells/c000-ends-swapped.toml: a cell whose team settings swap with the ends
 ATTEMPTS = 2  # a match that fails is played once more, then recorded as failed
 
 
@@ -50,10 +52,15 @@ def _play(cfg: MatchConfig, engine: str, watch: tuple[str, ...] = ()) -> MatchRe
     return play(cfg, engine=engine, watch=watch)
 
 
-def play_one(cfg: MatchConfig, engine: str, facts: bool) -> dict:
+def play_one(cfg: MatchConfig, engine: str, facts: bool, run: Callable[[MatchConfig, str], dict] | None = None) -> dict:
     """One match: its score, metres per robot, digest, CPU time and, with `facts`, the `arena facts`
-    measures of both teams; a worker's task. `team_view` turns it into one team's responses."""
+    measures of both teams; a worker's task. `team_view` turns it into one team's responses.
+    `run`: a base's own way to play `cfg` (a scenario's run and verdict, scenarios/experiment.py)."""
     cpu0 = time.process_time()
+    if run is not None:
+        out = run(cfg, engine)
+        out["cpu_s"] = round(time.process_time() - cpu0, 4)
+        return out
     m = _play(cfg, engine, ("world", "referee") if facts else ())
     if m.void:  # a void match is no result (match/faults.py)
         raise RuntimeError("void: " + "; ".join(m.outcome_reasons or ["no reason given"]))
@@ -70,6 +77,7 @@ def team_view(got: dict, team: str, share: int = 1) -> dict:
     out = responses(got, team)
     if "facts" in got:
         out.update(got["facts"][team])
+    out.update(got.get("extra", {}))  # a scenario's pass, drawn values and failed expectations
     out["digest"] = got["digest"]
     out["cpu_s"] = round(got["cpu_s"] / share, 4)
     return out
@@ -134,8 +142,11 @@ class Run:
         (out / "matches").mkdir(parents=True, exist_ok=True)
         (out / "cells").mkdir(exist_ok=True)
         write_atomic(kept, source)
-        for c, cfg in enumerate(self.exp.configs):
+        for c, cfg in enumerate(self.exp.configs if self.exp.scenario is None else ()):
             write_atomic(out / "cells" / f"c{c:03d}.toml", matchfile.dump(cfg))
+            swapped = self.exp.match_config({"cell": c, "seed": cfg.seed, "team": "b", "opponent": cfg.away})
+            if swapped.params != cfg.params:  # team settings: on the swapped ends they are the other team's
+                write_atomic(out / "cells" / f"c{c:03d}{SWAPPED}.toml", matchfile.dump(swapped))
         if self.opts.resume:
             for m in self.matches:
                 f = out / "matches" / f"{m['id']}.json"
@@ -149,10 +160,19 @@ class Run:
         row = {"match": m["id"], "cell": f"c{m['cell']:03d}", **cell}
         row |= {"strategy": self.exp.configs[m["cell"]].home, "opponent": m["opponent"], "seed": m["seed"]}
         row |= {"team": m["team"], "team_a": cfg.home, "team_b": cfg.away, "status": "ok" if got else "failed"}
+        if self.exp.scenario is None:
+            row["config"] = self.config_file(m)
         row |= got or {"reason": reason}
         row["attempts"] = attempts
         write_atomic(self.out / "matches" / f"{m['id']}.json", json.dumps(row))
         return row
+
+    def config_file(self, m: dict) -> str:
+        """The file (below `out`) that `arena match --config` plays this match from, with the row's seed
+        and strategies: the cell's, or on the swapped ends with team settings, the cell's swapped."""
+        cfg = self.exp.configs[m["cell"]]
+        swapped = m["team"] == "b" and self.exp.match_config(m).params != cfg.params
+        return f"cells/c{m['cell']:03d}{SWAPPED if swapped else ''}.toml"
 
     def todo(self) -> list[list[dict]]:
         """The matches still to play, grouped by configuration: in a round robin of cells, AD's match
@@ -195,7 +215,10 @@ class Run:
         return False
 
     def _task(self, m: dict) -> tuple:
-        return (self.exp.match_config(m), self.exp.engine, self.exp.needs_facts)
+        cfg = self.exp.match_config(m)
+        if self.exp.scenario is not None:
+            return (cfg, self.exp.engine, False, self.exp.scenario.task(self.exp.cells[m["cell"]]))
+        return (cfg, self.exp.engine, self.exp.needs_facts)
 
 
 def ray_task(task: tuple, driver: dict) -> dict:
@@ -254,7 +277,9 @@ class Bar:
         self.progress.update(self.task, advance=1, rate=self.rate())
         if self.show and not self.live:
             left = (self.total - self.done) * (time.monotonic() - self.t0) / self.fresh
-            what = f"{row['points']} points" if row["status"] == "ok" else f"failed: {row['reason']}"
+            what = f"failed: {row['reason']}" if row["status"] != "ok" else f"{row['points']} points"
+            if row["status"] == "ok" and "pass" in row:
+                what = "passed" if row["pass"] else f"did not pass ({row['failures']})"
             self.console.print(
                 f"[{self.done}/{self.total}] {row['match']}: {what} ({self.rate()}, {left:.0f} s left)",
                 highlight=False,

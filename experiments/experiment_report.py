@@ -1,5 +1,6 @@
 """What `arena experiment run` writes once its matches are in: the tidy rows (rows.csv,
-rows.json), per cell the mean of each response with its 95 % bootstrap interval
+rows.json), per cell the mean of each response with its 95 % bootstrap interval (a
+scenario's `pass`: the pass rate with its Wilson interval, as `arena scenario run` gives it)
 (summary.json), a plot per response (plots/<response>.png) and report.md.
 
 The interval is over seeds: a seed's value is its matches' mean (both ends, every
@@ -21,8 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from arena.experiments import experiment_standings
-from arena.experiments.design import Experiment
+from arena.experiments.design import PASS, Experiment
 from arena.experiments.fixtures import write_atomic
+from arena.experiments.ratings import wilson
 
 RESAMPLES = 2000
 BOOT_SEED = 20_260_101  # the bootstrap's own seed: the same intervals on every rerun
@@ -75,6 +77,9 @@ def summarise(exp: Experiment, rows: list[dict]) -> dict:
             v = np.array([by_seed[s] for s in seeds]) if full else np.array(list(by_seed.values()))
             own_idx = idx if full else rng.integers(0, max(1, len(v)), size=(RESAMPLES, max(1, len(v))))
             mean, lo, hi = bootstrap(v, own_idx)
+            if resp == PASS:  # a pass rate: the Wilson interval over the runs, as arena scenario run's
+                runs = [int(r[resp]) for r in rows if r["cell"] == name and r["status"] == "ok" and resp in r]
+                mean, (lo, hi) = (sum(runs) / len(runs) if runs else float("nan")), wilson(sum(runs), len(runs))
             out[resp] = {"mean": _r(mean), "low": _r(lo), "high": _r(hi), "seeds": len(v)}
             if full:
                 full_values[(c, resp)] = v
@@ -225,17 +230,21 @@ def _short(v) -> str:
 def report(exp: Experiment, summary: dict, plots: list[Path]) -> str:
     """report.md: what was played, the table of means with intervals, the plots."""
     lines = [f"# Experiment {exp.name}", ""]
+    sc = exp.scenario
+    played = f"runs of scenario {sc.name!r} ({sc.path})" if sc is not None else "matches"
+    ends = "one run per cell and seed" if sc is not None else "each played with the ends swapped"
     lines.append(
-        f"`arena experiment run {exp.path}`: {summary['matches']} matches ({summary['failed']} failed), "
+        f"`arena experiment run {exp.path}`: {summary['matches']} {played} ({summary['failed']} failed), "
         f"{len(exp.cells)} cells ({exp.design} design), seeds {exp.seeds[0]}..{exp.seeds[-1]}, "
-        f"each played with the ends swapped; engine {exp.engine}."
+        f"{ends}; engine {exp.engine}."
     )
     if exp.opponents:
         lines.append(f"Opponents: {', '.join(exp.opponents)} (each cell's strategy against each of the others).")
+    wilson_note = "; `pass`: the pass rate with its 95 % Wilson interval" if PASS in exp.responses else ""
     lines += [
         "",
-        "Mean per cell with its 95 % bootstrap interval over seeds; Δ: the difference to the reference cell "
-        "(the first with the same values of every factor but the last), paired by seed.",
+        f"Mean per cell with its 95 % bootstrap interval over seeds{wilson_note}; Δ: the difference to the "
+        "reference cell (the first with the same values of every factor but the last), paired by seed.",
         "",
     ]
     head = ["cell", *[f.path for f in exp.factors], "strategy", "matches", *exp.responses]

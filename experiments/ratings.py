@@ -1,5 +1,5 @@
 """A tournament's standings: the paper's Table 2, per-robot coverage (Fig. 9) and
-Bradley-Terry ratings with bootstrap confidence intervals."""
+Bradley-Terry ratings with bootstrap confidence intervals; the Wilson interval of a pass rate."""
 
 from __future__ import annotations
 
@@ -8,6 +8,20 @@ import random
 from dataclasses import replace
 
 from arena.experiments.fixtures import Result, plural, short
+
+Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
+
+
+def wilson(passed: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """The Wilson score interval of a pass rate `passed / n` (95 % by default): a scenario's pass rate,
+    an experiment's `pass` per cell."""
+    if n == 0:
+        return 0.0, 1.0
+    p = passed / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def standings(results: list[Result], teams: list[str]) -> list[dict]:

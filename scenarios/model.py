@@ -212,6 +212,8 @@ class Scenario:
     ranged: bool = False  # some number of `start` or `step` is drawn per run (scenarios/draws.py)
     subs: tuple[Step, ...] = ()  # the substitution's steps (they depend on no draw)
     notes: tuple[str, ...] = ()  # what the user should know though nothing is wrong
+    # match settings set over the file's, by dotted path as an experiment's factors (experiments/design.py)
+    settings: tuple[tuple[str, object], ...] = ()
 
     @property
     def name(self) -> str:
@@ -229,10 +231,10 @@ class Scenario:
 
     def config(self, seed: int = 0, base: MatchConfig | None = None) -> MatchConfig:
         """The match every engine plays for this scenario: `base` (default values if None) with what
-        plays, the time limit, the start and the steps."""
+        plays, the time limit, the start and the steps; then the `settings`, if any."""
         p = self.spec.play
         base = base or MatchConfig()
-        return base.replace(
+        cfg = base.replace(
             seed=seed,
             home=self.home,
             away=self.away,
@@ -244,6 +246,12 @@ class Scenario:
             rules=dataclasses.replace(base.rules, **p.rules),
             scenario=self.params_at(seed),
         )
+        if not self.settings:
+            return cfg
+        from arena.experiments.design import cell_config
+
+        played = cell_config(cfg.replace(scenario=ScenarioParams()), dict(self.settings), f"{self.path}: {self.name}")
+        return played.replace(scenario=cfg.scenario)
 
     def ticks(self, seconds: float) -> int:
         return int(round(seconds / self.dt))

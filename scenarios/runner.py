@@ -11,7 +11,6 @@ its 95 % Wilson score interval, and the scenario's verdict (`min_pass`)."""
 
 from __future__ import annotations
 
-import math
 import shlex
 import sys
 import time
@@ -20,13 +19,13 @@ from pathlib import Path
 
 import msgspec
 
+from arena.experiments.ratings import wilson
 from arena.scenarios.draws import resolve as resolve_draws
 from arena.scenarios.expect import Trace, judge
 from arena.scenarios.model import Scenario, run_end
 from arena.schemas.messages import EngineEvents, Referee, World
 
 ENGINES = ("inprocess", "processes")
-Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
 
 
 @dataclass(frozen=True)
@@ -85,17 +84,6 @@ class Verdict:
             "drawn": self.drawn,
             "seconds": round(self.seconds, 3),
         }
-
-
-def wilson(passed: int, n: int, z: float = Z95) -> tuple[float, float]:
-    """The Wilson score interval of a pass rate `passed / n` (95 % by default)."""
-    if n == 0:
-        return 0.0, 1.0
-    p = passed / n
-    denom = 1 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 @dataclass

@@ -27,7 +27,8 @@ RUN_EXAMPLES = """examples:
   arena experiment run sweep.toml --out runs/sweep            # rows.csv, summary.json, plots/, report.md there
   arena experiment run sweep.toml --out runs/sweep --resume   # only the matches not yet in runs/sweep
   arena experiment run sweep.toml --jobs 1                    # every match in this process, one after another
-  arena experiment run sweep.toml --ray 10.0.0.5:6379         # the Ray cluster whose head node is there"""
+  arena experiment run sweep.toml --ray 10.0.0.5:6379         # the Ray cluster whose head node is there
+  arena experiment run examples/studies/corner-latency.toml   # base: a scenario file; pass rates per cell"""
 
 COMPARE_EXAMPLES = """examples:
   arena experiment compare --candidate AD --baseline BS --half-time 30
@@ -107,8 +108,9 @@ def _run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from arena.experiments import design, experiment
+    from arena.scenarios.experiment import base as scenario_base
 
-    exp = design.load(args.file)
+    exp = design.load(args.file, scenarios=scenario_base)  # base may be a scenario file
     source = Path(args.file).read_text()
     out = Path(args.out or Path(args.file).name.removesuffix(".toml"))
     opts = experiment.RunOptions(jobs=args.jobs, ray=args.ray, out=out, resume=args.resume)

@@ -77,7 +77,7 @@ def test_digest_equals_arena_match_of_that_cell_and_seed(played, match_id):
     _, out, _ = played
     row = json.loads((out / "matches" / f"{match_id}.json").read_text())
     m = arena_json(
-        "match", "--config", str(out / "cells" / f"{row['cell']}.toml"), "--seed", str(row["seed"]),
+        "match", "--config", str(out / row["config"]), "--seed", str(row["seed"]),
         "--home", row["team_a"], "--away", row["team_b"], "--engine", "inprocess",
     )  # fmt: skip
     assert m["digest"] == row["digest"]

@@ -84,3 +84,34 @@ def test_no_round_robin_no_standings(tmp_path):
 
     exp = design.load(_file(tmp_path, '"timing.perception_latency" = [0, 3]\n'))
     assert experiment_standings.build(exp, []) == [] and experiment_standings.markdown([]) == []
+
+
+def test_a_team_parameter_follows_its_strategy_when_the_ends_swap(tmp_path):
+    """params.a is the row's strategy's: on the swapped match that strategy is team b, and so are its
+    parameters; params.b (the opponent's) moves to team a with it."""
+    exp = design.load(_file(tmp_path, 'home = ["AD"]\n"params.a.block_gain" = [2.0]\n"params.b.keeper_gain" = [1.5]\n'))
+    for m in exp.matches():
+        cfg = exp.match_config(m)
+        mine, theirs = ("a", "b") if m["team"] == "a" else ("b", "a")
+        assert getattr(cfg, {"a": "home", "b": "away"}[mine]) == "advance-dynamic"
+        assert cfg.params == {mine: {"block_gain": 2.0}, theirs: {"keeper_gain": 1.5}}, m
+    assert exp.configs[0].params == {"a": {"block_gain": 2.0}, "b": {"keeper_gain": 1.5}}  # the cell as written
+
+
+def test_a_round_robin_shares_a_match_only_when_the_parameters_agree(tmp_path):
+    """AD with kick_speed 3 against AS (AD team a) is not AS with kick_speed 3 against AD (AS team b): the
+    parameter is another strategy's there, so the two rows play two matches."""
+    from arena.experiments.experiment import Run, RunOptions
+
+    path = tmp_path / "e.toml"
+    path.write_text(
+        'seeds = 1\nopponents = ["AD", "AS"]\n[base]\nhalf_time = 5.0\n'
+        '[factors]\nhome = ["AD", "AS"]\n"params.a.kick_speed" = [3.0]\n'
+    )
+    exp = design.load(str(path))
+    groups = Run(exp, RunOptions(out=tmp_path / "out", progress=False), path.read_text()).todo()
+    assert len(exp.matches()) == 4 and len(groups) == 4
+    for g in groups:
+        cfg = exp.match_config(g[0])
+        mine = g[0]["team"]
+        assert cfg.params == {mine: {"kick_speed": 3.0}}
