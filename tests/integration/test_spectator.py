@@ -40,7 +40,10 @@ def hiccups(match, started: threading.Event, done: threading.Event) -> None:
         except ProcessLookupError:
             return
         time.sleep(0.3)
-        os.kill(match.pid, signal.SIGCONT)
+        try:
+            os.kill(match.pid, signal.SIGCONT)
+        except ProcessLookupError:  # the match ended while it was stopped
+            return
         done.wait(0.5)
 
 
