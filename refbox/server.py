@@ -32,6 +32,7 @@ import socket
 import threading
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from arena.config import RefboxParams
@@ -84,9 +85,19 @@ def check_listen(endpoint: str) -> None:
 
 
 class BridgeServer:
-    def __init__(self, host: str, port: int, params: RefboxParams, log: logging.Logger):
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        params: RefboxParams,
+        log: logging.Logger,
+        budget_clock: Callable[[], float] = time.monotonic,
+    ):
+        """`budget_clock`: the seconds a connection's byte budget refills by (`Client.spend`); a test
+        stops it to cut a flood off at `MAX_BURST` bytes whatever the host's load."""
         self.params = params
         self.log = log
+        self._budget_clock = budget_clock
         family = socket.AF_INET6 if ":" in host else socket.AF_INET
         try:
             self.sock = socket.create_server((host, port), family=family, backlog=8)
@@ -197,7 +208,7 @@ class BridgeServer:
             sock.close()
             return
         sock.setblocking(False)
-        client = Client(sock, ip, side, protocol, name)
+        client = Client(sock, ip, side, protocol, name, since=self._budget_clock())
         with self._lock:
             self.clients[sock] = client
         self.sel.register(sock, selectors.EVENT_READ, "client")
@@ -283,7 +294,7 @@ class BridgeServer:
         if not data:
             self._drop(client, "closed the connection")
             return
-        if not client.spend(len(data), time.monotonic()):
+        if not client.spend(len(data), self._budget_clock()):
             self.errors[client.side]["flooding"] += 1
             self._drop(client, f"misbehaving (flooding: more than {MAX_RATE >> 20} MB/s)")
             return

@@ -301,7 +301,11 @@ any process sees it, and nobody counts it. Measured with
 tests/integration/test_fuzz.py injecting as a client: 1 to 3 of every 100
 megabyte frames lost, none of 3,000 to 10,000 small ones. Frames of a match
 are far below {MAX_FRAME_BYTES:,} bytes, and a process injecting as a peer
-(direct links, BLOCK end to end) had every frame counted. In a `--secure`
+(direct links, BLOCK end to end) had every frame up to that size counted.
+Larger ones can be lost even so: zenoh gives a BLOCK put 5 s to find room
+in a link's queue, then closes the link with what it held
+(`wait_before_close`), and megabyte frames to a process that a loaded host
+keeps waiting fill it. In a `--secure`
 match every frame goes through the router with the sender's QoS, except
 towards the `viewer` principal, whom the router serves with DROP.
 

@@ -194,7 +194,9 @@ def main(argv: list[str]) -> int:
             summary_pub.put(payload, attachment=attachment)
             if not collector.is_set() or acked.wait(0.25) or time.monotonic() > give_up:
                 break
-        ended.wait(1.0)  # our last tick can come before the referee's last frame (schemas/README.md)
+        # Our last tick can come before the referee's last frame (schemas/README.md): wait for it. The
+        # referee sends it at tick total_ticks in every match that ends; 30 s bounds a void one only.
+        ended.wait(30.0)
         print(
             json.dumps(
                 {

@@ -7,7 +7,9 @@ receiver can ever expect (past the match's last tick, or negative), so nothing
 well-formed is injected: the match must play exactly as the unfuzzed one (the
 golden digests, tests/golden/digests.json), no process may crash or hang, and
 every payload must be counted exactly once by every process subscribed to its
-key, the ones over MAX_FRAME_BYTES as `too-large`.
+key. A payload over MAX_FRAME_BYTES is counted as `too-large`, unread, by every
+process it reaches; zenoh may lose such a frame on its way under load (below),
+so those are counted as they arrive: none twice, none as anything else.
 
 How the count is made exact: robot a/0 is left `--external`, so every other
 process has subscribed and waits at the start barrier while the payloads go
@@ -238,7 +240,7 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
     batches = [(drawn(n, False), False), *([(drawn(n_huge, True), True)] if n_huge else [])]
     # The launcher prints the command that starts a/0 (with its credentials): start it exactly so, later.
     command = launcher.line("arena run robot", 60).split()
-    sent = {"count": 0, "frames": 0, "too-large": 0, "big": 0}
+    sent = {"count": 0, "small": 0, "frames": 0, "too-large": 0, "big": 0}
     # A peer, as every process of the match: direct links, BLOCK end to end. Through the router
     # (a client) megabyte frames were lost before any process saw them: the router of a peer
     # match relays with DROP, and zenoh drops a fragmented frame it cannot queue within 50 ms
@@ -274,10 +276,15 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
                 sent["big"] += huge
                 if len(payload) > MAX_FRAME_BYTES:
                     sent["too-large"] += receivers
+                else:
+                    sent["small"] += receivers
         # Counted whenever they arrive, even after the start: no payload is at a tick anybody expects.
         # But a process counts only what it reads before it ends, and a put returns once queued:
         # payloads can still sit in the links' buffers (a fixed 3 s drain counted 1,010 of 1,011 at
-        # a load of 10). So the start waits for a signal that every one has arrived (`sentinels`).
+        # a load of 10). So the start waits for a signal that every one has arrived (`sentinels`),
+        # or will never arrive: a link whose queue stays full for 5 s (megabyte frames to a process
+        # the host's scheduler keeps waiting) is closed by zenoh with what it held, and the sentinel
+        # comes over the link that replaces it (`oversize_lost`).
         sentinels = arrived(session, match_id, pubs)
         # Its stderr into a file: a pipe nobody reads would stall a robot that says what it waits for.
         with open(launcher.logs / "external_robot_a_0.log", "wb") as log:
@@ -290,12 +297,29 @@ def fuzz_a_match(tmp_path, reap, n: int, n_huge: int) -> None:
     assert sent["big"] >= n_huge * 0.9 and (sent["too-large"] > 0) == (n_huge > 0), sent
     assert result["outcome"] == "completed", (result["faults"], result["outcome_reasons"])
     assert result["dead"] == [] and result["ticks"] == TOTAL
-    # Every payload is counted by every process subscribed to its key: none lost, none twice.
-    assert result["rejected"] == sent["count"] + len(sentinels), (result["rejected_reasons"], sent)
+    # Every payload of at most MAX_FRAME_BYTES is counted by every process subscribed to its key:
+    # none lost, none twice. Every oversize one that arrived is counted once, as `too-large` and as
+    # nothing else (one that were decoded would add a count of another reason and break the sum).
+    too_large = result["rejected_reasons"].get("too-large", 0)
+    assert result["rejected"] == sent["small"] + too_large + len(sentinels), (result["rejected_reasons"], sent)
     assert result["forged"] == dict(Counter(key for _, key in sentinels)), "each sentinel, and nothing else"
-    assert result["rejected_reasons"].get("too-large", 0) == sent["too-large"], (result["rejected_reasons"], sent)
+    assert (0 < too_large <= sent["too-large"]) == (n_huge > 0), (result["rejected_reasons"], sent)
     assert "conflict" not in result["rejected_reasons"] and "invalid" not in result["rejected_reasons"]
     assert result["process_digests"] == GOLDEN["digests"], "nothing well-formed went in: the match is unchanged"
+
+
+# `oversize_lost`: why a megabyte frame may never reach a process that waits at the start barrier,
+# with a BLOCK, reliable put on a direct link. zenoh gives a BLOCK put 5 s to find room in a link's
+# queue (two batches of 64 KiB per priority; `transport/link/tx/queue/congestion_control/block/
+# wait_before_close`), then closes that link with what it held. Measured: a peer stopped for 5.5 s
+# while another put twenty 1 MB frames to it got none of them, and the put returned after 5 s. In
+# a match the peers can connect again (gossip through the router), and later frames, the sentinel
+# too, take the new link. That is the shape of a run at a load of 10 that counted 4 of 15
+# `too-large` while every sentinel came (not reproduced in 30 runs beside two CPU hogs; in 19 of
+# them no fuzzed frame came relayed by the router, whose DROP marks what it relays).
+# Frames of at most MAX_FRAME_BYTES do not fill a queue here: 1,000 of them to seven processes are
+# a few hundred kB in all, which the sockets' buffers hold whether or not a receiver reads. No
+# genuine frame comes near MAX_FRAME_BYTES (schemas/keys.py).
 
 
 def waiting_receivers(rel: str) -> list[str]:

@@ -7,6 +7,7 @@ import time
 
 from arena.runtime.session import NetConfig, open_session
 from arena.runtime.transport import ZenohTransport
+from tests.integration.helpers import wait_for
 
 
 def test_a_callback_thread_keeps_its_python_thread_state(tmp_path):
@@ -60,9 +61,10 @@ def test_close_while_zenohs_thread_is_inside_a_put_does_not_raise(tmp_path):
     ):
         stall, stop = threading.Event(), threading.Event()
         sub = b.declare_subscriber("arena/borrow/k", lambda s: stall.wait(20))
-        time.sleep(0.5)
         tr = ZenohTransport(a)
         put = tr.publisher("arena/borrow/k")  # BLOCK, towards a receiver that does not read
+        # Its declaration has reached the publisher (else the puts go nowhere and never block).
+        wait_for(lambda: tr.has_subscribers("arena/borrow/k"), 30, "the subscriber's declaration")
         puts = [0]
 
         def flood() -> None:
@@ -97,7 +99,9 @@ def test_a_served_key_answers_an_ask_with_its_last_frame_and_nothing_before_one(
         tx, rx = ZenohTransport(robot), ZenohTransport(viewer)
         latest = Latest().wrap(tx.publisher("arena/t/team/a/report/0"))
         tx.serve("arena/t/team/a/report/0", latest.get)
-        time.sleep(0.3)  # the queryable's declaration reaches the viewer
+        querier = viewer.declare_querier("arena/t/team/a/report/0")  # says when the queryable is known
+        wait_for(lambda: querier.matching_status.matching, 30, "the queryable's declaration at the viewer")
+        querier.undeclare()
         answers: list[bytes] = []
         rx.ask("arena/t/team/a/report/0", answers.append, 2.0)
         time.sleep(0.5)

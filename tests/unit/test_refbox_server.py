@@ -9,7 +9,7 @@ import time
 
 from arena.config import RefboxParams, RefboxTeam
 from arena.recording.analysis.worldstates import score_team
-from arena.refbox.server import BridgeServer
+from arena.refbox.server import MAX_BURST, MAX_RATE, BridgeServer, Client
 from arena.schemas.messages import RobotState, World, Worldstate
 
 LOG = logging.getLogger("test.refbox")
@@ -241,11 +241,26 @@ def wait_for(cond, timeout: float = 10.0) -> bool:
     return cond()
 
 
+def closed_by_peer(sock: socket.socket, timeout: float) -> bool:
+    """Whether the other end closed `sock` having sent nothing more: the end of the stream, or a reset
+    (a server that closes with our bytes unread resets the connection). Silence raises TimeoutError."""
+    try:
+        return recv_until_closed(sock, timeout) == b""
+    except ConnectionResetError:
+        return True
+
+
 def test_a_hostile_base_station_neither_stalls_the_other_nor_stays():
     """Team a sends the 100 kB message of escaped quotes (a bad message, counted; its connection
     stays, as an honest station's typo would) and then floods; team b is served throughout, and the
-    flooding connection is cut off."""
-    server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x"), LOG)
+    flooding connection is cut off.
+
+    The budget's clock stands still: a connection may then send `MAX_BURST` bytes in all, and the
+    flood is cut off after them whenever this host's scheduler lets the server read them. (With the
+    wall clock and a 5 s send timeout, a server thread stalled for 5 s ended the flood early, and
+    the cut-off's reset then came to a socket nobody sent on: ConnectionResetError.)
+    `test_the_byte_budget_refills_at_max_rate` checks the rate itself."""
+    server = BridgeServer("127.0.0.1", 0, RefboxParams(listen="x"), LOG, budget_clock=lambda: 0.0)
     try:
         hostile = connect_as_a(server)
         good = socket.create_connection(("127.0.0.1", server.port))
@@ -254,12 +269,13 @@ def test_a_hostile_base_station_neither_stalls_the_other_nor_stays():
         good.sendall(GOOD)
         assert wait_for(lambda: server.counts["worldstates_a"] == 1 and server.counts["worldstates_b"] == 1)
         assert server.errors["a"] == {"malformed-json": 1} and server.sides() == 2
-        try:  # until it is cut off (a slow reader under load may take a while: up to 64 MB)
-            for _ in range(64):
+        hostile.settimeout(60.0)  # a bound only: 5 s ended a send to a stalled server before the budget
+        try:  # far past the budget: it is cut off while still sending
+            for _ in range(4 * MAX_BURST >> 20):
                 hostile.sendall(b"x" * (1 << 20))
         except OSError:
-            pass  # cut off while still sending
-        assert recv_until_closed(hostile, timeout=10.0) == b"", "disconnected"
+            pass
+        assert closed_by_peer(hostile, timeout=10.0), "disconnected"
         assert server.errors["a"]["flooding"] == 1 and server.sides() == 1
         server.broadcast("STOP")
         good.sendall(GOOD)
@@ -269,3 +285,15 @@ def test_a_hostile_base_station_neither_stalls_the_other_nor_stays():
         hostile.close()
     finally:
         server.close(linger=0)
+
+
+def test_the_byte_budget_refills_at_max_rate():
+    """A connection may send `MAX_BURST` at once and `MAX_RATE` a second on average for as long as it
+    likes; a tenth more than that is flooding within a minute. Times are given, not measured."""
+    client = Client(sock=None, address="127.0.0.1", side="a", protocol="json", since=0.0)  # type: ignore[arg-type]
+    assert client.spend(MAX_BURST, 0.0) and not client.spend(1, 0.0)
+    steady = Client(sock=None, address="127.0.0.1", side="a", protocol="json", since=0.0)  # type: ignore[arg-type]
+    assert all(steady.spend(MAX_RATE // 10, t / 10) for t in range(1, 36_000))  # an hour at MAX_RATE
+    flood = Client(sock=None, address="127.0.0.1", side="a", protocol="json", since=0.0)  # type: ignore[arg-type]
+    cut = next(t for t in range(1, 36_000) if not flood.spend(MAX_RATE * 11 // 100, t / 10))
+    assert cut / 10 < 60, cut
