@@ -61,6 +61,10 @@ def agent_name(text: str) -> str:
     return pid.short
 
 
+# A box action may stand a float32 rounding beyond +-1 (an exported tanh gives -1.0000001); it is clipped.
+BOX_SLACK = 1.0 + 1e-6
+
+
 class SoccerParallelEnv(ParallelEnv):
     metadata = {"name": "soccer_arena_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
@@ -246,7 +250,7 @@ class SoccerParallelEnv(ParallelEnv):
             raise ValueError(f"{a}: a box action has shape (4,) (vx, vy, omega, kick), got {v.shape}")
         if not np.isfinite(v).all():
             raise ValueError(f"{a}: a box action's numbers must be finite, got {v.tolist()}")
-        raise ValueError(f"{a}: a box action's numbers are in [-1, 1], got {v.tolist()}")
+        raise ValueError(f"{a}: a box action's numbers are in [-1, 1], got {v.tolist()}")  # beyond BOX_SLACK
 
     def _check(self, actions: dict[str, Any]) -> None:
         """ValueError, naming the agent, for an action that is missing, of the wrong shape, not finite or
@@ -266,7 +270,7 @@ class SoccerParallelEnv(ParallelEnv):
                 continue
             v = act.tolist() if isinstance(act, np.ndarray) else act
             try:
-                if len(v) == 4 and all(-1.0 <= x <= 1.0 for x in v):  # False for NaN: the one test a step pays
+                if len(v) == 4 and all(-BOX_SLACK <= x <= BOX_SLACK for x in v):  # False for NaN: one test a step
                     continue
             except TypeError:
                 pass

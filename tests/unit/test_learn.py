@@ -505,6 +505,15 @@ def test_a_bad_action_is_refused_with_the_agent_named_and_never_played(actions, 
     assert env.match.tick == tick and env.recorded["a/1"] == []
 
 
+def test_a_float32_rounding_past_one_is_played_clipped():
+    """An exported tanh policy gives -1.0000001 in float32: that is -1, not a bad action."""
+    env = SoccerParallelEnv(agents=["a/1"], **SHORT)
+    env.reset(seed=1)
+    tick = env.match.tick
+    env.step({"a/1": np.array([-1.0000001, 1.0000001, 0, 0], np.float32)})
+    assert env.match.tick > tick
+
+
 def test_a_deployed_policy_that_gives_nan_stops_its_robot_with_a_clear_error():
     from arena.strategies.learned import View, to_cmd
 
