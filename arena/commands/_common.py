@@ -119,3 +119,16 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
         print(f"{prog}: void: {'; '.join(match.outcome_reasons)}", file=sys.stderr)
         return 1
     return 0
+
+
+def ray_flag(p: argparse.ArgumentParser) -> None:
+    """`--ray [ADDRESS]` of a command that plays many matches (tournament, experiment run, compare, tune)."""
+    p.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
+        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
+    )

@@ -6,7 +6,8 @@ import argparse
 import json
 import sys
 
-from arena.commands._common import add_command, positive_int, seconds
+from arena.commands._common import add_command, positive_int, ray_flag
+from arena.commands._match_flags import add_match_flags
 from arena.config import ConfigError
 
 TUNE_EXAMPLES = """examples:
@@ -89,31 +90,9 @@ def add_tune_parser(what) -> None:
     t.add_argument(
         "--seed", type=int, default=0, metavar="N", help="the search's seed; tuning matches play seeds N, N+1, ... (0)"
     )
-    t.add_argument(
-        "--config",
-        dest="config_file",
-        metavar="FILE.toml",
-        help="every match's configuration file (arena config --print)",
-    )
-    t.add_argument("--half-time", type=seconds, default=None, metavar="SECONDS", help="simulated half length [s] (300)")
-    t.add_argument("--robots", type=int, default=None, metavar="N", help="robots per team (3)")
-    t.add_argument("--link", default=None, metavar="PRESET", help="link preset (ideal)")
-    t.add_argument(
-        "--link-param", action="append", default=[], metavar="CLASS.PARAM=V", help="override a link parameter"
-    )
-    t.add_argument(
-        "--perception-latency", type=int, default=None, metavar="TICKS", help="every match's perception latency (3)"
-    )
+    add_match_flags(t, seed=False, teams=False, config=True)  # every match's: --config, --half-time, links, ...
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
-    t.add_argument(
-        "--ray",
-        nargs="?",
-        const="",
-        default=None,
-        metavar="ADDRESS",
-        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
-        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
-    )
+    ray_flag(t)
     t.add_argument(
         "--out",
         default="tune",

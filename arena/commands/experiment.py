@@ -8,7 +8,7 @@ import argparse
 import json
 import sys
 
-from arena.commands._common import add_command
+from arena.commands._common import add_command, ray_flag
 from arena.commands._match_flags import add_match_flags
 from arena.commands._tune import add_tune_parser, run_tune
 from arena.config import ConfigError
@@ -41,18 +41,6 @@ CATCH_SIGTERM = True
 STOPS_PROCESSES = True
 
 
-def _ray_flag(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--ray",
-        nargs="?",
-        const="",
-        default=None,
-        metavar="ADDRESS",
-        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
-        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
-    )
-
-
 def add_parser(sub) -> None:
     ex = add_command(sub, "experiment", "sweeps over any match setting, paired tests of a change, tuning", EXAMPLES)
     what = ex.add_subparsers(dest="experiment", required=True, metavar="{run,compare,tune}")
@@ -61,7 +49,7 @@ def add_parser(sub) -> None:
     )
     r.add_argument("file", metavar="FILE.toml", help="the experiment file (docs/experiments.md)")
     r.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
-    _ray_flag(r)
+    ray_flag(r)
     r.add_argument("--out", default=None, metavar="DIR", help="results directory (default: the file's name)")
     r.add_argument("--resume", action="store_true", help="play only the matches not yet in --out")
     r.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -85,7 +73,7 @@ def add_parser(sub) -> None:
     c.add_argument("--first-seed", type=int, default=0, metavar="S", help="pairs play seeds S, S+1, ... (0)")
     add_match_flags(c, seed=False, teams=False, config=True)  # every match's: --config, --half-time, links, ...
     c.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
-    _ray_flag(c)
+    ray_flag(c)
     c.add_argument("--json", action="store_true", help="print the result as one JSON object")
     add_tune_parser(what)
 

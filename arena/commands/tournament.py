@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from arena.commands._common import ENGINE_FLAG, add_command, positive_int
+from arena.commands._common import ENGINE_FLAG, add_command, positive_int, ray_flag
 from arena.commands._match_flags import add_match_flags, allow_pickle_flag, match_config
 from arena.config import ConfigError
 
@@ -44,15 +44,7 @@ def add_parser(sub) -> None:
     t.add_argument("--jobs", type=int, default=0, metavar="N", help="matches at once; 0 (the default): one per core")
     t.add_argument("--out", default="tournament", metavar="DIR", help="results directory (tournament)")
     t.add_argument("--resume", action="store_true", help="skip the matches already finished in --out")
-    t.add_argument(
-        "--ray",
-        nargs="?",
-        const="",
-        default=None,
-        metavar="ADDRESS",
-        help="play every match as a Ray task: alone, a local Ray instance; auto or HOST:PORT, join that cluster "
-        "(needs pip install 'soccer-arena[cluster]'; docs/cluster.md)",
-    )
+    ray_flag(t)
     t.add_argument(
         "--ray-runtime-env",
         metavar="JSON",
