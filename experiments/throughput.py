@@ -25,7 +25,9 @@ included; the figure the engines' cost is compared by), the processes engine's
 rtf over the in-process engine's, pair by pair, and, where the learn extra is
 installed, the learning env's steps per CPU-second beside the in-process
 match's ticks per CPU-second, both measured in this process over the same match
-(`arena bench learn` has more)."""
+(`arena bench learn` has more), and, given `--rsoccer PYTHON` (an interpreter
+with rSoccer installed), rSoccer's VSS-v0 steps per CPU-second beside our
+match's ticks (experiments/rsoccer.py)."""
 
 from __future__ import annotations
 
@@ -41,6 +43,8 @@ from typing import TYPE_CHECKING
 from msgspec import UNSET
 
 from arena.experiments.matches import default_jobs
+from arena.experiments.rsoccer import beside as rsoccer_beside
+from arena.experiments.rsoccer import check as rsoccer_check
 from arena.match import child
 from arena.review.console import console as make_console
 
@@ -49,8 +53,8 @@ if TYPE_CHECKING:
 
 ENGINES = ("processes", "inprocess")
 RSOCCER = (
-    "not measured by this command: rSoccer's VSS-v0 needs Python 3.10 (rc-robosim, rsoccer-gym); "
-    "docs/performance.md has the side-by-side figures and how they were taken"
+    "not measured: rSoccer's VSS-v0 needs Python 3.10 (rc-robosim, rsoccer-gym); "
+    "name that interpreter with --rsoccer PYTHON to measure it beside our match"
 )
 # What "launch" means in the two start-up rows (printed with the table; docs/performance.md).
 LAUNCH_DEFINITIONS = {
@@ -124,10 +128,14 @@ def bench_throughput(
     strategy: str,
     as_json: bool,
     learn_rates: Callable[[MatchConfig, int, str, Callable[[str], None]], dict] | None = None,
+    rsoccer: str = "",
 ) -> int:
     """`runs` matches of `base` between two teams of `strategy`, on each engine, interleaved;
-    `learn_rates`: the learning env's figures (arena/learn/bench.py), None without the learn extra."""
+    `learn_rates`: the learning env's figures (arena/learn/bench.py), None without the learn extra;
+    `rsoccer`: a Python with rSoccer installed ("" for none; experiments/rsoccer.py)."""
     console = make_console(stderr=True)
+    if rsoccer:
+        rsoccer_check(rsoccer)  # a wrong interpreter is told before the first match, not after the last
     cores = os.cpu_count() or 1
     jobs = default_jobs()
     played: dict[str, list[dict]] = {e: [] for e in ENGINES}
@@ -143,6 +151,7 @@ def bench_throughput(
     ratio = statistics.median(b["rtf"] / a["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
     back = statistics.median(a["rtf"] / b["rtf"] for a, b in zip(played["processes"], played["inprocess"]))
     learn = learn_rates(base, runs, strategy, console.print) if learn_rates is not None else None
+    vss = rsoccer_beside(base, runs, strategy, rsoccer, console.print) if rsoccer else None
     out = {
         "runs": runs,
         "match": f"{strategy} v {strategy}, {base.robots}v{base.robots}, 2 x {base.half_time:g} s, link {base.link}",
@@ -152,7 +161,7 @@ def bench_throughput(
         "rtf_ratio_inprocess_over_processes": round(ratio, 2),
         "rtf_ratio_processes_over_inprocess": round(back, 3),
         "learn": learn,  # None: the learn extra is not installed
-        "rsoccer": RSOCCER,
+        "rsoccer": vss if vss is not None else RSOCCER,
         "digests_equal": same,
         "throughput_how": "matches/hour of 2 x 300 s = min(jobs x 3600 / (600 / rtf + start-up and teardown), "
         "cores x 3600 / (CPU s per simulated s x 600)), from the medians above",
@@ -209,7 +218,14 @@ def bench_throughput(
             f"match's {learn['match_ticks_per_cpu_s']:.0f} ticks per CPU-second (this process): "
             f"{learn['env_over_match']:.2f} x"
         )
-    console.print(f"rSoccer VSS-v0: {RSOCCER}")
+    if vss is None:
+        console.print(f"rSoccer VSS-v0: {RSOCCER}")
+    else:
+        console.print(
+            f"rSoccer VSS-v0 (3v3, no referee, random actions): {vss['vss_steps_per_cpu_s']:.0f} steps per "
+            f"CPU-second; our 3v3 match with the referee: {vss['ours_ticks_per_cpu_s']:.0f} ticks per "
+            f"CPU-second: {vss['ours_over_vss']:.2f} x (median of the pairs)"
+        )
     console.print("throughput derived: " + out["throughput_how"])
     console.print(f"(1) {LAUNCH_DEFINITIONS['command']}")
     console.print(f"(2) {LAUNCH_DEFINITIONS['play_match']}")

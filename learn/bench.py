@@ -26,19 +26,12 @@ import gymnasium
 import numpy as np
 
 from arena.config import MatchConfig
+from arena.experiments.rsoccer import match_rate
 from arena.learn.parallel import SoccerParallelEnv
 from arena.learn.single import SoccerEnv, make_vector_env
-from arena.match import play
 from arena.review.console import console as make_console
 
 ACTIONS = np.random.default_rng(0).uniform(-1, 1, (64, 4)).astype(np.float32)  # cycled: no draw in the loop
-
-
-def match_rate(cfg: MatchConfig) -> float:
-    """In-process match: ticks per CPU-second."""
-    t0 = time.process_time()
-    play(cfg)
-    return (cfg.total_ticks + 1) / (time.process_time() - t0)
 
 
 def env_rate(cfg: MatchConfig, agents: list[str], frame_skip: int = 1) -> float:

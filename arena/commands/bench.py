@@ -17,6 +17,7 @@ EXAMPLES = """examples:
   arena bench record               # median rtf with and without --record, and the ratio
   arena bench robot                # median us per robot control step and per F-SFM step
   arena bench throughput --runs 5  # both engines interleaved: rtf, ratio, start-up, tournament matches/hour
+  arena bench throughput --rsoccer ~/rsoccer/bin/python  # and rSoccer's VSS-v0 beside our match
   arena bench learn --half-time 30 # env steps/cpu-s for 1 and 3 learners vs. the match; vector env 2 vs. 1
   arena bench experiment          # CPU the experiment runner adds to the in-process matches it plays
   arena bench scenario --runs 10   # 10-s scenario runs per minute, in process, and the ratio to a plain match
@@ -33,7 +34,7 @@ MATCH_DEFAULTS = {"half_time": 60.0}
 USES = {
     "match": {"runs", *MATCH},
     "record": {"runs", *MATCH},
-    "throughput": {"runs", *MATCH, "strategy"},
+    "throughput": {"runs", *MATCH, "strategy", "rsoccer"},
     "robot": {"strategy"},
     "learn": {"runs", "half_time", "strategy"},
     "scenario": {"runs"},
@@ -50,6 +51,7 @@ DEFAULTS = {
     "scenarios": None,
     "only": None,
     "plots": None,
+    "rsoccer": None,
 }
 
 
@@ -91,6 +93,11 @@ def add_parser(sub) -> None:
     )
     b.add_argument("--only", action="append", metavar="NAME[,NAME]", help="nav: run only these scenarios")
     b.add_argument("--plots", metavar="DIR", help="nav: also write PNG trajectory plots into DIR")
+    b.add_argument(
+        "--rsoccer",
+        metavar="PYTHON",
+        help="throughput: a Python 3.10 with rSoccer (rsoccer-gym, rc-robosim) installed: its VSS-v0 beside our match",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -137,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
             from arena.learn.bench import learn_rates
         except ImportError:
             learn_rates = None  # type: ignore[assignment]
-        return throughput.bench_throughput(base, args.runs, strategy, args.json, learn_rates)
+        return throughput.bench_throughput(base, args.runs, strategy, args.json, learn_rates, args.rsoccer or "")
     if args.what == "nav":
         from arena.experiments import navbench
 

@@ -157,6 +157,8 @@ BAD = [
     (["bench", "match", "--half-time", "0.001"], "shorter than one tick"),  # before "run 1/3" is printed
     (["bench", "record", "--link", "moon"], "unknown link preset 'moon'"),  # was two empty matches, then no MCAP
     (["bench", "throughput", "--strategy", "nope"], "unknown strategy 'nope'"),  # was an internal error
+    (["bench", "throughput", "--rsoccer", "/nonexistent/python"], "--rsoccer /nonexistent/python: no such interpreter"),
+    (["bench", "match", "--rsoccer", "/usr/bin/python3"], "--rsoccer does not apply to arena bench match"),
     (["bench", "nav", "--trials", "0"], "--trials: '0'"),
     (["bench", "nav", "--scenarios", "/nonexistent.toml"], "nonexistent.toml"),
     (["bench", "nav", "--only", "nosuch"], "nosuch"),
