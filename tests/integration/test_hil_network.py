@@ -102,7 +102,7 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     result = json.loads(out)
     a1 = next(p for p in result["processes"] if (p["kind"], p["team"], p["robot"]) == ("robot", "a", 1))
     assert a1["external"] and result["distance_m"]["a/1"] > 0.5, "the robot across the network moved"
-    assert result["dead"] == []
+    assert result["dead"] == [], (result["faults"], result["outcome_reasons"], err[-4000:], r_err[-2000:])
 
 
 def test_an_external_robot_that_never_comes_is_named(tmp_path):
