@@ -21,8 +21,7 @@
 
 from __future__ import annotations
 
-import math
-from math import cos, hypot, sin
+from math import cos, hypot, sin, sqrt
 
 from arena.navigation.pid import update as pid_update
 from arena.schemas.messages import Cmd, Order
@@ -111,12 +110,16 @@ class MotionMixin:
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
         c, s = cos(th), sin(th)
-        nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
-        vx, vy = self.guard_push(nx, ny, vx, vy, p.contact_range)
         has_ball = view.has_ball
-        if has_ball:  # the held ball is part of the body: do not push it into an opponent either
-            reach = self.ball_reach
-            vx, vy = self.guard_push(nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
+        guard = self._guard
+        if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
+            nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
+            opponents = view.opponents_now
+            vx, vy = _guard_push(opponents, guard, nx, ny, vx, vy, p.contact_range)
+            if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
+                # the held ball is part of the body: do not push it into an opponent either
+                reach = self.ball_reach
+                vx, vy = _guard_push(opponents, guard, nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
         mem = self.mem
         omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
@@ -136,21 +139,36 @@ class MotionMixin:
         that shields the ball with its body can turn away, and a holder does
         not drive the ball into an opponent (which would knock it loose).
         """
-        rng, brake2, guard2, contact_push = self._guard
-        if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
-            return vx, vy
-        for ox, oy in self.view.opponents_now:
-            dx, dy = ox - x, oy - y
-            if abs(dx) > rng or abs(dy) > rng:
-                continue
-            d = hypot(dx, dy)
-            if 1e-6 < d < rng:
-                ex, ey = dx / d, dy / d
-                closing = vx * ex + vy * ey
-                if closing <= contact_push:
-                    continue
-                cap = contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
-                if closing > cap:
-                    vx -= (closing - cap) * ex
-                    vy -= (closing - cap) * ey
+        return _guard_push(self.view.opponents_now, self._guard, x, y, vx, vy, contact)
+
+
+def _guard_push(
+    opponents: list[Vec],
+    guard: tuple[float, float, float, float],
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    contact: float,
+) -> Vec:
+    """`MotionMixin.guard_push` on the opponents given, with `guard` = (push_guard_range, 2 brake, push_guard^2,
+    contact_push): a plain function, so that `drive` fetches the opponents once for the robot and its ball."""
+    rng, brake2, guard2, contact_push = guard
+    if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
         return vx, vy
+    nrng = -rng
+    for ox, oy in opponents:
+        dx, dy = ox - x, oy - y
+        if not (nrng <= dx <= rng and nrng <= dy <= rng):  # abs(dx) > rng or abs(dy) > rng, without the calls
+            continue
+        d = hypot(dx, dy)
+        if 1e-6 < d < rng:
+            ex, ey = dx / d, dy / d
+            closing = vx * ex + vy * ey
+            if closing <= contact_push:
+                continue
+            cap = contact_push if d < contact else sqrt(guard2 + brake2 * (d - contact))
+            if closing > cap:
+                vx -= (closing - cap) * ex
+                vy -= (closing - cap) * ey
+    return vx, vy
