@@ -47,6 +47,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self.order: Order | None = None
         self.plan: Plan | None = None
         self._support: tuple[Order | None, Vec] | None = None
+        self._restart: tuple[Order, Vec, float, tuple[Vec, ...]] | None = None  # see `position_for_restart`
         self._planned: Order | None = None
         self._ticks_2s = int(2.0 / cfg.timing.dt)
         self.tick = 0
