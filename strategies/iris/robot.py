@@ -49,6 +49,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._support: tuple[Order | None, Vec] | None = None
         self._restart: tuple[Order, Vec, float, tuple[Vec, ...]] | None = None  # see `position_for_restart`
         self._planned: Order | None = None
+        self._may_keep_away = False  # see `step`
         self._ticks_2s = int(2.0 / cfg.timing.dt)
         self.tick = 0
         self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
@@ -76,12 +77,14 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
             return Cmd(tick=tick)
         mem = self.mem
         command = order.command
-        if command != mem.command:
-            mem.command, mem.command_since = command, tick
-        self.role = order.role or self.role or "defender"
-        if order is not self._planned:
+        if order is not self._planned:  # what follows from the order alone, once per order
+            if command != mem.command:
+                mem.command, mem.command_since = command, tick
+            self.role = order.role or self.role or "defender"
             self.plan = self.make_plan(order)
             self._planned = order
+            # `keep_setpiece_distance` is False for the rest of this order: not the opponents' restart, or the keeper
+            self._may_keep_away = order.command_team not in (self.team, "") and self.role != "goalkeeper"
         has_ball = view.has_ball
         if not has_ball:
             if mem.carry_from is not None and tick - mem.kicked_at > 2:
@@ -97,7 +100,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         ball = view.ball
         if ball is None:
             return Cmd(tick=tick, omega=1.0)  # look round for the ball
-        if self.keep_setpiece_distance(tick, order, ball):
+        if self._may_keep_away and self.keep_setpiece_distance(tick, order, ball):
             return self.position_for_restart(tick, order)
         if self.role == "goalkeeper":
             return self.goalkeeper(tick, order, ball)
