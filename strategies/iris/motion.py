@@ -21,9 +21,9 @@
 
 from __future__ import annotations
 
-from math import cos, hypot, sin, sqrt
+from math import cos, hypot, pi, remainder, sin, sqrt
 
-from arena.navigation.pid import update as pid_update
+from arena.navigation.frames import TAU
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import Vec
@@ -120,11 +120,34 @@ class MotionMixin:
                 # the held ball is part of the body: do not push it into an opponent either
                 reach = self.ball_reach
                 vx, vy = _guard_push(opponents, guard, nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
-        mem = self.mem
-        omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
+        omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
         omega = -limit if omega < -limit else limit if omega > limit else omega
         return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
+
+    def _heading_pid(self, beta: float, theta: float) -> float:
+        """The heading PID (paper 1 eq. 15-16) on the robot's memory: `arena.navigation.pid.update` inlined,
+        the same float operations in the same order, with its gains read once (`_pid`); this runs every tick."""
+        mem = self.mem
+        k_p, k_i, k_d, max_integral, max_output = self._pid
+        err = remainder(beta - theta, TAU)  # eq. 15
+        if err == -pi:
+            err = pi
+        integral = mem.pid_integral + err
+        if not -max_integral < integral < max_integral:
+            integral = max(-max_integral, min(max_integral, integral))
+        prev = mem.pid_error
+        if prev is None:
+            derivative = 0.0
+        else:
+            derivative = remainder(err - prev, TAU)
+            if derivative == -pi:
+                derivative = pi
+        mem.pid_integral, mem.pid_error = integral, err
+        out = k_p * err + k_i * integral + k_d * derivative  # eq. 16
+        if not -max_output < out < max_output:
+            out = max(-max_output, min(max_output, out))
+        return out
 
     def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:
         """Cap the closing speed towards every nearby opponent, so that contact is never a pushing foul.

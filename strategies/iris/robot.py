@@ -62,6 +62,8 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._drive_hy = self.half_width + 0.3  # [m]
         self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
         self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
+        pid = p.heading_pid
+        self._pid = (pid.k_p, pid.k_i, pid.k_d, pid.max_integral, pid.max_output)  # `_heading_pid`
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
 
