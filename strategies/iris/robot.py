@@ -118,18 +118,10 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         areas = self._areas.get(key)
         if areas is None:
             areas = self._areas[key] = R.areas(roles, self.area_params)
-        attackers: list[Vec] = []
-        mates: list[Vec] = []
-        for n, (x, y, r) in sorted(self.view.mates.items()):
-            if n != 0:
-                mates.append((x, y))
-                if r == "attacker":
-                    attackers.append((x, y))
         return Plan(
             role=self.role,
             area=areas.get(self.n, self._defense_area),
             areas=areas,
-            attackers=tuple(attackers),
-            mates=tuple(mates),
             attacking=R.is_attacking(order.role_state),
+            team=self.view.mates,  # a new dict with every order (`RobotView.update`)
         )
