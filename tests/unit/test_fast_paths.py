@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 import random
+from dataclasses import replace
 
 from arena.config import MatchConfig
 from arena.navigation import fsfm, pid
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
+from arena.strategies import registry
+from arena.strategies.base import RobotContext
 from arena.strategies.world import FusionParams, RobotView
 
 
@@ -64,11 +67,6 @@ def test_pid_update_is_bit_identical_to_eq_16():
 
 
 def test_the_robots_heading_pid_is_bit_identical_to_pid_update():
-    from dataclasses import replace
-
-    from arena.strategies import registry
-    from arena.strategies.base import RobotContext
-
     cfg = MatchConfig()
     rng = random.Random(5)
     for p in (pid.PIDParams(), pid.PIDParams(max_output=2.0, max_integral=0.5)):
