@@ -202,16 +202,23 @@ def gain(d: float, phi: float, fis: FIS = FIS()) -> float:
 
     ``phi`` may be signed; left and right are symmetric. Only the sets with
     a non-zero degree take part (at most two per input with these partitions).
+    The direction degrees are `_degrees` inlined (this runs per obstacle and tick), the same arithmetic.
     """
     mu_d = _degrees(d, fis.distance_mf)
     num = den = 0.0
     table = fis.table
-    for b, mg in _degrees(abs(phi), fis.direction_mf):
-        row = table[b]
-        for a, md in mu_d:
-            fire = mg * md  # B_ab, eq. 9
-            num += fire * row[a]
-            den += fire
+    x = abs(phi)
+    for b, u, v, w, vu, wv in fis.direction_mf:
+        if x <= v:
+            mg = 1.0 if u == v else (x - u) / vu if x > u else 0.0
+        else:
+            mg = 1.0 if v == w else (w - x) / wv if x < w else 0.0
+        if mg > 0.0:
+            row = table[b]
+            for a, md in mu_d:
+                fire = mg * md  # B_ab, eq. 9
+                num += fire * row[a]
+                den += fire
     if den == 0.0:
         raise ValueError(f"no rule fires for d={d}, phi={phi}: the input sets do not cover it")
     return num / den

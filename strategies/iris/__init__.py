@@ -20,12 +20,14 @@ One module per concern:
   `attack.py`, `defense.py`, `positions.py`, `keeper.py` and `setpieces.py`;
 * `memory.py`: what a robot remembers between ticks and the plan of an order.
 
-Cost: what depends only on the order (areas, roles, teammates) is worked out
-once per order (`Plan`, `support_point`), not once per tick; with no robot
+Cost: what depends only on the order (areas, roles, teammates, a restart's
+fixed place) is worked out once per order (`Plan`, `support_point`,
+`position_for_restart`), not once per tick; with no robot
 within `obstacle_range` the navigator is not called (F-SFM then gives the
 straight line at cruise speed). The per-tick path (`step`, `drive`, the
 goalkeeper, the chaser) keeps its constants in attributes worked out in
-`__init__` and inlines small helpers (`inside`, `S.dist`, `S.angle_to`, `min`);
+`__init__` and inlines small helpers (`inside`, `S.dist`, `S.angle_to`, `min`,
+the heading PID's `arena.navigation.pid.update`);
 each inlined expression does the very float operations of the helper it stands
 for, so that matches replay bit for bit.
 """

@@ -88,9 +88,10 @@ class DefenseMixin:
         sp = self.p.skills
         own = self.own_goal(order)
         carrier = self.carrier(ball)
-        if carrier is not None and S.dist(carrier, own) < self.p.block_zone:
+        d_carrier = S.dist(carrier, own) if carrier is not None else 0.0  # [m] the carrier to our goal centre
+        if carrier is not None and d_carrier < self.p.block_zone:
             block = S.block_point(carrier, own, sp, ball)
-            if self.is_blocker(order, block, carrier, own):
+            if self.is_blocker(order, block, d_carrier - 0.2, own):
                 # Within take_distance of the ball, take it, but only from the kick line: straight at the
                 # ball from goal-side; going round the ball to get behind it would open the line to our goal.
                 on_line = abs(wrap_angle(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
@@ -98,7 +99,7 @@ class DefenseMixin:
                     return self.drive(
                         tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True, avoid=False
                     )
-                goal_side = S.dist(pos, own) < S.dist(carrier, own) - 0.2
+                goal_side = S.dist(pos, own) < d_carrier - 0.2
                 return self.drive(
                     tick,
                     block,
@@ -122,26 +123,32 @@ class DefenseMixin:
             return None
         return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
 
-    def is_blocker(self, order: Order, block: Vec, carrier: Vec, own: Vec) -> bool:
+    def is_blocker(self, order: Order, block: Vec, limit: float, own: Vec) -> bool:
         """Advance defense: of our outfield robots, the one that gets onto the kick line soonest blocks:
-        the nearest to the block point, counting `behind_penalty` more for a robot not goal-side of the
-        carrier (it has to go round it) and `chase_hysteresis` less for the current blocker. Static roles:
-        only robots whose Fig. 5 area holds the block point."""
+        the nearest to the block point, counting `behind_penalty` more for a robot farther than `limit` [m]
+        (the carrier's distance to our goal centre `own` less 0.2 m: not goal-side of the carrier, it has to
+        go round it) and `chase_hysteresis` less for the current blocker. Static roles: only robots whose
+        Fig. 5 area holds the block point."""
+        mem = self.mem
         if not self.in_area(order, block):
-            self.mem.blocking = False
+            mem.blocking = False
             return False
-        limit = S.dist(carrier, own) - 0.2
-
-        def cost(pt: Vec) -> float:
-            return S.dist(pt, block) + (self.p.behind_penalty if S.dist(pt, own) > limit else 0.0)
-
+        penalty = self.p.behind_penalty
+        bx, by = block
+        ox, oy = own
         x, y, _ = self.view.pose  # type: ignore[misc]
-        mine = (cost((x, y)) - (self.p.chase_hysteresis if self.mem.blocking else 0.0), self.n)
-        mates = self.view.mates.items()
-        self.mem.blocking = all(
-            (cost((mx, my)), n) > mine for n, (mx, my, _) in mates if n != 0 and self.in_area(order, block, n)
-        )
-        return self.mem.blocking
+        # cost(pt) = S.dist(pt, block) + (penalty if S.dist(pt, own) > limit else 0.0), inlined
+        mine = hypot(x - bx, y - by) + (penalty if hypot(x - ox, y - oy) > limit else 0.0)
+        mine -= self.p.chase_hysteresis if mem.blocking else 0.0
+        me = self.n
+        for n, (mx, my, _) in self.view.mates.items():
+            if n != 0 and self.in_area(order, block, n):
+                cost = hypot(mx - bx, my - by) + (penalty if hypot(mx - ox, my - oy) > limit else 0.0)
+                if not (cost > mine or cost == mine and n > me):  # not (cost, n) > (mine, me)
+                    mem.blocking = False
+                    return False
+        mem.blocking = True
+        return True
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
         """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""

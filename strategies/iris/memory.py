@@ -33,6 +33,15 @@ class Plan:
     role: str
     area: tuple[float, float]  # (u_min, u_max) [m] of this robot
     areas: dict[int, tuple[float, float]]  # of every outfield teammate with a role
-    attackers: tuple[Vec, ...]  # positions [m] of the teammates that are attackers, by robot number
-    mates: tuple[Vec, ...]  # positions [m] of the outfield teammates, by robot number
     attacking: bool  # Fig. 6: the team is in attacking mode
+    team: dict[int, tuple[float, float, str]]  # the order's teammates: n -> (x [m], y [m], role)
+
+    @property
+    def mates(self) -> tuple[Vec, ...]:
+        """Positions [m] of the outfield teammates, by robot number (asked for with the ball only)."""
+        return tuple((x, y) for n, (x, y, _) in sorted(self.team.items()) if n != 0)
+
+    @property
+    def attackers(self) -> tuple[Vec, ...]:
+        """Positions [m] of the teammates that are attackers, by robot number."""
+        return tuple((x, y) for n, (x, y, r) in sorted(self.team.items()) if n != 0 and r == "attacker")

@@ -21,10 +21,9 @@
 
 from __future__ import annotations
 
-import math
-from math import cos, hypot, sin
+from math import cos, hypot, pi, remainder, sin, sqrt
 
-from arena.navigation.pid import update as pid_update
+from arena.navigation.frames import TAU
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import Vec
@@ -111,17 +110,44 @@ class MotionMixin:
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
         c, s = cos(th), sin(th)
-        nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
-        vx, vy = self.guard_push(nx, ny, vx, vy, p.contact_range)
         has_ball = view.has_ball
-        if has_ball:  # the held ball is part of the body: do not push it into an opponent either
-            reach = self.ball_reach
-            vx, vy = self.guard_push(nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
-        mem = self.mem
-        omega, mem.pid_integral, mem.pid_error = pid_update(mem.pid_integral, mem.pid_error, heading, th, p.heading_pid)
+        guard = self._guard
+        if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
+            nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
+            opponents = view.opponents_now
+            vx, vy = _guard_push(opponents, guard, nx, ny, vx, vy, p.contact_range)
+            if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
+                # the held ball is part of the body: do not push it into an opponent either
+                reach = self.ball_reach
+                vx, vy = _guard_push(opponents, guard, nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
+        omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
         omega = -limit if omega < -limit else limit if omega > limit else omega
         return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
+
+    def _heading_pid(self, beta: float, theta: float) -> float:
+        """The heading PID (paper 1 eq. 15-16) on the robot's memory: `arena.navigation.pid.update` inlined,
+        the same float operations in the same order, with its gains read once (`_pid`); this runs every tick."""
+        mem = self.mem
+        k_p, k_i, k_d, max_integral, max_output = self._pid
+        err = remainder(beta - theta, TAU)  # eq. 15
+        if err == -pi:
+            err = pi
+        integral = mem.pid_integral + err
+        if not -max_integral < integral < max_integral:
+            integral = max(-max_integral, min(max_integral, integral))
+        prev = mem.pid_error
+        if prev is None:
+            derivative = 0.0
+        else:
+            derivative = remainder(err - prev, TAU)
+            if derivative == -pi:
+                derivative = pi
+        mem.pid_integral, mem.pid_error = integral, err
+        out = k_p * err + k_i * integral + k_d * derivative  # eq. 16
+        if not -max_output < out < max_output:
+            out = max(-max_output, min(max_output, out))
+        return out
 
     def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:
         """Cap the closing speed towards every nearby opponent, so that contact is never a pushing foul.
@@ -136,21 +162,36 @@ class MotionMixin:
         that shields the ball with its body can turn away, and a holder does
         not drive the ball into an opponent (which would knock it loose).
         """
-        rng, brake2, guard2, contact_push = self._guard
-        if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
-            return vx, vy
-        for ox, oy in self.view.opponents_now:
-            dx, dy = ox - x, oy - y
-            if abs(dx) > rng or abs(dy) > rng:
-                continue
-            d = hypot(dx, dy)
-            if 1e-6 < d < rng:
-                ex, ey = dx / d, dy / d
-                closing = vx * ex + vy * ey
-                if closing <= contact_push:
-                    continue
-                cap = contact_push if d < contact else math.sqrt(guard2 + brake2 * (d - contact))
-                if closing > cap:
-                    vx -= (closing - cap) * ex
-                    vy -= (closing - cap) * ey
+        return _guard_push(self.view.opponents_now, self._guard, x, y, vx, vy, contact)
+
+
+def _guard_push(
+    opponents: list[Vec],
+    guard: tuple[float, float, float, float],
+    x: float,
+    y: float,
+    vx: float,
+    vy: float,
+    contact: float,
+) -> Vec:
+    """`MotionMixin.guard_push` on the opponents given, with `guard` = (push_guard_range, 2 brake, push_guard^2,
+    contact_push): a plain function, so that `drive` fetches the opponents once for the robot and its ball."""
+    rng, brake2, guard2, contact_push = guard
+    if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
         return vx, vy
+    nrng = -rng
+    for ox, oy in opponents:
+        dx, dy = ox - x, oy - y
+        if not (nrng <= dx <= rng and nrng <= dy <= rng):  # abs(dx) > rng or abs(dy) > rng, without the calls
+            continue
+        d = hypot(dx, dy)
+        if 1e-6 < d < rng:
+            ex, ey = dx / d, dy / d
+            closing = vx * ex + vy * ey
+            if closing <= contact_push:
+                continue
+            cap = contact_push if d < contact else sqrt(guard2 + brake2 * (d - contact))
+            if closing > cap:
+                vx -= (closing - cap) * ex
+                vy -= (closing - cap) * ey
+    return vx, vy

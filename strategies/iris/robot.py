@@ -47,7 +47,9 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self.order: Order | None = None
         self.plan: Plan | None = None
         self._support: tuple[Order | None, Vec] | None = None
+        self._restart: tuple[Order, Vec, float, tuple[Vec, ...]] | None = None  # see `position_for_restart`
         self._planned: Order | None = None
+        self._may_keep_away = False  # see `step`
         self._ticks_2s = int(2.0 / cfg.timing.dt)
         self.tick = 0
         self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
@@ -60,6 +62,8 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._drive_hy = self.half_width + 0.3  # [m]
         self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
         self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
+        pid = p.heading_pid
+        self._pid = (pid.k_p, pid.k_i, pid.k_d, pid.max_integral, pid.max_output)  # `_heading_pid`
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
 
@@ -75,12 +79,14 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
             return Cmd(tick=tick)
         mem = self.mem
         command = order.command
-        if command != mem.command:
-            mem.command, mem.command_since = command, tick
-        self.role = order.role or self.role or "defender"
-        if order is not self._planned:
+        if order is not self._planned:  # what follows from the order alone, once per order
+            if command != mem.command:
+                mem.command, mem.command_since = command, tick
+            self.role = order.role or self.role or "defender"
             self.plan = self.make_plan(order)
             self._planned = order
+            # `keep_setpiece_distance` is False for the rest of this order: not the opponents' restart, or the keeper
+            self._may_keep_away = order.command_team not in (self.team, "") and self.role != "goalkeeper"
         has_ball = view.has_ball
         if not has_ball:
             if mem.carry_from is not None and tick - mem.kicked_at > 2:
@@ -96,7 +102,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         ball = view.ball
         if ball is None:
             return Cmd(tick=tick, omega=1.0)  # look round for the ball
-        if self.keep_setpiece_distance(tick, order, ball):
+        if self._may_keep_away and self.keep_setpiece_distance(tick, order, ball):
             return self.position_for_restart(tick, order)
         if self.role == "goalkeeper":
             return self.goalkeeper(tick, order, ball)
@@ -112,18 +118,10 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         areas = self._areas.get(key)
         if areas is None:
             areas = self._areas[key] = R.areas(roles, self.area_params)
-        attackers: list[Vec] = []
-        mates: list[Vec] = []
-        for n, (x, y, r) in sorted(self.view.mates.items()):
-            if n != 0:
-                mates.append((x, y))
-                if r == "attacker":
-                    attackers.append((x, y))
         return Plan(
             role=self.role,
             area=areas.get(self.n, self._defense_area),
             areas=areas,
-            attackers=tuple(attackers),
-            mates=tuple(mates),
             attacking=R.is_attacking(order.role_state),
+            team=self.view.mates,  # a new dict with every order (`RobotView.update`)
         )

@@ -24,12 +24,17 @@ class SetPieceMixin:
     """Mixin of `IrisRobot`: set pieces."""
 
     def position_for_restart(self, tick: int, order: Order) -> Cmd:
+        fixed = self._restart
+        if fixed is not None and fixed[0] is order:  # the keeper's place or the home of this order, as last tick
+            _, target, heading, extra = fixed
+            return self.drive(tick, target, heading, self.p.cruise, extra_obstacles=extra)
         spot = (order.spot_x, order.spot_y)
         goal = self.goal(order)
         if self.role == "goalkeeper":
             own = self.own_goal(order)
             target = (own[0] + order.attack_dir * self.p.skills.keeper_depth, 0.0)
-            return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise)
+            self._restart = (order, target, S.angle_to(target, spot), ())
+            return self.drive(tick, target, self._restart[2], self.p.cruise)
         ours = order.command_team in (self.team, "")
         if ours and self.is_taker(order, spot):
             behind = order.command_team == self.team and order.command == "DROP_BALL"
@@ -54,6 +59,8 @@ class SetPieceMixin:
         if S.dist(home, spot) < keep:
             a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, self.own_goal(order))
             home = self.inside((spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a)), margin=-0.2)
+        if not ours and not (self.p.advance and order.command in WALL_PIECES):  # no taker nor wall: fixed for the order
+            self._restart = (order, home, S.angle_to(home, spot), (spot,))
         return self.drive(tick, home, S.angle_to(home, spot), self.p.cruise, extra_obstacles=(spot,))
 
     def setpiece_defense(self, order: Order, spot: Vec) -> Vec | None:

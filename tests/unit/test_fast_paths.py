@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 import random
+from dataclasses import replace
 
 from arena.config import MatchConfig
 from arena.navigation import fsfm, pid
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
+from arena.strategies import registry
+from arena.strategies.base import RobotContext
 from arena.strategies.world import FusionParams, RobotView
 
 
@@ -61,6 +64,21 @@ def test_pid_update_is_bit_identical_to_eq_16():
             out_b, b = _pid_reference(b, beta, theta, p)
             assert (out_a, a) == (out_b, b)
             assert math.copysign(1.0, out_a) == math.copysign(1.0, out_b)
+
+
+def test_the_robots_heading_pid_is_bit_identical_to_pid_update():
+    cfg = MatchConfig()
+    rng = random.Random(5)
+    for p in (pid.PIDParams(), pid.PIDParams(max_output=2.0, max_integral=0.5)):
+        robot = registry.get("AD").make_robot(RobotContext(cfg=cfg, team="a", n=1, rng=random.Random(0)))
+        robot.p = replace(robot.p, heading_pid=p)
+        robot._pid = (p.k_p, p.k_i, p.k_d, p.max_integral, p.max_output)
+        integral, prev = 0.0, None
+        for _ in range(5000):
+            beta, theta = rng.uniform(-4.0, 4.0), rng.choice([math.pi, -math.pi, rng.uniform(-4.0, 4.0)])
+            out, integral, prev = pid.update(integral, prev, beta, theta, p)
+            assert robot._heading_pid(beta, theta) == out
+            assert (robot.mem.pid_integral, robot.mem.pid_error) == (integral, prev)
 
 
 def test_robot_view_merges_the_order_with_own_detections():
