@@ -138,12 +138,13 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
 
     def _apply_commands(self, s: list[float]) -> None:
         half_dt = self._dt / 2
+        cos, sin = math.cos, math.sin
         for r in self._robots:
             o = r.off
             if r.cmd is not None:
                 vx, vy, w = r.twist
                 theta = s[o + 2] + half_dt * s[o + 5]
-                c, sn = math.cos(theta), math.sin(theta)
+                c, sn = cos(theta), sin(theta)
                 target = (c * vx - sn * vy, sn * vx + c * vy, w)
             else:
                 target = (0.0, 0.0, 0.0)
@@ -152,13 +153,26 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
                 set_velocity(ctrl, target[:2])
                 set_angular_velocity(ctrl, target[2])
                 r.ctrl_set = target
-            if self._holder is r and not r.dribbler:
-                self._release()
             holder = self._holder
-            free = not self._dead and self._pin is None
-            if r.kick_armed and free and (holder is r or (holder is None and self._in_reach(r, s))):
+            if holder is r and not r.dribbler:
+                self._release()
+                holder = None
+            # `_can_capture(r)`, inlined (six robots a tick); a kick that cannot fire falls through to it.
+            if (
+                r.kick_armed
+                and not self._dead
+                and self._pin is None
+                and (holder is r or (holder is None and self._in_reach(r, s)))
+            ):
                 self._kick(r, s)
-            elif self._can_capture(r) and self._in_reach(r, s):
+            elif (
+                r.dribbler
+                and holder is None
+                and not self._dead
+                and self._pin is None
+                and self.tick >= r.catch_from
+                and self._in_reach(r, s)
+            ):
                 self._capture(r, s)
 
     def _after_tick(self) -> None:
