@@ -107,7 +107,15 @@ class Drive:
                 return 0.0, 0.0, 0.0
             s = saturation_scale(cmd.wheels, self.max_wheel_speed)
             return self._cap(*self.body_twist([w * s for w in cmd.wheels]))
-        vx, vy, w = self._cap(cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega)
+        # self._cap(cmd.vx, vy, cmd.omega), inlined (six times a tick); min(max(w, -m), m) as two tests
+        vx, vy, w = cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega
+        speed, top, m = math.hypot(vx, vy), self.max_speed, self.max_omega
+        if speed > top:
+            vx, vy = vx * top / speed, vy * top / speed
+        if w < -m:
+            w = -m
+        elif w > m:
+            w = m
         # saturation_scale(self.wheel_speeds(vx, vy, w), ...) without building the
         # list: the engine does this six times a tick. Same operations, same bits
         # (and x * 1.0 == x, so an unsaturated twist is returned as it is).
