@@ -27,6 +27,7 @@ from arena.sim.physics.bodies import (
     set_angular_velocity,
     set_velocity,
     step_space,
+    unpack,
 )
 from arena.sim.physics.events import Events
 from arena.sim.physics.placement import Placement
@@ -115,11 +116,15 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
         self._events = events = []
         s = self._snap
         self._apply_commands(s)
-        space, read, h = self._space_c, self._read, self._h
-        robots = self._robots
+        space, h, robots = self._space_c, self._h, self._robots
+        # `self._read()` (bodies.py BodyReader), inlined: five reads a tick
+        rd = self._read
+        arr, each, bodies, iterate, data = rd._arr, rd._each, rd._space, rd._iterate, rd._data
         for _ in range(self._substeps):
             step_space(space, h)
-            new = read()
+            arr.num = 0
+            each(bodies, iterate, data)
+            new = unpack(arr.arr, arr.num)
             for r in robots:
                 o = r.off
                 r.dist += math.hypot(new[o] - s[o], new[o + 1] - s[o + 1])
