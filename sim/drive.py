@@ -84,6 +84,12 @@ class Drive:
         self.max_wheel_speed = rp.max_wheel_speed  # [rad/s]
         self.max_speed = rp.max_speed  # [m/s]
         self.max_omega = rp.max_omega  # [rad/s]
+        # A capped body twist whose wheel speeds cannot reach the limit skips the per-wheel check
+        # (`twist`): |a vx + b vy + c w| <= hypot(a, b) hypot(vx, vy) + |c| |w| (Cauchy-Schwarz), and
+        # the 1e-9 margin is far above the rounding of either side, so the check would have passed.
+        self._k_speed = max(math.hypot(a, b) for a, b, _ in self.inverse_rows)
+        self._k_omega = max(abs(c) for _, _, c in self.inverse_rows)
+        self._unsaturated = rp.max_wheel_speed * (1.0 - 1e-9) if rp.max_wheel_speed > 0.0 else -1.0
 
     def wheel_speeds(self, vx: float, vy: float, omega: float) -> list[float]:
         """Inverse kinematics: wheel angular speeds [rad/s] for a body twist, unsaturated."""
@@ -107,7 +113,17 @@ class Drive:
                 return 0.0, 0.0, 0.0
             s = saturation_scale(cmd.wheels, self.max_wheel_speed)
             return self._cap(*self.body_twist([w * s for w in cmd.wheels]))
-        vx, vy, w = self._cap(cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega)
+        # self._cap(cmd.vx, vy, cmd.omega), inlined (six times a tick); min(max(w, -m), m) as two tests
+        vx, vy, w = cmd.vx, cmd.vy if self.holonomic else 0.0, cmd.omega
+        speed, top, m = math.hypot(vx, vy), self.max_speed, self.max_omega
+        if speed > top:
+            vx, vy, speed = vx * top / speed, vy * top / speed, top
+        if w < -m:
+            w = -m
+        elif w > m:
+            w = m
+        if speed * self._k_speed + abs(w) * self._k_omega <= self._unsaturated:
+            return vx, vy, w  # within the wheels' limit, for sure (see __init__)
         # saturation_scale(self.wheel_speeds(vx, vy, w), ...) without building the
         # list: the engine does this six times a tick. Same operations, same bits
         # (and x * 1.0 == x, so an unsaturated twist is returned as it is).

@@ -59,6 +59,7 @@ _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
 step_space = lib.cpSpaceStep  # (space._space, dt): `Space.step` without its add/remove-later queues
 set_velocity = lib.cpBodySetVelocity  # (body._body, (vx, vy)): `Body.velocity = vx, vy`
 set_angular_velocity = lib.cpBodySetAngularVelocity  # (body._body, w): `Body.angular_velocity = w`
+unpack = ffi.unpack
 
 
 class BodyReader:
@@ -90,7 +91,7 @@ class BodyReader:
         arr = self._arr
         arr.num = 0
         self._each(self._space, self._iterate, self._data)
-        return ffi.unpack(arr.arr, arr.num)  # type: ignore[no-any-return]
+        return unpack(arr.arr, arr.num)  # type: ignore[no-any-return]
 
 
 @dataclass(eq=False)

@@ -27,6 +27,7 @@ from arena.sim.physics.bodies import (
     set_angular_velocity,
     set_velocity,
     step_space,
+    unpack,
 )
 from arena.sim.physics.events import Events
 from arena.sim.physics.placement import Placement
@@ -115,11 +116,15 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
         self._events = events = []
         s = self._snap
         self._apply_commands(s)
-        space, read, h = self._space_c, self._read, self._h
-        robots = self._robots
+        space, h, robots = self._space_c, self._h, self._robots
+        # `self._read()` (bodies.py BodyReader), inlined: five reads a tick
+        rd = self._read
+        arr, each, bodies, iterate, data = rd._arr, rd._each, rd._space, rd._iterate, rd._data
         for _ in range(self._substeps):
             step_space(space, h)
-            new = read()
+            arr.num = 0
+            each(bodies, iterate, data)
+            new = unpack(arr.arr, arr.num)
             for r in robots:
                 o = r.off
                 r.dist += math.hypot(new[o] - s[o], new[o + 1] - s[o + 1])
@@ -138,12 +143,13 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
 
     def _apply_commands(self, s: list[float]) -> None:
         half_dt = self._dt / 2
+        cos, sin = math.cos, math.sin
         for r in self._robots:
             o = r.off
             if r.cmd is not None:
                 vx, vy, w = r.twist
                 theta = s[o + 2] + half_dt * s[o + 5]
-                c, sn = math.cos(theta), math.sin(theta)
+                c, sn = cos(theta), sin(theta)
                 target = (c * vx - sn * vy, sn * vx + c * vy, w)
             else:
                 target = (0.0, 0.0, 0.0)
@@ -152,13 +158,26 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
                 set_velocity(ctrl, target[:2])
                 set_angular_velocity(ctrl, target[2])
                 r.ctrl_set = target
-            if self._holder is r and not r.dribbler:
-                self._release()
             holder = self._holder
-            free = not self._dead and self._pin is None
-            if r.kick_armed and free and (holder is r or (holder is None and self._in_reach(r, s))):
+            if holder is r and not r.dribbler:
+                self._release()
+                holder = None
+            # `_can_capture(r)`, inlined (six robots a tick); a kick that cannot fire falls through to it.
+            if (
+                r.kick_armed
+                and not self._dead
+                and self._pin is None
+                and (holder is r or (holder is None and self._in_reach(r, s)))
+            ):
                 self._kick(r, s)
-            elif self._can_capture(r) and self._in_reach(r, s):
+            elif (
+                r.dribbler
+                and holder is None
+                and not self._dead
+                and self._pin is None
+                and self.tick >= r.catch_from
+                and self._in_reach(r, s)
+            ):
                 self._capture(r, s)
 
     def _after_tick(self) -> None:

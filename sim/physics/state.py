@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from arena.navigation.frames import wrap_angle
+from arena.navigation.frames import TAU, wrap_angle
 from arena.schemas.messages import RobotState, World
 
 
@@ -13,11 +13,12 @@ class State:
 
     def robot_states(self) -> list[tuple[str, int, float, float, float, float, float, float]]:
         """Every robot's (team, n, x, y, theta, vx, vy, omega), field frame, in one pass."""
-        s = self._fresh()
-        return [
-            (r.team, r.n, s[r.off], s[r.off + 1], wrap_angle(s[r.off + 2]), s[r.off + 3], s[r.off + 4], s[r.off + 5])
-            for r in self._robots
-        ]
+        s, out, remainder, pi = self._fresh(), [], math.remainder, math.pi
+        for r in self._robots:
+            o = r.off
+            theta = remainder(s[o + 2], TAU)  # wrap_angle, inlined (the engine reads this every tick)
+            out.append((r.team, r.n, s[o], s[o + 1], pi if theta == -pi else theta, s[o + 3], s[o + 4], s[o + 5]))
+        return out
 
     def commanded_speed(self, team: str, n: int) -> float:
         """[m/s] the linear speed robot n's command asks for (within the limits); 0 when parked."""
@@ -62,20 +63,23 @@ class State:
     def world(self, tick: int) -> World:
         """Ground truth as the G_V message."""
         s, b, holder, last = self._fresh(), self._ball_off, self._holder, self._last
-        robots = [
-            RobotState(
-                team=r.team,
-                robot=r.n,
-                x=s[r.off],
-                y=s[r.off + 1],
-                theta=wrap_angle(s[r.off + 2]),
-                vx=s[r.off + 3],
-                vy=s[r.off + 4],
-                omega=s[r.off + 5],
-                has_ball=r is holder,
+        robots, remainder, pi = [], math.remainder, math.pi
+        for r in self._robots:
+            o = r.off
+            theta = remainder(s[o + 2], TAU)  # wrap_angle, inlined (a frame every tick)
+            robots.append(
+                RobotState(
+                    team=r.team,
+                    robot=r.n,
+                    x=s[o],
+                    y=s[o + 1],
+                    theta=pi if theta == -pi else theta,
+                    vx=s[o + 3],
+                    vy=s[o + 4],
+                    omega=s[o + 5],
+                    has_ball=r is holder,
+                )
             )
-            for r in self._robots
-        ]
         return World(
             tick=tick,
             t=tick * self._dt,

@@ -103,14 +103,18 @@ def test_body_twist_is_bit_for_bit_the_saturated_inverse(model):
 
     d = Drive(replace(IRIS, model=model))
     rng = random.Random(11)
-    saturated = 0
-    for _ in range(2000):
-        c = body(rng.uniform(-8, 8), rng.uniform(-8, 8), rng.uniform(-30, 30))
+    saturated = surely_not = 0
+    for i in range(4000):
+        top = 8 if i % 2 else 4  # around the caps, and within them
+        c = body(rng.uniform(-top, top), rng.uniform(-top, top), rng.uniform(-30 / top, 30 / top))
         vx, vy, w = d._cap(c.vx, c.vy if d.holonomic else 0.0, c.omega)
         s = saturation_scale(d.wheel_speeds(vx, vy, w), d.max_wheel_speed)
         saturated += s < 1.0
+        surely_not += math.hypot(vx, vy) * d._k_speed + abs(w) * d._k_omega <= d._unsaturated
         assert d.twist(c) == (vx * s, vy * s, w * s)
-    assert saturated > 100  # both branches ran
+    assert saturated > 100 and surely_not > 100  # both branches ran, and the check wheel by wheel was skipped
+    if d.holonomic:  # (a diff drive's bound is tight: every twist is either)
+        assert 4000 - saturated - surely_not > 100  # and ran, where the bound could not tell
 
 
 def test_a_limit_of_zero_is_still_an_error():

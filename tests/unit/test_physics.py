@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import random
+from types import SimpleNamespace
 
 import pytest
 
@@ -592,18 +593,26 @@ def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
         spaces[self._space._space] = self._space
         ctrls.update((r.ctrl._body, r.ctrl) for r in self._robots)
 
-    def read(space_c):
-        buf = pmbatch.Buffer()
+    class Read:
+        """BodyReader's call, and the parts of it that `Physics.step` inlines, over pymunk's public batch API."""
 
-        def snapshot() -> list[float]:
-            buf.clear()
+        def __init__(self, space: object) -> None:
+            self._space, self._iterate, self._data = space._space, None, None
+            self._arr = SimpleNamespace(arr=self, num=0)  # `unpack(arr.arr, arr.num)` gets this reader back
+            self.last: list[float] = []
+
+        def _each(self, space_c, _iterate, _data) -> None:
+            buf = pmbatch.Buffer()
             pmbatch.get_space_bodies(spaces[space_c], bodies._ALL_FIELDS, buf)
-            return memoryview(buf.float_buf()).cast("d").tolist()
+            self.last = memoryview(buf.float_buf()).cast("d").tolist()
 
-        return snapshot
+        def __call__(self) -> list[float]:
+            self._each(self._space, None, None)
+            return self.last
 
     monkeypatch.setattr(world.WorldBuilding, "_build_world", build)
-    monkeypatch.setattr(world, "BodyReader", lambda space: read(space._space))
+    monkeypatch.setattr(world, "BodyReader", Read)
+    monkeypatch.setattr(model, "unpack", lambda reader, _num: reader.last)
     monkeypatch.setattr(model, "step_space", lambda space_c, h: spaces[space_c].step(h))
     monkeypatch.setattr(model, "set_velocity", lambda body_c, v: setattr(ctrls[body_c], "velocity", v))
     monkeypatch.setattr(model, "set_angular_velocity", lambda body_c, w: setattr(ctrls[body_c], "angular_velocity", w))
