@@ -95,7 +95,7 @@ def resolve_name(name: str) -> str:
     only for a name that is not built in.
     """
     if name.startswith(POLICY_PREFIX):  # a policy file: its absolute path, as every process opens it
-        from arena.strategies import policy_file  # numpy, onnx: only for a policy file
+        from arena.strategies import policy_file  # the policy-file modules: imported for a policy file only
 
         if not name[len(POLICY_PREFIX) :].strip():  # Path("") is the working directory
             raise ConfigError(f"{name!r} names no file: policy:PATH, a file written by arena.learn.save_policy")
