@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
 if TYPE_CHECKING:
@@ -73,6 +71,9 @@ class Processes:
     def play(self, cfg: MatchConfig, *, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
         if not watch:
             return self._play(cfg, record)
+        import tempfile
+        from pathlib import Path
+
         from arena.recording.reader import load
 
         with tempfile.TemporaryDirectory(prefix="arena-match-") as tmp:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 
-from arena.refbox.follow import ViaRefbox
 from arena.rules.referee_box import check_referee
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
@@ -32,7 +31,11 @@ class BaseStationNode(Node):
         self.brain = strategy.make_team(TeamContext(cfg=cfg, team=team, rng=self.rng("strategy")))
         # --via-refbox (real time only): commands and score come over TCP from the RefBox bridge, as
         # a real team's would; the zenoh referee frames are then only the clock (docs/refbox.md).
-        self.via = ViaRefbox(cfg, team, self.log) if cfg.refbox.via else None
+        self.via = None
+        if cfg.refbox.via:  # its TCP client imports socket: only for a match that plays via the RefBox
+            from arena.refbox.follow import ViaRefbox
+
+            self.via = ViaRefbox(cfg, team, self.log)
         self.latest: dict = {}
 
     def on_peer_dead(self, peer: str) -> None:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 
-from arena.refbox.follow import Follower
 from arena.rules.referee_box import RefereeBox
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
@@ -27,7 +26,11 @@ class RefereeNode(Node):
         self.ref_out = self.out("referee")
         self.box = RefereeBox(self.cfg)
         # --refbox-follow: a human at a real MSL RefBox decides (docs/refbox.md); our rules only end the match.
-        self.follower = Follower(self.box, self.log) if self.cfg.refbox.follow else None
+        self.follower = None
+        if self.cfg.refbox.follow:  # its TCP client imports socket: only for a match that follows one
+            from arena.refbox.follow import Follower
+
+            self.follower = Follower(self.box, self.log)
         self.decide = self.follower.step if self.follower else self.box.step
         # A scenario's referee overrides (sim/director.py), each forced at the first referee tick >= its own.
         self.forced = []

@@ -17,8 +17,6 @@ The `Annotated` descriptions are the source of schemas/README.md; run
 `arena schemas --write` after changing anything here.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Literal
 
 import msgspec

@@ -42,6 +42,8 @@ from typing import Protocol
 from arena.config import ConfigError, MatchConfig, ParamValue
 from arena.schemas.messages import Cmd, Order, Pose, Referee, Report, Sense
 
+POLICY_PREFIX = "policy:"  # a policy file's strategy name: policy:PATH (learned.py, policy_file.py)
+
 
 def report_of(
     tick: int, n: int, sense: Sense | None, role: str, pose: tuple[float, float, float] = (0.0, 0.0, 0.0)

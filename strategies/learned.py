@@ -29,9 +29,9 @@ import numpy as np
 from arena.config import MatchConfig
 from arena.schemas.messages import Cmd, Order, Report, Sense
 from arena.schemas.vocabulary import RefCommandName
-from arena.strategies.base import RobotContext, report_of
+from arena.strategies.base import POLICY_PREFIX, RobotContext, report_of
 
-PREFIX = "policy:"
+PREFIX = POLICY_PREFIX
 COMMANDS: tuple[str, ...] = get_args(RefCommandName)
 ROLES = ("goalkeeper", "defender", "attacker")
 MAX_AGE = 60.0  # [s] ages are clipped here

@@ -6,8 +6,7 @@ from functools import cache
 from pathlib import Path
 
 from arena.config import ConfigError, MatchConfig, ParamValue
-from arena.strategies import learned, policy_file
-from arena.strategies.base import Strategy, check_values
+from arena.strategies.base import POLICY_PREFIX, Strategy, check_values
 
 GROUP = "soccer_arena.strategies"
 
@@ -95,10 +94,12 @@ def resolve_name(name: str) -> str:
     Built-ins come first, as in `all_strategies`, so the entry points are read
     only for a name that is not built in.
     """
-    if name.startswith(learned.PREFIX):  # a policy file: its absolute path, as every process opens it
-        if not name[len(learned.PREFIX) :].strip():  # Path("") is the working directory
+    if name.startswith(POLICY_PREFIX):  # a policy file: its absolute path, as every process opens it
+        from arena.strategies import policy_file  # the policy-file modules: imported for a policy file only
+
+        if not name[len(POLICY_PREFIX) :].strip():  # Path("") is the working directory
             raise ConfigError(f"{name!r} names no file: policy:PATH, a file written by arena.learn.save_policy")
-        return policy_file.policy_strategy(learned.PREFIX + str(Path(name[len(learned.PREFIX) :]).resolve())).name
+        return policy_file.policy_strategy(POLICY_PREFIX + str(Path(name[len(POLICY_PREFIX) :]).resolve())).name
     wanted = name.strip().lower()
     found = _find(builtin_strategies(), wanted) or _find(all_strategies(), wanted)
     if found is not None:
@@ -112,7 +113,9 @@ def resolve_name(name: str) -> str:
 
 
 def get(name: str) -> Strategy:
-    if name.startswith(learned.PREFIX):
+    if name.startswith(POLICY_PREFIX):
+        from arena.strategies import policy_file
+
         return policy_file.policy_strategy(name)
     canonical = resolve_name(name)
     return builtin_strategies().get(canonical) or all_strategies()[canonical]

@@ -105,13 +105,14 @@ def emit_match(match: MatchResult, as_json: bool, prog: str = "arena match") -> 
     each. A void match (match/faults.py) exits 1 with one line naming the cause.
     """
     from arena.match import faults
-    from arena.review import report
 
     if as_json:
         printed = match.to_dict()
         printed.pop("referee_log", None)
         print(json.dumps(printed, indent=2))
-    else:
+    else:  # the tables need rich (~25 ms of imports): not for --json
+        from arena.review import report
+
         report.print_match(match)
     for line in faults.warnings(match):
         print(f"{prog}: warning: {line}", file=sys.stderr)

@@ -13,12 +13,15 @@ def full_config(args: argparse.Namespace) -> tuple[MatchConfig, str]:
     """The match `arena match` plays, and the absolute path of its recording ("" for none)."""
     from arena.commands._match_flags import match_config
     from arena.commands._refbox_flags import refbox_params
-    from arena.match.run import record_path
 
     missing = [f for f, v in (("--home", args.home), ("--away", args.away)) if v is None]
     if missing and not args.config_file:
         raise ConfigError(f"the following arguments are required: {', '.join(missing)} (or give them in --config FILE)")
-    record = record_path(args.record, fresh=True) if args.record else ""
+    record = ""
+    if args.record:  # match.run imports zenoh, ssl and the credentials: not for a match without a file
+        from arena.match.run import record_path
+
+        record = record_path(args.record, fresh=True)
     cfg = match_config(
         args, realtime=args.realtime, external=args.external, tap=bool(record), refbox=refbox_params(args)
     )
@@ -61,13 +64,13 @@ def add_live_flags(m: argparse.ArgumentParser) -> None:
 
 def live_config(cfg: MatchConfig, live: int | None, pace: float | None, host: str = "127.0.0.1") -> MatchConfig:
     """`--live [PORT]` and `--pace X`: a viewer, and in lockstep a paced, pausable engine."""
-    import dataclasses
-    import socket
-
     if live is None:
         if pace is not None:
             raise ConfigError("--pace needs --live")
         return cfg
+    import dataclasses
+    import socket
+
     if pace is not None and cfg.realtime:
         raise ConfigError("--pace applies to lockstep; --realtime already plays at the wall clock's speed")
     pace = 0.0 if cfg.realtime else (1.0 if pace is None else pace)

@@ -68,6 +68,9 @@ def warn_unreachable_refbox(endpoint: str) -> None:
 
 def refbox_params(args: argparse.Namespace):
     """The RefBox flags of `arena match` as `RefboxParams` (None without any); bad values are a ConfigError."""
+    flags = ("refbox", "refbox_teams", "refbox_protocol", "refbox_swap", "refbox_targets", "refbox_wait")
+    if not any(getattr(args, f) for f in (*flags, "refbox_follow", "via_refbox")):
+        return None  # none given: the protocol module (~2 ms of imports) is not needed
     from pathlib import Path
 
     from arena.config import RefboxParams
