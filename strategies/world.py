@@ -42,6 +42,7 @@ from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
+Columns = tuple[list[int], list[float], list[float]]  # a track's detections: their ticks, x and y
 
 
 @dataclass(frozen=True)
@@ -189,12 +190,11 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
-def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Vec:
-    """[m/s] The least-squares slope of x and y over the track's ticks; (0, 0) with fewer than 3 points."""
-    n = len(track)
+def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
+    """[m/s] The least-squares slope of x and y over the ticks ts (rising); (0, 0) with fewer than 3 points."""
+    n = len(ts)
     if n < 3:
         return 0.0, 0.0
-    ts, xs, ys = zip(*track)  # the same sums as over generators, without one frame per element
     mx = sum(xs) / n
     my = sum(ys) / n
     if ts[-1] - ts[0] == n - 1 and n in _CONSECUTIVE:  # a detection every tick (ticks rise: `_track`)
@@ -206,7 +206,7 @@ def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Ve
         return sxt / (stt * dt), syt / (stt * dt)
     mt = sum(ts) / n
     stt = sxt = syt = 0.0
-    for t, x, y in track:
+    for t, x, y in zip(ts, xs, ys):
         d = t - mt
         stt += d * d
         sxt += d * (x - mx)
@@ -242,7 +242,7 @@ class RobotView:
         self.n = n
         self.p = p
         self.lead = latency * dt  # [s] how far the view is behind the present
-        self._tracks: list[list[tuple[int, float, float]]] = []  # per opponent seen: its last detections
+        self._tracks: list[Columns] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
@@ -334,24 +334,28 @@ class RobotView:
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
         old, merge2, window = self._tracks, self._merge2, self.p.track_window
-        tracks: list[list[tuple[int, float, float]]] = []
+        tracks: list[Columns] = []
         for x, y in seen:
             best, best_d2 = None, merge2
             for t in old:
-                _, lx, ly = t[-1]
-                d2 = (lx - x) ** 2 + (ly - y) ** 2
+                d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
                 if d2 < best_d2:
                     best, best_d2 = t, d2
             if best is not None:
                 old.remove(best)
-                if best[-1][0] >= tick:  # the same sense again: the newer detection replaces it
-                    best.pop()
-                best.append((tick, x, y))
-                if len(best) > window:
-                    del best[0]
+                ts, xs, ys = best
+                if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
+                    ts.pop()
+                    xs.pop()
+                    ys.pop()
+                ts.append(tick)
+                xs.append(x)
+                ys.append(y)
+                if len(ts) > window:
+                    del ts[0], xs[0], ys[0]
                 tracks.append(best)
             else:
-                tracks.append([(tick, x, y)])
+                tracks.append(([tick], [x], [y]))
         self._tracks = tracks
 
     @property
@@ -363,10 +367,9 @@ class RobotView:
         now = self._now
         if now is None:
             lead, now = self.lead, []
-            for t in self._tracks:
-                vx, vy = _regression_velocity(t, self.dt)
-                _, x, y = t[-1]
-                now.append((x + vx * lead, y + vy * lead))
+            for ts, xs, ys in self._tracks:
+                vx, vy = _regression_velocity(ts, xs, ys, self.dt)
+                now.append((xs[-1] + vx * lead, ys[-1] + vy * lead))
             now.extend(self.opponents[len(self._seen) :])
             self._now = now
         return now
