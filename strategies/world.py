@@ -244,6 +244,7 @@ class RobotView:
         self.lead = latency * dt  # [s] how far the view is behind the present
         self._tracks: list[Columns] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
+        self._slopes = {n: (ds, stt * dt) for n, (ds, stt) in _CONSECUTIVE.items()}  # `_regression_velocity`'s
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
         self.dt = dt
@@ -366,9 +367,21 @@ class RobotView:
             return self.opponents
         now = self._now
         if now is None:
-            lead, now = self.lead, []
+            lead, dt, slopes, now = self.lead, self.dt, self._slopes, []
             for ts, xs, ys in self._tracks:
-                vx, vy = _regression_velocity(ts, xs, ys, self.dt)
+                n = len(ts)
+                c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
+                if c is not None:  # `_regression_velocity` of a consecutive track, inlined: the usual case
+                    ds, stt_dt = c
+                    mx = sum(xs) / n
+                    my = sum(ys) / n
+                    sxt = syt = 0.0
+                    for d, x, y in zip(ds, xs, ys):
+                        sxt += d * (x - mx)
+                        syt += d * (y - my)
+                    vx, vy = sxt / stt_dt, syt / stt_dt
+                else:
+                    vx, vy = _regression_velocity(ts, xs, ys, dt)
                 now.append((xs[-1] + vx * lead, ys[-1] + vy * lead))
             now.extend(self.opponents[len(self._seen) :])
             self._now = now
