@@ -216,6 +216,12 @@ def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: fl
     return sxt / (stt * dt), syt / (stt * dt)
 
 
+def _spread(values: list[float]) -> float:
+    """max - min (one sort of ten floats costs half of max() and min())."""
+    s = sorted(values)
+    return s[-1] - s[0]
+
+
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
     """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
     if not seen:  # nothing to explain them away: all of them
@@ -244,7 +250,13 @@ class RobotView:
         self.lead = latency * dt  # [s] how far the view is behind the present
         self._tracks: list[Columns] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
-        self._slopes = {n: (ds, stt * dt) for n, (ds, stt) in _CONSECUTIVE.items()}  # `_regression_velocity`'s
+        # Per consecutive track length n: `_regression_velocity`'s tick offsets and stt * dt, and a bound:
+        # |prediction - last detection| <= reach * the spread of the detections (|sum d (x - mean)| <= sum |d| * spread)
+        self._slopes = {
+            n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
+            for n, (ds, stt) in _CONSECUTIVE.items()
+        }
+        self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
         self.dt = dt
@@ -330,7 +342,8 @@ class RobotView:
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
         if self.lead > 0.0 and sense is not None:
             self._track(sense.tick, seen)
-            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`)
+            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
+            self._ahead = [None] * len(self._tracks)
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
@@ -367,25 +380,48 @@ class RobotView:
             return self.opponents
         now = self._now
         if now is None:
-            lead, dt, slopes, now = self.lead, self.dt, self._slopes, []
-            for ts, xs, ys in self._tracks:
+            now = self._now = self.opponents_near(0.0, 0.0, math.inf)
+        return now
+
+    def opponents_near(self, x: float, y: float, rng: float) -> list[Vec]:
+        """`opponents_now` less tracked opponents that are surely farther than rng [m] from (x, y) along x or y.
+
+        The same positions in the same order, only fewer: a caller that skips what lies outside that box
+        gets the same result from either. A track is predicted only when it may be inside: the regression
+        is most of the view's work (the bound: `_slopes`, plus 1 um for rounding).
+        """
+        if self.lead == 0.0:
+            return self.opponents
+        if self._now is not None:
+            return self._now
+        ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
+        rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
+        for k, (ts, xs, ys) in enumerate(self._tracks):
+            p = ahead[k]
+            if p is None:
                 n = len(ts)
                 c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
-                if c is not None:  # `_regression_velocity` of a consecutive track, inlined: the usual case
-                    ds, stt_dt = c
+                if c is None:  # fewer than 3 detections, or a gap: the general regression
+                    vx, vy = _regression_velocity(ts, xs, ys, self.dt)
+                else:  # `_regression_velocity` of a consecutive track, inlined: the usual case
+                    ds, stt_dt, reach = c
+                    out_x = abs(xs[-1] - x) - rng  # [m] how far outside the box; the spread only then
+                    if out_x > 0.0 and out_x > reach * _spread(xs):
+                        continue
+                    out_y = abs(ys[-1] - y) - rng
+                    if out_y > 0.0 and out_y > reach * _spread(ys):
+                        continue
                     mx = sum(xs) / n
                     my = sum(ys) / n
                     sxt = syt = 0.0
-                    for d, x, y in zip(ds, xs, ys):
-                        sxt += d * (x - mx)
-                        syt += d * (y - my)
+                    for d, u, v in zip(ds, xs, ys):
+                        sxt += d * (u - mx)
+                        syt += d * (v - my)
                     vx, vy = sxt / stt_dt, syt / stt_dt
-                else:
-                    vx, vy = _regression_velocity(ts, xs, ys, dt)
-                now.append((xs[-1] + vx * lead, ys[-1] + vy * lead))
-            now.extend(self.opponents[len(self._seen) :])
-            self._now = now
-        return now
+                p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+            out.append(p)
+        out.extend(self.opponents[len(self._seen) :])
+        return out
 
     @property
     def pose_now(self) -> tuple[float, float]:

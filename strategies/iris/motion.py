@@ -139,7 +139,7 @@ class MotionMixin:
         rng, brake2, guard2, contact_push = self._guard
         if vx == 0.0 and vy == 0.0 and contact_push >= 0.0:  # not moving: closing on nobody
             return vx, vy
-        for ox, oy in self.view.opponents_now:
+        for ox, oy in self.view.opponents_near(x, y, rng):  # those surely outside the box below left out
             dx, dy = ox - x, oy - y
             if abs(dx) > rng or abs(dy) > rng:
                 continue
