@@ -135,32 +135,40 @@ class TeamModel:
         balls: list[tuple[float, float, float]] = []
         seen: list[tuple[float, float, float]] = []
         newest = -1
-        own, other, hypot, sensor = self.own, self.other, math.hypot, self.sensor
+        own, has_ball, other, hypot = self.own, self.has_ball, self.other, math.hypot
+        det, per_m = self.sensor.det_sigma, self.sensor.det_sigma_per_m  # `detection_sigma`, inlined
         for n in sorted(reports):
             rep = reports[n]
             pose = rep.pose
             px, py = pose.x, pose.y
             if n not in own or rep.tick >= own[n][3]:
                 own[n] = (px, py, pose.theta, rep.tick)
-                self.has_ball[n] = rep.has_ball
+                has_ball[n] = rep.has_ball
             b = rep.ball
             if b.visible:
-                s = detection_sigma(sensor, hypot(b.x - px, b.y - py))
+                s = det + per_m * hypot(b.x - px, b.y - py)
                 balls.append((b.x, b.y, 1.0 / (s * s)))
-                newest = max(newest, rep.tick)
+                if rep.tick > newest:
+                    newest = rep.tick
             for r in rep.robots:
                 if r.team == other:
-                    s = detection_sigma(sensor, hypot(r.x - px, r.y - py))
+                    s = det + per_m * hypot(r.x - px, r.y - py)
                     seen.append((r.x, r.y, 1.0 / (s * s)))
         if balls:
             bx, by, _ = cluster(balls, math.inf)[0]
             self.ball.observe(newest, bx, by)
-        fresh = sorted(cluster(seen, self.p.merge_radius), key=lambda c: -c[2])[: self.robots]
+        robots, merge = self.robots, self.p.merge_radius
+        fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
         tracks = [Track(x, y, tick) for x, y, _ in fresh]
+        oldest = tick - self.p.opponent_memory
         for old in self.opponents:
-            if len(tracks) >= self.robots or tick - old.tick > self.p.opponent_memory:
+            if len(tracks) >= robots or old.tick < oldest:
                 continue
-            if all(math.hypot(old.x - t.x, old.y - t.y) >= self.p.merge_radius for t in tracks):
+            ox, oy = old.x, old.y
+            for t in tracks:
+                if not hypot(ox - t.x, oy - t.y) >= merge:  # not `<`: a NaN counts as near, as it did
+                    break
+            else:
                 tracks.append(old)
         self.opponents = tracks
 
