@@ -42,6 +42,7 @@ from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
+Columns = tuple[list[int], list[float], list[float]]  # a track's detections: their ticks, x and y
 
 
 @dataclass(frozen=True)
@@ -134,32 +135,40 @@ class TeamModel:
         balls: list[tuple[float, float, float]] = []
         seen: list[tuple[float, float, float]] = []
         newest = -1
-        own, other, hypot, sensor = self.own, self.other, math.hypot, self.sensor
+        own, has_ball, other, hypot = self.own, self.has_ball, self.other, math.hypot
+        det, per_m = self.sensor.det_sigma, self.sensor.det_sigma_per_m  # `detection_sigma`, inlined
         for n in sorted(reports):
             rep = reports[n]
             pose = rep.pose
             px, py = pose.x, pose.y
             if n not in own or rep.tick >= own[n][3]:
                 own[n] = (px, py, pose.theta, rep.tick)
-                self.has_ball[n] = rep.has_ball
+                has_ball[n] = rep.has_ball
             b = rep.ball
             if b.visible:
-                s = detection_sigma(sensor, hypot(b.x - px, b.y - py))
+                s = det + per_m * hypot(b.x - px, b.y - py)
                 balls.append((b.x, b.y, 1.0 / (s * s)))
-                newest = max(newest, rep.tick)
+                if rep.tick > newest:
+                    newest = rep.tick
             for r in rep.robots:
                 if r.team == other:
-                    s = detection_sigma(sensor, hypot(r.x - px, r.y - py))
+                    s = det + per_m * hypot(r.x - px, r.y - py)
                     seen.append((r.x, r.y, 1.0 / (s * s)))
         if balls:
             bx, by, _ = cluster(balls, math.inf)[0]
             self.ball.observe(newest, bx, by)
-        fresh = sorted(cluster(seen, self.p.merge_radius), key=lambda c: -c[2])[: self.robots]
+        robots, merge = self.robots, self.p.merge_radius
+        fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
         tracks = [Track(x, y, tick) for x, y, _ in fresh]
+        oldest = tick - self.p.opponent_memory
         for old in self.opponents:
-            if len(tracks) >= self.robots or tick - old.tick > self.p.opponent_memory:
+            if len(tracks) >= robots or old.tick < oldest:
                 continue
-            if all(math.hypot(old.x - t.x, old.y - t.y) >= self.p.merge_radius for t in tracks):
+            ox, oy = old.x, old.y
+            for t in tracks:
+                if not hypot(ox - t.x, oy - t.y) >= merge:  # not `<`: a NaN counts as near, as it did
+                    break
+            else:
                 tracks.append(old)
         self.opponents = tracks
 
@@ -189,12 +198,11 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
-def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Vec:
-    """[m/s] The least-squares slope of x and y over the track's ticks; (0, 0) with fewer than 3 points."""
-    n = len(track)
+def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
+    """[m/s] The least-squares slope of x and y over the ticks ts (rising); (0, 0) with fewer than 3 points."""
+    n = len(ts)
     if n < 3:
         return 0.0, 0.0
-    ts, xs, ys = zip(*track)  # the same sums as over generators, without one frame per element
     mx = sum(xs) / n
     my = sum(ys) / n
     if ts[-1] - ts[0] == n - 1 and n in _CONSECUTIVE:  # a detection every tick (ticks rise: `_track`)
@@ -206,7 +214,7 @@ def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Ve
         return sxt / (stt * dt), syt / (stt * dt)
     mt = sum(ts) / n
     stt = sxt = syt = 0.0
-    for t, x, y in track:
+    for t, x, y in zip(ts, xs, ys):
         d = t - mt
         stt += d * d
         sxt += d * (x - mx)
@@ -214,6 +222,12 @@ def _regression_velocity(track: list[tuple[int, float, float]], dt: float) -> Ve
     if stt <= 0.0:
         return 0.0, 0.0
     return sxt / (stt * dt), syt / (stt * dt)
+
+
+def _spread(values: list[float]) -> float:
+    """max - min (one sort of ten floats costs half of max() and min())."""
+    s = sorted(values)
+    return s[-1] - s[0]
 
 
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
@@ -242,8 +256,15 @@ class RobotView:
         self.n = n
         self.p = p
         self.lead = latency * dt  # [s] how far the view is behind the present
-        self._tracks: list[list[tuple[int, float, float]]] = []  # per opponent seen: its last detections
+        self._tracks: list[Columns] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
+        # Per consecutive track length n: `_regression_velocity`'s tick offsets and stt * dt, and a bound:
+        # |prediction - last detection| <= reach * the spread of the detections (|sum d (x - mean)| <= sum |d| * spread)
+        self._slopes = {
+            n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
+            for n, (ds, stt) in _CONSECUTIVE.items()
+        }
+        self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
         self.dt = dt
@@ -329,29 +350,34 @@ class RobotView:
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
         if self.lead > 0.0 and sense is not None:
             self._track(sense.tick, seen)
-            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`)
+            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
+            self._ahead = [None] * len(self._tracks)
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
         old, merge2, window = self._tracks, self._merge2, self.p.track_window
-        tracks: list[list[tuple[int, float, float]]] = []
+        tracks: list[Columns] = []
         for x, y in seen:
             best, best_d2 = None, merge2
             for t in old:
-                _, lx, ly = t[-1]
-                d2 = (lx - x) ** 2 + (ly - y) ** 2
+                d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
                 if d2 < best_d2:
                     best, best_d2 = t, d2
             if best is not None:
                 old.remove(best)
-                if best[-1][0] >= tick:  # the same sense again: the newer detection replaces it
-                    best.pop()
-                best.append((tick, x, y))
-                if len(best) > window:
-                    del best[0]
+                ts, xs, ys = best
+                if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
+                    ts.pop()
+                    xs.pop()
+                    ys.pop()
+                ts.append(tick)
+                xs.append(x)
+                ys.append(y)
+                if len(ts) > window:
+                    del ts[0], xs[0], ys[0]
                 tracks.append(best)
             else:
-                tracks.append([(tick, x, y)])
+                tracks.append(([tick], [x], [y]))
         self._tracks = tracks
 
     @property
@@ -362,14 +388,48 @@ class RobotView:
             return self.opponents
         now = self._now
         if now is None:
-            lead, now = self.lead, []
-            for t in self._tracks:
-                vx, vy = _regression_velocity(t, self.dt)
-                _, x, y = t[-1]
-                now.append((x + vx * lead, y + vy * lead))
-            now.extend(self.opponents[len(self._seen) :])
-            self._now = now
+            now = self._now = self.opponents_near(0.0, 0.0, math.inf)
         return now
+
+    def opponents_near(self, x: float, y: float, rng: float) -> list[Vec]:
+        """`opponents_now` less tracked opponents that are surely farther than rng [m] from (x, y) along x or y.
+
+        The same positions in the same order, only fewer: a caller that skips what lies outside that box
+        gets the same result from either. A track is predicted only when it may be inside: the regression
+        is most of the view's work (the bound: `_slopes`, plus 1 um for rounding).
+        """
+        if self.lead == 0.0:
+            return self.opponents
+        if self._now is not None:
+            return self._now
+        ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
+        rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
+        for k, (ts, xs, ys) in enumerate(self._tracks):
+            p = ahead[k]
+            if p is None:
+                n = len(ts)
+                c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
+                if c is None:  # fewer than 3 detections, or a gap: the general regression
+                    vx, vy = _regression_velocity(ts, xs, ys, self.dt)
+                else:  # `_regression_velocity` of a consecutive track, inlined: the usual case
+                    ds, stt_dt, reach = c
+                    out_x = abs(xs[-1] - x) - rng  # [m] how far outside the box; the spread only then
+                    if out_x > 0.0 and out_x > reach * _spread(xs):
+                        continue
+                    out_y = abs(ys[-1] - y) - rng
+                    if out_y > 0.0 and out_y > reach * _spread(ys):
+                        continue
+                    mx = sum(xs) / n
+                    my = sum(ys) / n
+                    sxt = syt = 0.0
+                    for d, u, v in zip(ds, xs, ys):
+                        sxt += d * (u - mx)
+                        syt += d * (v - my)
+                    vx, vy = sxt / stt_dt, syt / stt_dt
+                p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+            out.append(p)
+        out.extend(self.opponents[len(self._seen) :])
+        return out
 
     @property
     def pose_now(self) -> tuple[float, float]:

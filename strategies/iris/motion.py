@@ -114,12 +114,14 @@ class MotionMixin:
         guard = self._guard
         if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
             nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
-            opponents = view.opponents_now
-            vx, vy = _guard_push(opponents, guard, nx, ny, vx, vy, p.contact_range)
+            near = view.opponents_near(nx, ny, guard[0])  # those surely outside the guard's box left out
+            vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
             if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
                 # the held ball is part of the body: do not push it into an opponent either
                 reach = self.ball_reach
-                vx, vy = _guard_push(opponents, guard, nx + reach * c, ny + reach * s, vx, vy, p.ball_contact_range)
+                bx, by = nx + reach * c, ny + reach * s
+                near = view.opponents_near(bx, by, guard[0])
+                vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
         omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
         omega = -limit if omega < -limit else limit if omega > limit else omega
@@ -162,7 +164,7 @@ class MotionMixin:
         that shields the ball with its body can turn away, and a holder does
         not drive the ball into an opponent (which would knock it loose).
         """
-        return _guard_push(self.view.opponents_now, self._guard, x, y, vx, vy, contact)
+        return _guard_push(self.view.opponents_near(x, y, self._guard[0]), self._guard, x, y, vx, vy, contact)
 
 
 def _guard_push(

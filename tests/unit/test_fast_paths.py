@@ -119,3 +119,39 @@ def test_segment_room_is_the_least_segment_distance_bit_for_bit():
         points = [(rng.uniform(-7, 7), rng.uniform(-5, 5)) for _ in range(rng.randrange(0, 7))]
         expected = min((segment_distance(q, a, b)[0] for q in points), default=math.inf)
         assert segment_room(points, a, b) == expected
+
+
+def _guard_box(points: list[tuple[float, float]], x: float, y: float, rng: float) -> list[tuple[float, float]]:
+    """What the push guard keeps: the points within rng of (x, y) along both axes."""
+    return [(ox, oy) for ox, oy in points if not (abs(ox - x) > rng or abs(oy - y) > rng)]
+
+
+def test_opponents_near_leaves_out_only_opponents_outside_the_box():
+    """`opponents_near` skips predicting far tracks; what it keeps, in the box, is `opponents_now` bit for bit."""
+    cfg = MatchConfig()
+    rng = random.Random(5)
+    order = Order(tick=0, robot=1, opponents=[TeamPose(robot=-1, x=-4.0, y=2.0), TeamPose(robot=-1, x=5.0, y=-3.0)])
+    for _ in range(200):
+        views = [RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams(), latency=3) for _ in range(2)]
+        movers = [(rng.uniform(-5, 5), rng.uniform(-3, 3), rng.uniform(-4, 4), rng.uniform(-4, 4)) for _ in range(3)]
+        for k in range(rng.randrange(1, 16)):
+            noise = 0.05 if rng.random() < 0.5 else 0.0
+            robots = [
+                RobotSeen(
+                    team="b", x=x + vx * 0.02 * k + rng.gauss(0, noise), y=y + vy * 0.02 * k + rng.gauss(0, noise)
+                )
+                for x, y, vx, vy in movers
+                if rng.random() < 0.95  # now and then one is not seen: a gap in its track, or a new track
+            ]
+            sense = Sense(tick=k, pose=Pose(x=0.0, y=0.0, theta=0.0), robots=robots)
+            for view in views:
+                view.update(k + 3, sense, order)
+        now = views[0].opponents_now
+        near = views[1]
+        for ox, oy in now:  # boxes whose edge passes within a few cm of a prediction, and farther ones
+            for r in (0.4, 2.5):
+                sx, sy = rng.choice((-1, 1)) * (r + rng.uniform(-0.03, 0.03)), rng.uniform(-r, r)
+                for cx, cy in ((ox + sx, oy + sy), (ox + sy, oy + sx), (ox + 3 * sx, oy)):
+                    kept = near.opponents_near(cx, cy, r)
+                    assert _guard_box(kept, cx, cy, r) == _guard_box(now, cx, cy, r)
+                    assert all(p in now for p in kept)
