@@ -5,11 +5,12 @@ needs that link's frames due at tick k (runtime/lockstep.py). Each node's
 driver is a `Task` (a `Driver`, runtime/drivers.py), and `play` runs every
 node's `Node.playing()` at once: `drive` resumes each one with the drivers'
 shared `advance` as long as the link it waits on is `ready(k)`, and parks it
-otherwise; a frame put on the channel a parked node waits on makes that node
-runnable again. Frames are the very msgpack bytes a real match sends, on the
-in-memory bus (`CoopBus`, a `MemoryBus` without locks whose channels know who
-waits on them), and they are accepted by the same `Inbound` code in the same
-order, so every process's digest is the one of the distributed run.
+otherwise. Frames are the very msgpack bytes a real match sends, on the
+in-memory bus (`CoopBus`, a `MemoryBus` without locks), and they are accepted
+by the same `Inbound` code in the same order, so every process's digest is the
+one of the distributed run. A link takes each frame in as it is put, in the
+sender's turn (`CoopLink`), and a frame that makes the link a parked node
+waits on ready makes that node runnable again.
 
 Nothing blocks, so nothing needs a watchdog thread: when no node is runnable
 and some have not finished, every unfinished node waits on another one, a
@@ -26,9 +27,9 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
-from arena.runtime.drivers import Wait, advance, subscribe
+from arena.runtime.drivers import Wait, advance
 from arena.runtime.lockstep import Inbound, Waits
-from arena.runtime.transport import MemoryBus
+from arena.runtime.transport import MemoryBus, MemoryTransport
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:
@@ -66,6 +67,37 @@ class CoopChannel:
         raise WouldBlock("recv on an empty channel in a cooperative match (lockstep only; no --realtime)")
 
 
+class CoopLink:
+    """A lockstep link's subscription (`Task.connect`): a frame put is taken in by its `Inbound` at
+    once, in the sender's turn, as a `Reactor` takes it in from a receive callback; its parked task
+    (if any) is woken only once the link is ready for the tick it waits on.
+
+    Taking a frame in early is what a distributed receiver does whenever the network is quick: a
+    frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
+    queue at each wait, without the queue (a deque, its drain and two `try_recv` per frame)."""
+
+    __slots__ = ("_ib", "_feed", "waiter", "_wake")
+
+    def __init__(self, ib: Inbound[Any], wake: Callable[[Task], None]):
+        self._ib = ib
+        self._feed = ib.feed
+        self.waiter: Task | None = None
+        self._wake = wake
+
+    def put(self, payload: bytes) -> None:
+        self._feed(payload)
+        w = self.waiter
+        if w is not None and self._ib.ready(w.waiting[1]):  # type: ignore[index]
+            self.waiter = None
+            self._wake(w)
+
+    def try_recv(self) -> bytes | None:
+        return None  # every frame was taken in as it was put
+
+    def recv(self) -> bytes:
+        raise WouldBlock("recv on a cooperative link (lockstep only; no --realtime)")
+
+
 class CoopBus(MemoryBus):
     """The in-memory bus of one cooperative match: no locks, delivery targets cached per key."""
 
@@ -90,6 +122,19 @@ class CoopBus(MemoryBus):
         self._targets.clear()
         return ch
 
+    def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
+        """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
+        ch = CoopLink(ib, self.runnable.append)
+        self._subs[ib.key].append((owner, ch))  # type: ignore[arg-type]
+        self._targets.clear()
+        return ch
+
+
+def connect(ib: Inbound[Any], transport: MemoryTransport, verify: object, on_forged: object) -> None:
+    """`Driver.connect` of a cooperative match: `ib` takes each frame in as it is put (`CoopLink`).
+    No MAC on the in-memory bus: its frames come from this process's own nodes."""
+    ib.channel = transport.bus.link(transport, ib)  # type: ignore[attr-defined]
+
 
 class Task:
     """One node's driver in a cooperative match (`Node(driver=Task(name))`), and its loop as
@@ -100,7 +145,7 @@ class Task:
 
     cooperative = True
     watchdog = None  # nothing blocks: a deadlock is detected by `drive`, not waited out
-    connect = staticmethod(subscribe)
+    connect = staticmethod(connect)
 
     def __init__(self, name: str, steps: Waits | None = None, flush: Callable[[], None] | None = None):
         self.name = name
@@ -108,7 +153,9 @@ class Task:
         self.flush = flush  # called as the task parks on a link not `paired` (`Node.batch_flusher`)
         self.waiting: Wait | None = None
         self.done = False
-        self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
+        # Wall seconds spent inside this node's loop (one thread: its CPU share), with what its
+        # receivers did to take in its frames (`CoopLink`).
+        self.busy_s = 0.0
         self.resumes = 0
         self.summary: Summary | None = None  # what `play` played to its end returned
 
