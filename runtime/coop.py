@@ -104,29 +104,49 @@ class CoopBus(MemoryBus):
     def __init__(self) -> None:
         super().__init__()
         self.runnable: deque[Task] = deque()
-        self._targets: dict[str, list[tuple[object, CoopChannel]]] = {}
+        self._targets: dict[str, list[tuple[object, CoopChannel | CoopLink]]] = {}
+        self._puts: dict[str, list[Callable[[bytes], None]]] = {}  # key -> its targets' `put`s (`putter`)
 
-    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+    def _targets_of(self, key: str) -> list[tuple[object, CoopChannel | CoopLink]]:
         targets = self._targets.get(key)
         if targets is None:
             targets = self._targets[key] = [
                 (owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs
             ]
-        for owner, ch in targets:
+        return targets
+
+    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+        for owner, ch in self._targets_of(key):
             if only is None or owner is only:
                 ch.put(payload)
 
-    def subscribe(self, owner: object, key: str) -> CoopChannel:  # type: ignore[override]
-        ch = CoopChannel(self.runnable.append)
+    def putter(self, key: str) -> Callable[[bytes], None]:
+        """`deliver(key, payload)` for a publisher: its targets looked up once, kept current as others subscribe."""
+        puts = self._puts.get(key)
+        if puts is None:
+            puts = self._puts[key] = [ch.put for _, ch in self._targets_of(key)]
+
+        def put(payload: bytes) -> None:
+            for p in puts:
+                p(payload)
+
+        return put
+
+    def _subscribed(self, owner: object, key: str, ch: CoopChannel | CoopLink) -> None:
         self._subs[key].append((owner, ch))  # type: ignore[arg-type]
         self._targets.clear()
+        for k, puts in self._puts.items():  # in place: the publishers' `put`s hold these lists
+            puts[:] = [c.put for _, c in self._targets_of(k)]
+
+    def subscribe(self, owner: object, key: str) -> CoopChannel:  # type: ignore[override]
+        ch = CoopChannel(self.runnable.append)
+        self._subscribed(owner, key, ch)
         return ch
 
     def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
         """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
         ch = CoopLink(ib, self.runnable.append)
-        self._subs[ib.key].append((owner, ch))  # type: ignore[arg-type]
-        self._targets.clear()
+        self._subscribed(owner, ib.key, ch)
         return ch
 
 
