@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 from arena.runtime.drivers import Wait, advance
 from arena.runtime.lockstep import Inbound, Waits
-from arena.runtime.transport import MemoryBus, MemoryTransport
+from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:
@@ -76,18 +76,22 @@ class CoopLink:
     frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
     queue at each wait, without the queue (a deque, its drain and two `try_recv` per frame)."""
 
-    __slots__ = ("_ib", "_feed", "waiter", "_wake")
+    __slots__ = ("_ib", "_accept", "waiter", "_wake")
 
     def __init__(self, ib: Inbound[Any], wake: Callable[[Task], None]):
         self._ib = ib
-        self._feed = ib.feed
+        self._accept = ib._accept_frame
         self.waiter: Task | None = None
         self._wake = wake
 
     def put(self, payload: bytes) -> None:
-        self._feed(payload)
+        ib = self._ib
+        if payload == WAKE:  # `Inbound.feed`, inlined
+            ib.woken = True
+        else:
+            self._accept(payload, None)
         w = self.waiter
-        if w is not None and self._ib.ready(w.waiting[1]):  # type: ignore[index]
+        if w is not None and w.waiting[1] < ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
             self.waiter = None
             self._wake(w)
 
