@@ -138,9 +138,11 @@ class CoopBus(MemoryBus):
 
     def _subscribed(self, owner: object, key: str, ch: CoopChannel | CoopLink) -> None:
         self._subs[key].append((owner, ch))  # type: ignore[arg-type]
-        self._targets.clear()
-        for k, puts in self._puts.items():  # in place: the publishers' `put`s hold these lists
-            puts[:] = [c.put for _, c in self._targets_of(k)]
+        for k in [k for k in self._targets if self.matches(key, k)]:
+            del self._targets[k]
+            puts = self._puts.get(k)
+            if puts is not None:  # in place: the publishers' `put`s hold these lists
+                puts[:] = [c.put for _, c in self._targets_of(k)]
 
     def subscribe(self, owner: object, key: str) -> CoopChannel:  # type: ignore[override]
         ch = CoopChannel(self.runnable.append)
