@@ -23,7 +23,6 @@ class RobotNode(Node):
         cfg = self.cfg
         team, n = self.pid.team, self.pid.robot
         self.report_schedule = self.schedule("report")
-        self._report_period, self._report_phase = self.report_schedule.period, self.report_schedule.phase
         # The perception latency L: at tick k the robot sees the sense of tick k - L.
         self.sense_in = self.inp("sense", team, n, lag=cfg.timing.perception_latency)
         self.order_in = self.inp("order", team, n)
@@ -39,7 +38,7 @@ class RobotNode(Node):
         sense = self.sense_in.latest_by(k)
         order = self.order_in.latest_by(k)
         self.cmd_out.send(self.brain.step(k, sense, order))
-        if k >= self._report_phase and (k - self._report_phase) % self._report_period == 0:  # `report_schedule.due(k)`
+        if self.report_schedule.due(k):
             self.report_out.send(self.brain.report(k, sense))
         self.last_tick = k
         self._work_s.append(perf_counter() - t0)  # `timed(t0)`, one call less a tick
