@@ -27,7 +27,7 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
-from arena.runtime.drivers import Wait, advance
+from arena.runtime.drivers import Wait, advance, subscribe
 from arena.runtime.lockstep import Inbound, Waits
 from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.messages import Summary
@@ -158,8 +158,13 @@ class CoopBus(MemoryBus):
 
 def connect(ib: Inbound[Any], transport: MemoryTransport, verify: object, on_forged: object) -> None:
     """`Driver.connect` of a cooperative match: `ib` takes each frame in as it is put (`CoopLink`).
-    No MAC on the in-memory bus: its frames come from this process's own nodes."""
-    ib.channel = transport.bus.link(transport, ib)  # type: ignore[attr-defined]
+    No MAC on the in-memory bus: its frames come from this process's own nodes. On a plain
+    `MemoryBus` (no `link`), a channel as any driver's (`subscribe`), drained at each wait."""
+    link = getattr(getattr(transport, "bus", None), "link", None)
+    if link is None:
+        subscribe(ib, transport, verify, on_forged)  # type: ignore[arg-type]
+        return
+    ib.channel = link(transport, ib)
 
 
 class Task:
