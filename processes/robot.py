@@ -9,7 +9,7 @@ are the keys' (`KeySpec.timing`, schemas/README.md).
 
 from __future__ import annotations
 
-import time
+from time import perf_counter
 
 from arena.runtime.lockstep import Waits
 from arena.runtime.node import Node
@@ -34,23 +34,23 @@ class RobotNode(Node):
         self.brain = strategy.make_robot(RobotContext(cfg=cfg, team=team, n=n, rng=self.rng("strategy")))
 
     def act(self, k: int) -> None:
-        t0 = time.perf_counter()
+        t0 = perf_counter()
         sense = self.sense_in.latest_by(k)
         order = self.order_in.latest_by(k)
         self.cmd_out.send(self.brain.step(k, sense, order))
         if self.report_schedule.due(k):
             self.report_out.send(self.brain.report(k, sense))
         self.last_tick = k
-        self._work_s.append(time.perf_counter() - t0)  # `timed(t0)`, one call less a tick
+        self._work_s.append(perf_counter() - t0)  # `timed(t0)`, one call less a tick
 
     def lockstep(self) -> Waits:
         sense_in, order_in, skip_below = self.sense_in, self.order_in, self.skip_below
         for k in range(self.cfg.total_ticks + 1):
             sense_in.waited = k  # a wait not yielded (`Node.skip_below`)
-            if k >= skip_below or not sense_in.ready(k):
+            if k >= skip_below or k >= sense_in.ready_below:  # `not sense_in.ready(k)`, one call less
                 yield sense_in, k
             order_in.waited = k
-            if k >= skip_below or not order_in.ready(k):
+            if k >= skip_below or k >= order_in.ready_below:
                 yield order_in, k
             self.act(k)
 

@@ -5,11 +5,12 @@ needs that link's frames due at tick k (runtime/lockstep.py). Each node's
 driver is a `Task` (a `Driver`, runtime/drivers.py), and `play` runs every
 node's `Node.playing()` at once: `drive` resumes each one with the drivers'
 shared `advance` as long as the link it waits on is `ready(k)`, and parks it
-otherwise; a frame put on the channel a parked node waits on makes that node
-runnable again. Frames are the very msgpack bytes a real match sends, on the
-in-memory bus (`CoopBus`, a `MemoryBus` without locks whose channels know who
-waits on them), and they are accepted by the same `Inbound` code in the same
-order, so every process's digest is the one of the distributed run.
+otherwise. Frames are the very msgpack bytes a real match sends, on the
+in-memory bus (`CoopBus`, a `MemoryBus` without locks), and they are accepted
+by the same `Inbound` code in the same order, so every process's digest is the
+one of the distributed run. A link takes each frame in as it is put, in the
+sender's turn (`CoopLink`), and a frame that makes the link a parked node
+waits on ready makes that node runnable again.
 
 Nothing blocks, so nothing needs a watchdog thread: when no node is runnable
 and some have not finished, every unfinished node waits on another one, a
@@ -28,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 from arena.runtime.drivers import Wait, advance, subscribe
 from arena.runtime.lockstep import Inbound, Waits
-from arena.runtime.transport import MemoryBus
+from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:
@@ -66,29 +67,104 @@ class CoopChannel:
         raise WouldBlock("recv on an empty channel in a cooperative match (lockstep only; no --realtime)")
 
 
+class CoopLink:
+    """A lockstep link's subscription (`Task.connect`): a frame put is taken in by its `Inbound` at
+    once, in the sender's turn, as a `Reactor` takes it in from a receive callback; its parked task
+    (if any) is woken only once the link is ready for the tick it waits on.
+
+    Taking a frame in early is what a distributed receiver does whenever the network is quick: a
+    frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
+    queue at each wait, without the queue (a deque, its drain and two `try_recv` per frame)."""
+
+    __slots__ = ("_ib", "_accept", "waiter", "_wake")
+
+    def __init__(self, ib: Inbound[Any], wake: Callable[[Task], None]):
+        self._ib = ib
+        self._accept = ib._accept_frame
+        self.waiter: Task | None = None
+        self._wake = wake
+
+    def put(self, payload: bytes) -> None:
+        ib = self._ib
+        if payload == WAKE:  # `Inbound.feed`, inlined
+            ib.woken = True
+        else:
+            self._accept(payload, None)
+        w = self.waiter
+        if w is not None and w.waiting[1] < ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
+            self.waiter = None
+            self._wake(w)
+
+    def try_recv(self) -> bytes | None:
+        return None  # every frame was taken in as it was put
+
+    def recv(self) -> bytes:
+        raise WouldBlock("recv on a cooperative link (lockstep only; no --realtime)")
+
+
 class CoopBus(MemoryBus):
     """The in-memory bus of one cooperative match: no locks, delivery targets cached per key."""
 
     def __init__(self) -> None:
         super().__init__()
         self.runnable: deque[Task] = deque()
-        self._targets: dict[str, list[tuple[object, CoopChannel]]] = {}
+        self._targets: dict[str, list[tuple[object, CoopChannel | CoopLink]]] = {}
+        self._puts: dict[str, list[Callable[[bytes], None]]] = {}  # key -> its targets' `put`s (`putter`)
 
-    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+    def _targets_of(self, key: str) -> list[tuple[object, CoopChannel | CoopLink]]:
         targets = self._targets.get(key)
         if targets is None:
             targets = self._targets[key] = [
                 (owner, ch) for expr, subs in self._subs.items() if self.matches(expr, key) for owner, ch in subs
             ]
-        for owner, ch in targets:
+        return targets
+
+    def deliver(self, key: str, payload: bytes, only: object | None = None) -> None:
+        for owner, ch in self._targets_of(key):
             if only is None or owner is only:
                 ch.put(payload)
 
+    def putter(self, key: str) -> Callable[[bytes], None]:
+        """`deliver(key, payload)` for a publisher: its targets looked up once, kept current as others subscribe."""
+        puts = self._puts.get(key)
+        if puts is None:
+            puts = self._puts[key] = [ch.put for _, ch in self._targets_of(key)]
+
+        def put(payload: bytes) -> None:
+            for p in puts:
+                p(payload)
+
+        return put
+
+    def _subscribed(self, owner: object, key: str, ch: CoopChannel | CoopLink) -> None:
+        self._subs[key].append((owner, ch))  # type: ignore[arg-type]
+        for k in [k for k in self._targets if self.matches(key, k)]:
+            del self._targets[k]
+            puts = self._puts.get(k)
+            if puts is not None:  # in place: the publishers' `put`s hold these lists
+                puts[:] = [c.put for _, c in self._targets_of(k)]
+
     def subscribe(self, owner: object, key: str) -> CoopChannel:  # type: ignore[override]
         ch = CoopChannel(self.runnable.append)
-        self._subs[key].append((owner, ch))  # type: ignore[arg-type]
-        self._targets.clear()
+        self._subscribed(owner, key, ch)
         return ch
+
+    def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
+        """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
+        ch = CoopLink(ib, self.runnable.append)
+        self._subscribed(owner, ib.key, ch)
+        return ch
+
+
+def connect(ib: Inbound[Any], transport: MemoryTransport, verify: object, on_forged: object) -> None:
+    """`Driver.connect` of a cooperative match: `ib` takes each frame in as it is put (`CoopLink`).
+    No MAC on the in-memory bus: its frames come from this process's own nodes. On a plain
+    `MemoryBus` (no `link`), a channel as any driver's (`subscribe`), drained at each wait."""
+    link = getattr(getattr(transport, "bus", None), "link", None)
+    if link is None:
+        subscribe(ib, transport, verify, on_forged)  # type: ignore[arg-type]
+        return
+    ib.channel = link(transport, ib)
 
 
 class Task:
@@ -100,7 +176,7 @@ class Task:
 
     cooperative = True
     watchdog = None  # nothing blocks: a deadlock is detected by `drive`, not waited out
-    connect = staticmethod(subscribe)
+    connect = staticmethod(connect)
 
     def __init__(self, name: str, steps: Waits | None = None, flush: Callable[[], None] | None = None):
         self.name = name
@@ -108,7 +184,9 @@ class Task:
         self.flush = flush  # called as the task parks on a link not `paired` (`Node.batch_flusher`)
         self.waiting: Wait | None = None
         self.done = False
-        self.busy_s = 0.0  # wall seconds spent inside this node's loop (one thread: its CPU share)
+        # Wall seconds spent inside this node's loop (one thread: its CPU share), with what its
+        # receivers did to take in its frames (`CoopLink`).
+        self.busy_s = 0.0
         self.resumes = 0
         self.summary: Summary | None = None  # what `play` played to its end returned
 
@@ -141,7 +219,10 @@ class NodeFailed(RuntimeError):
 
 
 def _drained(ib: Inbound[Any], k: int) -> bool:
-    """`advance`'s last look: take in what arrived on the link's channel."""
+    """`advance`'s last look: take in what arrived on the link's channel (a `CoopLink` took
+    every frame in as it was put: nothing to look at)."""
+    if type(ib.channel) is CoopLink:
+        return False
     ib.drain()
     return ib.ready(k)
 

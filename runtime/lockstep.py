@@ -231,7 +231,7 @@ class Outbound(Generic[M]):
     ~5 % of a batched distributed match.
     """
 
-    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last")
+    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last", "_heads")
 
     def __init__(self, key: str, rel: str, put: Callable[[bytes], None], digest: hashlib.blake2b):
         self.key = key
@@ -243,6 +243,7 @@ class Outbound(Generic[M]):
         self._buf: list[bytes] | None = None  # None: one frame per message
         self._size = 1
         self._last = 0
+        self._heads: dict[int, bytes] = {}  # payload length -> rel + that length, as the digest takes them
 
     def batch(self, size: int, last: int) -> None:
         """Send `size` frames per message (ticks aligned to multiples of `size`); 1: one per message."""
@@ -278,9 +279,14 @@ class Outbound(Generic[M]):
     def send(self, msg: M) -> bytes:
         """Encode, digest and put `msg`; returns the payload (for a tap, runtime/tap.py)."""
         payload = self._encode(msg)
+        # The digest takes rel, the payload's length (4 bytes, little-endian), the payload: the
+        # first two as one prebuilt header per length (the same bytes, one update less).
+        n = len(payload)
+        head = self._heads.get(n)
+        if head is None:
+            head = self._heads[n] = self.rel + n.to_bytes(4, "little")
         d = self._digest
-        d.update(self.rel)
-        d.update(len(payload).to_bytes(4, "little"))
+        d.update(head)
         d.update(payload)
         self.sent += 1
         buf = self._buf
@@ -297,6 +303,7 @@ class Outbound(Generic[M]):
 
 # [frames] accepted frames per link kept to tell a conflicting frame for a past tick from a repeat.
 RECENT = 256
+NEVER = 1 << 62  # [ticks] past the last tick of any match
 
 # A lockstep loop is a generator that yields (inbound, k) where it needs every
 # frame of that link due at tick k; the driver resumes it once they are in.
@@ -329,9 +336,7 @@ class Inbound(Generic[M]):
         self._decode = msgspec.msgpack.Decoder(msg_type).decode
         self.channel = channel
         self.schedule = schedule
-        # Every tick, from tick 0 (sense, cmd): the next frame is last_seen + 1 and
-        # the last one due by k is k itself; saves two method calls per frame.
-        self._every_tick = schedule.period == 1 and schedule.phase == 0
+        self._period = schedule.period
         self.lag = lag
         self.link_class = link_class
         self.sender = sender
@@ -346,6 +351,12 @@ class Inbound(Generic[M]):
         self.paired = False  # its sender batches on our batches' grid: no flush before waiting on it (`Outbound`)
         self.last_seen = -1  # tick of the last accepted frame
         self.dead = False
+        # `ready(k)` is `k < ready_below`: the next frame due, `_next` (the tick it is sent at), is
+        # needed from tick `_next + lag` on. Kept by `_accept_one`, and past every k once the sender
+        # is dead (`_hold` then adds NEVER), so that a wait costs a comparison, not a call.
+        self._next = schedule.first_after(-1)
+        self._hold = lag
+        self.ready_below = self._next + lag
         self.woken = False  # reactive mode: a WAKE came (a peer's token vanished)
         self._pending: list[tuple[int, int, M]] = []  # (deliver tick, send tick, message)
         self.latest: M | None = None  # the last delivered message
@@ -395,13 +406,16 @@ class Inbound(Generic[M]):
             self._rej.reject(self.key, "malformed", str(exc)[:120])
             return False
         tick = msg.tick
-        last_seen = self.last_seen
         if self.strict:  # lockstep: exactly the next scheduled tick
-            expected = last_seen + 1 if self._every_tick else self.schedule.first_after(last_seen)
-            if tick != expected:
-                return self._refuse(raw, msg, f"tick {tick}, expected {expected}")
-        elif tick <= last_seen:
-            return self._refuse(raw, msg, f"tick {tick} after {last_seen}")
+            if tick != self._next:
+                return self._refuse(raw, msg, f"tick {tick}, expected {self._next}")
+            # `first_after(tick)` of a tick on the schedule
+            self._next = nxt = tick + self._period
+        elif tick <= self.last_seen:
+            return self._refuse(raw, msg, f"tick {tick} after {self.last_seen}")
+        else:
+            self._next = nxt = self.schedule.first_after(tick)
+        self.ready_below = nxt + self._hold
         # Accepted ticks only ever rise, so the oldest of `_recent` is the first in `_recent_ticks`
         # (a dict's next(iter()) walks past every deleted slot before it: ~3x the whole update).
         self._recent[tick] = raw
@@ -494,10 +508,11 @@ class Inbound(Generic[M]):
 
     # ------------------------------------------------- what drivers ask of a link
     def ready(self, k: int) -> bool:
-        """Every frame sent at or before k - lag is in (or the sender is dead)."""
-        if self._every_tick:  # last_at_or_before(j) is j (or -1 below 0, which last_seen >= -1 meets either way)
-            return self.dead or self.last_seen >= k - self.lag
-        return self.dead or self.last_seen >= self.schedule.last_at_or_before(k - self.lag)
+        """Every frame sent at or before k - lag is in (or the sender is dead).
+
+        That is, no frame is due after `last_seen` and at or before k - lag: the
+        next one, sent at `_next`, is needed from `_next + lag` on (`ready_below`)."""
+        return k < self.ready_below
 
     def drain(self) -> None:
         """Lockstep, never blocking: take in whatever has arrived on the channel (the cooperative driver)."""
@@ -572,6 +587,7 @@ class Inbound(Generic[M]):
     def give_up(self, why: str) -> None:
         """Stop waiting for this link (its sender is dead); `why` is recorded with the sender."""
         self.dead = True
+        self._hold = self.ready_below = NEVER
         self._on_dead(self.sender, f"{self.key}: {why}")
 
     # ---------------------------------------------------------------- delivery

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import _thread
 import ctypes
+import functools
 import queue
 import threading
 from collections import defaultdict
@@ -409,6 +410,10 @@ class MemoryBus:
             if only is None or owner is only:
                 ch._q.put(payload)
 
+    def putter(self, key: str) -> Callable[[bytes], None]:
+        """What a publisher of `key` puts with: `deliver(key, payload)`."""
+        return functools.partial(self.deliver, key)
+
     def subscribe(self, owner: object, key: str) -> _MemoryChannel:
         ch = _MemoryChannel()
         with self._lock:
@@ -440,12 +445,7 @@ class MemoryTransport:
 
     def publisher(self, key: str, when_matched: bool = False, sign: Sign | None = None) -> Callable[[bytes], None]:
         # No attachments on the memory bus: it runs in one trusted process (unit tests).
-        bus = self.bus
-
-        def put(payload: bytes) -> None:
-            bus.deliver(key, payload)
-
-        return put
+        return self.bus.putter(key)
 
     def subscribe(self, key: str, latest: int = 0, verify=None, on_forged=None) -> Channel:
         return self.bus.subscribe(self, key)

@@ -102,3 +102,44 @@ def test_observers_are_not_nodes_and_a_node_takes_its_driver():
     assert isinstance(realtime, Pull)
     realtime.close()
     assert run.driver(ProcessId("recorder"), cfg, tr, Keys("t")) == {}
+
+
+def test_a_cooperative_link_takes_a_frame_in_as_it_is_put_and_wakes_its_task_only_once_ready():
+    """`CoopLink`: no queue to drain at the next wait, and no resume for a frame that does not make
+    the link ready for the tick its task waits on; the loop sees what a pulling driver sees."""
+    from arena.runtime import coop
+    from arena.runtime.drivers import pull
+    from tests.unit.test_lockstep import _frames, _two_harnesses, _two_link_loop
+
+    pulled: list = []
+    a, b = _two_harnesses()
+    for raw in _frames(range(7)):
+        a.put(raw)
+    for raw in _frames(range(0, 7, 2)):
+        b.put(raw)
+    pull(_two_link_loop(a.inbound, b.inbound, pulled))
+
+    log: list = []
+    a2, b2 = _two_harnesses()
+    bus = coop.CoopBus()
+    for h, key in ((a2, "arena/t/a"), (b2, "arena/t/b")):
+        h.inbound.key = key
+        coop.connect(h.inbound, coop.MemoryTransport(bus), None, None)
+    task = coop.Task("n")
+    task.steps = task.drive(_two_link_loop(a2.inbound, b2.inbound, log), None)
+    coop._advance(task)
+    assert task.waiting == (a2.inbound, 1) and a2.inbound.channel.waiter is task
+    bus.deliver("arena/t/b", _frames([0])[0])
+    assert b2.inbound.last_seen == 0, "taken in as it was put"
+    assert not bus.runnable, "a frame on another link wakes nobody"
+    bus.deliver("arena/t/a", _frames([0])[0])
+    assert list(bus.runnable) == [task] and a2.inbound.channel.waiter is None, "ready for tick 1: woken"
+    for t in range(1, 7):
+        bus.deliver("arena/t/a", _frames([t])[0])
+        if t % 2 == 0:
+            bus.deliver("arena/t/b", _frames([t])[0])
+    assert a2.inbound.channel.try_recv() is None, "nothing queued"
+    assert coop.drive(bus, [task]) == [] and task.done
+    assert log == pulled and len(log) == 7
+    for h in (a, b, a2, b2):
+        h.close()

@@ -551,3 +551,27 @@ def test_a_forged_frame_is_counted_per_key_and_announced_once():
     assert rej.forged_by_key == {KEY: 3, "arena/t/referee": 1}
     assert rej.by_reason == {"forged": 4} and rej.conflicts == {}
     assert rej.spoofed_new == [KEY, "arena/t/referee"]
+
+
+@pytest.mark.parametrize(("period", "phase", "lag"), [(1, 0, 0), (1, 0, 1), (1, 0, 3), (5, 0, 1), (5, 4, 1), (5, 2, 0)])
+def test_ready_is_every_frame_due_by_k_minus_lag_in_or_a_dead_sender(period, phase, lag):
+    """`ready(k)` as kept per frame (`ready_below`) says what its definition says, at every k, as frames come."""
+    schedule = Schedule(period, phase)
+    h = Harness(schedule=schedule, lag=lag)
+    ib = h.inbound
+
+    def defined(k):
+        return ib.dead or ib.last_seen >= schedule.last_at_or_before(k - lag)
+
+    for t in [-1, *schedule.ticks(30)]:
+        if t >= 0:
+            h.put(encode(Cmd(tick=t)))
+            ib.drain()
+            assert ib.last_seen == t
+        assert [ib.ready(k) for k in range(40)] == [defined(k) for k in range(40)]
+    ib.give_up("test")
+    assert all(ib.ready(k) for k in range(10_000))
+    h.put(encode(Cmd(tick=schedule.first_after(30))))
+    ib.drain()
+    assert ib.ready(10_000), "a dead sender's late frame makes nobody wait for it again"
+    h.close()
