@@ -108,16 +108,9 @@ def test_a_cooperative_link_takes_a_frame_in_as_it_is_put_and_wakes_its_task_onl
     """`CoopLink`: no queue to drain at the next wait, and no resume for a frame that does not make
     the link ready for the tick its task waits on; the loop sees what a pulling driver sees."""
     from arena.runtime import coop
-    from arena.runtime.drivers import pull
-    from tests.unit.test_lockstep import _frames, _two_harnesses, _two_link_loop
+    from tests.unit.test_lockstep import _frames, _pulled, _two_harnesses, _two_link_loop
 
-    pulled: list = []
-    a, b = _two_harnesses()
-    for raw in _frames(range(7)):
-        a.put(raw)
-    for raw in _frames(range(0, 7, 2)):
-        b.put(raw)
-    pull(_two_link_loop(a.inbound, b.inbound, pulled))
+    pulled = _pulled()
 
     log: list = []
     a2, b2 = _two_harnesses()
@@ -141,5 +134,5 @@ def test_a_cooperative_link_takes_a_frame_in_as_it_is_put_and_wakes_its_task_onl
     assert a2.inbound.channel.try_recv() is None, "nothing queued"
     assert coop.drive(bus, [task]) == [] and task.done
     assert log == pulled and len(log) == 7
-    for h in (a, b, a2, b2):
+    for h in (a2, b2):
         h.close()

@@ -214,18 +214,32 @@ def _two_harnesses(**kw):
     return Harness(**kw), Harness(schedule=Schedule(2, 0), **kw)
 
 
-def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
-    """Same frames, any arrival order between links: the same steps, whoever drives."""
-    from arena.runtime.drivers import Reactor, pull
-
-    pulled: list = []
-    a, b = _two_harnesses()
+def _fed(a, b) -> None:
+    """Every frame of the two-link loop's seven ticks queued on its harness (b's every other tick)."""
     for raw in _frames(range(7)):
         a.put(raw)
     for raw in _frames(range(0, 7, 2)):
         b.put(raw)
-    pull(_two_link_loop(a.inbound, b.inbound, pulled))
 
+
+def _pulled() -> list:
+    """The steps of the two-link loop pulled over `_fed` harnesses: what every other driver must take."""
+    from arena.runtime.drivers import pull
+
+    pulled: list = []
+    a, b = _two_harnesses()
+    _fed(a, b)
+    pull(_two_link_loop(a.inbound, b.inbound, pulled))
+    for harness in (a, b):
+        harness.close()
+    return pulled
+
+
+def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
+    """Same frames, any arrival order between links: the same steps, whoever drives."""
+    from arena.runtime.drivers import Reactor
+
+    pulled = _pulled()
     reacted: list = []
     a2, b2 = _two_harnesses()
     reactor = Reactor(timeout=5.0)
@@ -239,7 +253,7 @@ def test_the_reactor_runs_a_loop_exactly_as_pulling_does():
     done.join(5.0)
     assert not done.is_alive() and reactor.error is None
     assert reacted == pulled and len(reacted) == 7
-    for harness in (a, b, a2, b2):
+    for harness in (a2, b2):
         harness.close()
 
 
@@ -248,12 +262,6 @@ def test_every_driver_runs_a_loop_through_the_one_advance_and_flushes_before_a_w
     only where the loop is about to wait on a link that is not ready and not `paired`."""
     from arena.runtime import coop
     from arena.runtime.drivers import Pull, Reactor
-
-    def fed(a, b):
-        for raw in _frames(range(7)):
-            a.put(raw)
-        for raw in _frames(range(0, 7, 2)):
-            b.put(raw)
 
     runs = {}
     for name in ("pull", "reactor", "coop"):
@@ -264,7 +272,7 @@ def test_every_driver_runs_a_loop_through_the_one_advance_and_flushes_before_a_w
         steps = _two_link_loop(a.inbound, b.inbound, log)
         flush = lambda log=log, flushed=flushed: flushed.append(len(log))
         if name == "pull":
-            fed(a, b)
+            _fed(a, b)
             driver = Pull(a.rx, 5.0)
             assert list(driver.drive(steps, flush)) == [], "a blocking driver yields nothing"
             driver.close()
