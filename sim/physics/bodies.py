@@ -50,6 +50,7 @@ _ALL_FIELDS = (
     | pmbatch.BodyFields.ANGULAR_VELOCITY
 )
 _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
+_POSITION = pmbatch.BodyFields.POSITION  # a positions-only read: x, y per body, in the snapshot's body order
 
 # The per-substep calls straight into Chipmunk, without pymunk's Python wrappers
 # around them (its `__setattr__` hook, the batch set-up, `Space.step`'s queues):
@@ -70,16 +71,17 @@ class BodyReader:
     descriptor built once instead of on every read. `Space.step` is called
     around it straight through `step_space`, so the space's collision
     callbacks must not add or remove anything (ours only record, and the
-    changes they lead to are made after the step).
+    changes they lead to are made after the step). With `fields=_POSITION`,
+    every body's (x, y) only.
     """
 
     __slots__ = ("_space", "_buf", "_data", "_arr", "_each", "_iterate")
 
-    def __init__(self, space: pymunk.Space) -> None:
+    def __init__(self, space: pymunk.Space, fields: pmbatch.BodyFields = _ALL_FIELDS) -> None:
         self._space = space._space
         self._buf = pmbatch.Buffer()  # owns the C arrays the reads fill
         data = ffi.new("pmBatchedData *")
-        data.fields = _ALL_FIELDS.value
+        data.fields = fields.value
         data.floatArray = self._buf._float_arr
         data.intArray = self._buf._int_arr
         self._data = data

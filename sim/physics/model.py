@@ -114,32 +114,50 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
             self._refresh()
         self.tick += 1
         self._events = events = []
-        s = self._snap
+        s0 = s = self._snap
         self._apply_commands(s)
-        space, h, robots = self._space_c, self._h, self._robots
-        # `self._read()` (bodies.py BodyReader), inlined: five reads a tick
-        rd = self._read
+        space, h, last = self._space_c, self._h, self._substeps - 1
+        # `self._read()` (bodies.py BodyReader), inlined. A substep reads every body only when
+        # something needs it (the last, the ball in the air, a contact); the robots' distances
+        # need only positions: every substep's are appended to one C array, unpacked once a tick.
+        rd, pos = self._read, self._positions
         arr, each, bodies, iterate, data = rd._arr, rd._each, rd._space, rd._iterate, rd._data
-        for _ in range(self._substeps):
+        parr, pdata, peach = pos._arr, pos._data, pos._each
+        parr.num = 0
+        for i in range(self._substeps):
             step_space(space, h)
-            arr.num = 0
-            each(bodies, iterate, data)
-            new = unpack(arr.arr, arr.num)
-            for r in robots:
-                o = r.off
-                r.dist += math.hypot(new[o] - s[o], new[o + 1] - s[o + 1])
-            s = new
-            if self._airborne:
-                self._fly(s)
-            if self._contacts:
-                self._handle_contacts(s)
+            peach(bodies, iterate, pdata)
+            if i == last or self._airborne or self._contacts:
+                arr.num = 0
+                each(bodies, iterate, data)
+                s = unpack(arr.arr, arr.num)
+                if self._airborne:
+                    self._fly(s)
+                if self._contacts:
+                    self._handle_contacts(s)
             if self._impacts:
                 self._handle_impacts()
+        self._add_distances(s0, unpack(parr.arr, parr.num))
         self._snap = s
         if self._dirty:
             self._refresh()
         self._after_tick()
         return events
+
+    def _add_distances(self, s: list[float], p: list[float]) -> None:
+        """Each robot's distance, from `s` (the tick's start) through each substep's positions `p`.
+
+        The same additions as one per robot per substep, robot by robot: a robot's sum sees them in order.
+        """
+        stride, hypot = len(p) // self._substeps, math.hypot
+        for r in self._robots:
+            o = r.off
+            x0, y0, d = s[o], s[o + 1], r.dist
+            for i in range(o // 3, len(p), stride):  # (x, y) per body, in the snapshot's order
+                x, y = p[i], p[i + 1]
+                d += hypot(x - x0, y - y0)
+                x0, y0 = x, y
+            r.dist = d
 
     def _apply_commands(self, s: list[float]) -> None:
         half_dt = self._dt / 2

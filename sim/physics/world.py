@@ -11,9 +11,11 @@
   GearJoint with max_force = moment * max_alpha does the same for the turn
   rate. Robots collide with each other, the ball, the goals and the fence; a
   robot pushed by another resists with its own drive force.
-* **Snapshot.** One batch read per substep (`BodyReader`) gives every body's
+* **Snapshot.** A batch read (`BodyReader`) gives every body's
   (x, y, angle, vx, vy, omega) in a flat list; `RobotBody.off` and
-  `_ball_off` index it.
+  `_ball_off` index it. A tick reads it after its last substep (and after
+  any substep with the ball in the air or touched); every substep's positions
+  alone, for the distances travelled, go to a second C array.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from arena.sim.physics.bodies import (
     _CAT_FENCE,
     _CAT_GOAL,
     _CAT_ROBOT,
+    _POSITION,
     _ROBOT_TYPE0,
     _STRIDE,
     COLLISION_SLOP,
@@ -106,6 +109,7 @@ class WorldBuilding:
         pmbatch.get_space_bodies(space, pmbatch.BodyFields.BODY_ID, ids_buf)
         ids = list(memoryview(ids_buf.int_buf()).cast("P"))
         self._read = BodyReader(space)
+        self._positions = BodyReader(space, _POSITION)  # each substep's (x, y), for the distances (model.py `step`)
         self._space_c = space._space
         self._ball_off = ids.index(self._ball.id) * _STRIDE
         for r in self._robots:

@@ -550,8 +550,8 @@ def test_two_instances_with_the_same_commands_agree_at_every_tick():
     assert worlds[0].distance == worlds[1].distance
 
 
-def _random_play(cfg: MatchConfig, ticks: int) -> list[tuple[list[BallEvent], object]]:
-    """Events and world frame at every tick of a match of random commands (contacts, kicks, dribbles)."""
+def _random_play(cfg: MatchConfig, ticks: int) -> list[tuple[list[BallEvent], object, dict]]:
+    """Events, world frame and distances at every tick of a match of random commands (contacts, kicks, dribbles)."""
     ph = Physics(cfg)
     ph.kickoff_positions("a")
     rnd = random.Random(5)
@@ -571,12 +571,14 @@ def _random_play(cfg: MatchConfig, ticks: int) -> list[tuple[list[BallEvent], ob
                         kick_lob=rnd.random() < 0.3,
                     ),
                 )
-        out.append((ph.step(), ph.world(tick)))
+        out.append((ph.step(), ph.world(tick), ph.distance))
     return out
 
 
 def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
-    """`step_space`, `set_velocity`, `set_angular_velocity` and `BodyReader` (sim/physics/bodies.py) bit for bit."""
+    """`step_space`, `set_velocity`, `set_angular_velocity` and `BodyReader` (sim/physics/bodies.py) bit for bit.
+
+    The distances too: summed here after every substep, robot after robot, as `Physics.step` once did."""
     from pymunk import batch as pmbatch
 
     from arena.sim.physics import bodies, model, world
@@ -586,43 +588,60 @@ def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
 
     # The same world again, every direct call replaced by pymunk's public API.
     spaces, ctrls = {}, {}  # C pointer -> pymunk object
+    walked: dict[tuple[str, int], list[float]] = {}  # robot -> [x, y, metres] after each substep
     real_build = world.WorldBuilding._build_world
 
     def build(self, *args):
         real_build(self, *args)
         spaces[self._space._space] = self._space
         ctrls.update((r.ctrl._body, r.ctrl) for r in self._robots)
+        robots.extend(self._robots)
+
+    robots: list = []
+
+    def step_space(space_c, h) -> None:
+        for r in robots:
+            walked.setdefault((r.team, r.n), [*r.body.position, 0.0])
+        spaces[space_c].step(h)
+        for r in robots:
+            w, (x, y) = walked[(r.team, r.n)], r.body.position
+            w[:] = x, y, w[2] + math.hypot(x - w[0], y - w[1])
 
     class Read:
         """BodyReader's call, and the parts of it that `Physics.step` inlines, over pymunk's public batch API."""
 
-        def __init__(self, space: object) -> None:
-            self._space, self._iterate, self._data = space._space, None, None
+        def __init__(self, space: object, fields: pmbatch.BodyFields = bodies._ALL_FIELDS) -> None:
+            self._space, self._iterate, self._data, self._fields = space._space, None, None, fields
             self._arr = SimpleNamespace(arr=self, num=0)  # `unpack(arr.arr, arr.num)` gets this reader back
             self.last: list[float] = []
 
         def _each(self, space_c, _iterate, _data) -> None:
             buf = pmbatch.Buffer()
-            pmbatch.get_space_bodies(spaces[space_c], bodies._ALL_FIELDS, buf)
-            self.last = memoryview(buf.float_buf()).cast("d").tolist()
+            pmbatch.get_space_bodies(spaces[space_c], self._fields, buf)
+            read = memoryview(buf.float_buf()).cast("d").tolist()
+            self.last = self.last + read if self._arr.num else read  # appended, as a C array's pushes are
+            self._arr.num = len(self.last)
 
         def __call__(self) -> list[float]:
+            self._arr.num = 0
             self._each(self._space, None, None)
             return self.last
 
     monkeypatch.setattr(world.WorldBuilding, "_build_world", build)
     monkeypatch.setattr(world, "BodyReader", Read)
     monkeypatch.setattr(model, "unpack", lambda reader, _num: reader.last)
-    monkeypatch.setattr(model, "step_space", lambda space_c, h: spaces[space_c].step(h))
+    monkeypatch.setattr(model, "step_space", step_space)
     monkeypatch.setattr(model, "set_velocity", lambda body_c, v: setattr(ctrls[body_c], "velocity", v))
     monkeypatch.setattr(model, "set_angular_velocity", lambda body_c, w: setattr(ctrls[body_c], "angular_velocity", w))
     public = _random_play(cfg, 600)
 
     assert spaces and ctrls, "the public API was not used"
-    assert sum(len(events) for events, _ in fast) > 0, "nothing happened to the ball"
-    assert len({(w.ball_x, w.ball_y) for _, w in fast}) > 100, "the ball hardly moved"
+    assert sum(len(events) for events, _, _ in fast) > 0, "nothing happened to the ball"
+    assert len({(w.ball_x, w.ball_y) for _, w, _ in fast}) > 100, "the ball hardly moved"
     for tick, (a, b) in enumerate(zip(fast, public, strict=True), start=1):
         assert a == b, f"tick {tick} differs"
+    assert min(fast[-1][2].values()) > 1.0, "the robots hardly moved"
+    assert fast[-1][2] == {r: w[2] for r, w in walked.items()}
 
 
 def test_world_message_is_ground_truth():
