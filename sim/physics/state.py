@@ -12,12 +12,19 @@ class State:
     """Mixin of `Physics`: reading the world back."""
 
     def robot_states(self) -> list[tuple[str, int, float, float, float, float, float, float]]:
-        """Every robot's (team, n, x, y, theta, vx, vy, omega), field frame, in one pass."""
-        s, out, remainder, pi = self._fresh(), [], math.remainder, math.pi
+        """Every robot's (team, n, x, y, theta, vx, vy, omega), field frame, in one pass.
+
+        Built once per snapshot (the engine's senses, `world` and stuck check all read it): do not modify it.
+        """
+        s = self._fresh()
+        if s is self._states_of:
+            return self._states
+        out, remainder, pi = [], math.remainder, math.pi
         for r in self._robots:
             o = r.off
             theta = remainder(s[o + 2], TAU)  # wrap_angle, inlined (the engine reads this every tick)
             out.append((r.team, r.n, s[o], s[o + 1], pi if theta == -pi else theta, s[o + 3], s[o + 4], s[o + 5]))
+        self._states_of, self._states = s, out
         return out
 
     def commanded_speed(self, team: str, n: int) -> float:
@@ -62,24 +69,12 @@ class State:
 
     def world(self, tick: int) -> World:
         """Ground truth as the G_V message."""
-        s, b, holder, last = self._fresh(), self._ball_off, self._holder, self._last
-        robots, remainder, pi = [], math.remainder, math.pi
-        for r in self._robots:
-            o = r.off
-            theta = remainder(s[o + 2], TAU)  # wrap_angle, inlined (a frame every tick)
-            robots.append(
-                RobotState(
-                    team=r.team,
-                    robot=r.n,
-                    x=s[o],
-                    y=s[o + 1],
-                    theta=pi if theta == -pi else theta,
-                    vx=s[o + 3],
-                    vy=s[o + 4],
-                    omega=s[o + 5],
-                    has_ball=r is holder,
-                )
-            )
+        states = self.robot_states()
+        s, b, holder, last = self._snap, self._ball_off, self._holder, self._last
+        robots = [
+            RobotState(team=t, robot=n, x=x, y=y, theta=theta, vx=vx, vy=vy, omega=w, has_ball=r is holder)
+            for r, (t, n, x, y, theta, vx, vy, w) in zip(self._robots, states)
+        ]
         return World(
             tick=tick,
             t=tick * self._dt,

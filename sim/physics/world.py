@@ -116,6 +116,8 @@ class WorldBuilding:
             r.off = ids.index(r.body.id) * _STRIDE
         self._snap: list[float] = []
         self._dirty = True
+        self._states_of: list[float] | None = None  # the snapshot `_states` was built from (state.py `robot_states`)
+        self._states: list[tuple[str, int, float, float, float, float, float, float]] = []
 
     def _add_fence(self, f: FieldParams) -> None:
         x = f.length / 2 + f.runoff + FENCE_RADIUS

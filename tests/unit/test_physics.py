@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import pytest
 
 from arena.config import ROBOTINO, MatchConfig
-from arena.schemas.messages import BallEvent, Cmd
+from arena.schemas.messages import BallEvent, Cmd, RobotState
 from arena.sim.drive import Drive
 from arena.sim.physics import PIN_TOLERANCE, Physics, wrap_angle
 
@@ -750,3 +750,19 @@ def test_after_start_the_first_touch_is_reported_even_by_the_last_toucher():
     ph.set_command("a", 0, cmd(vx=1.0))
     events = run(ph, 50)
     assert [(e.kind, e.team, e.robot) for e in events] == [("TOUCH", "a", 0)]
+
+
+def test_robot_states_are_built_once_per_snapshot_and_follow_every_change():
+    ph = make()
+    first = ph.robot_states()
+    assert ph.robot_states() is first, "read twice from one snapshot, built once"
+    ph.place_robot("b", 0, 1.0, 2.0, 3.0)
+    placed = ph.robot_states()
+    assert placed is not first and ("b", 0, 1.0, 2.0, 3.0) == next(st for st in placed if st[:2] == ("b", 0))[:5]
+    ph.set_command("b", 0, cmd(vx=1.0))
+    ph.step()
+    moved = next(st for st in ph.robot_states() if st[:2] == ("b", 0))
+    assert moved[2] != 1.0 and ph.world(1).robots == [
+        RobotState(team=t, robot=n, x=x, y=y, theta=th, vx=vx, vy=vy, omega=w, has_ball=False)
+        for t, n, x, y, th, vx, vy, w in ph.robot_states()
+    ]
