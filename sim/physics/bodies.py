@@ -51,15 +51,14 @@ _ALL_FIELDS = (
 )
 _STRIDE = 6  # floats per body in a batch snapshot: x, y, angle, vx, vy, omega
 _POSITION = pmbatch.BodyFields.POSITION  # a positions-only read: x, y per body, in the snapshot's body order
+_CONTROL = pmbatch.BodyFields.VELOCITY | pmbatch.BodyFields.ANGULAR_VELOCITY  # vx, vy, omega per control body
 
 # The per-substep calls straight into Chipmunk, without pymunk's Python wrappers
 # around them (its `__setattr__` hook, the batch set-up, `Space.step`'s queues):
 # the same C functions with the same arguments, so the same floats, for about a
 # third of the Python work of a substep.
-# tests/unit/test_physics.py checks them against pymunk's public API.
+# tests/unit/test_physics.py checks them (and `BodyReader`, `ControlWriter`) against pymunk's public API.
 step_space = lib.cpSpaceStep  # (space._space, dt): `Space.step` without its add/remove-later queues
-set_velocity = lib.cpBodySetVelocity  # (body._body, (vx, vy)): `Body.velocity = vx, vy`
-set_angular_velocity = lib.cpBodySetAngularVelocity  # (body._body, w): `Body.angular_velocity = w`
 unpack = ffi.unpack
 
 
@@ -96,6 +95,41 @@ class BodyReader:
         return unpack(arr.arr, arr.num)  # type: ignore[no-any-return]
 
 
+class ControlWriter:
+    """Every control body's (vx, vy, omega), set in one C call.
+
+    What `pmbatch.set_space_bodies(space, _CONTROL, buf)` does, with the batch
+    descriptor built once: `cpBodySetVelocity` and `cpBodySetAngularVelocity`
+    for each body of `space` in turn (in the order they were added), where a
+    call of each per robot cost six times as much Python. `space` holds the
+    kinematic control bodies alone and is never stepped: the robots' joints
+    only read their velocities, as when they were in no space.
+    """
+
+    __slots__ = ("_space", "_buf", "_data", "_arr", "_n", "_each", "_iterate")
+
+    def __init__(self, space: pymunk.Space) -> None:
+        self._space = space._space
+        self._buf = pmbatch.Buffer()
+        pmbatch.get_space_bodies(space, _CONTROL, self._buf)  # sizes the C array: three floats a body
+        data = ffi.new("pmBatchedData *")
+        data.fields = _CONTROL.value
+        data.floatArray = self._buf._float_arr
+        data.intArray = self._buf._int_arr
+        self._data = data
+        self._arr = self._buf._float_arr
+        self._n = self._arr.num
+        self._each = lib.cpSpaceEachBody
+        self._iterate = ffi.addressof(lib, "pmSpaceBodySetIteratorFuncBatched")
+
+    def __call__(self, values: list[float]) -> None:
+        """Set (vx, vy, omega) of every body, flat, in the order the bodies were added."""
+        arr = self._arr
+        arr.arr[0 : self._n] = values
+        arr.num = 0  # the setter reads from here on
+        self._each(self._space, self._iterate, self._data)
+
+
 @dataclass(eq=False)
 class RobotBody:
     team: str
@@ -111,6 +145,5 @@ class RobotBody:
     dist: float = 0.0  # [m] travelled
     catch_from: int = 0  # first tick at which the dribbler may capture the ball again
     challenge_from: int = 0  # first tick at which it may challenge a holder again
-    ctrl_set: tuple[float, float, float] = (0.0, 0.0, 0.0)  # last control velocity written
     carry_from: tuple[float, float] = (0.0, 0.0)  # [m] its centre when its dribbler took the ball
     parked: bool = False  # taken off the field for good (its process died): no commands, no collisions

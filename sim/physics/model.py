@@ -24,8 +24,6 @@ from arena.sim.physics.bodies import (
     NO_CHALLENGE_S,
     PIN_TOLERANCE,
     RobotBody,
-    set_angular_velocity,
-    set_velocity,
     step_space,
     unpack,
 )
@@ -162,20 +160,16 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
     def _apply_commands(self, s: list[float]) -> None:
         half_dt = self._dt / 2
         cos, sin = math.cos, math.sin
+        controls: list[float] = []  # every robot's control body (vx, vy, omega), set in one call below
         for r in self._robots:
             o = r.off
             if r.cmd is not None:
                 vx, vy, w = r.twist
                 theta = s[o + 2] + half_dt * s[o + 5]
                 c, sn = cos(theta), sin(theta)
-                target = (c * vx - sn * vy, sn * vx + c * vy, w)
+                controls += (c * vx - sn * vy, sn * vx + c * vy, w)
             else:
-                target = (0.0, 0.0, 0.0)
-            if target != r.ctrl_set:
-                ctrl = r.ctrl._body
-                set_velocity(ctrl, target[:2])
-                set_angular_velocity(ctrl, target[2])
-                r.ctrl_set = target
+                controls += (0.0, 0.0, 0.0)
             holder = self._holder
             if holder is r and not r.dribbler:
                 self._release()
@@ -197,6 +191,7 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
                 and self._in_reach(r, s)
             ):
                 self._capture(r, s)
+        self._set_controls(controls)
 
     def _after_tick(self) -> None:
         """End of a tick: a pinned ball put back, the holder checked, the lines watched."""

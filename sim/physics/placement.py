@@ -77,7 +77,6 @@ class Placement:
         r.body.angular_velocity = 0.0
         r.ctrl.velocity = 0.0, 0.0
         r.ctrl.angular_velocity = 0.0
-        r.ctrl_set = (0.0, 0.0, 0.0)
         self._space.reindex_shapes_for_body(r.body)
         self._dirty = True
 

@@ -42,6 +42,7 @@ from arena.sim.physics.bodies import (
     SOLVER_ITERATIONS,
     WALL_FRICTION,
     BodyReader,
+    ControlWriter,
     RobotBody,
 )
 
@@ -75,6 +76,7 @@ class WorldBuilding:
         space.add(self._roll)
 
         self._robots: list[RobotBody] = []
+        controls = pymunk.Space()
         moment = pymunk.moment_for_box(rp.mass, (rp.size, rp.size))
         side = rp.size - 2 * ROBOT_CORNER
         for team in TEAMS:
@@ -88,7 +90,9 @@ class WorldBuilding:
                 space.add(body, shape)
                 # The control body stays out of the space: only its velocity matters to
                 # the joints, and the batch snapshot then holds just the ball and the robots.
+                # It is in a space of its own, never stepped, where one call sets them all.
                 ctrl = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+                controls.add(ctrl)
                 hold = pymunk.PivotJoint(body, self._ball, (self._hold_dist, 0.0), (0.0, 0.0))
                 self._robots.append(RobotBody(team, n, body, ctrl, hold))
         for i, r in enumerate(self._robots):
@@ -104,11 +108,16 @@ class WorldBuilding:
                 if self._robots[j].team != r.team:
                     space.on_collision(_ROBOT_TYPE0 + i, _ROBOT_TYPE0 + j, begin=self._on_impact, data=(i, j))
         self._by_id = {(r.team, r.n): r for r in self._robots}
+        self._batch_io(space, controls)
 
+    def _batch_io(self, space: pymunk.Space, controls: pymunk.Space) -> None:
+        """The batch reads of the bodies (offsets into the snapshot) and the control bodies' writer."""
         ids_buf = pmbatch.Buffer()
         pmbatch.get_space_bodies(space, pmbatch.BodyFields.BODY_ID, ids_buf)
         ids = list(memoryview(ids_buf.int_buf()).cast("P"))
         self._read = BodyReader(space)
+        self._controls = controls  # (the writer holds only its C pointer)
+        self._set_controls = ControlWriter(controls)  # every robot's commanded (vx, vy, omega), model.py
         self._positions = BodyReader(space, _POSITION)  # each substep's (x, y), for the distances (model.py `step`)
         self._space_c = space._space
         self._ball_off = ids.index(self._ball.id) * _STRIDE

@@ -111,7 +111,8 @@ def test_body_and_wheel_commands_obey_the_same_wheel_saturation():
     ph.set_command("a", 0, cmd(vx=twist[0], vy=twist[1], omega=twist[2]))
     ph.set_command("a", 1, cmd(mode="wheels", wheels=list(Drive(R).wheel_speeds(*twist))))
     run(ph, 1)
-    assert ph._robots[0].ctrl_set == pytest.approx(ph._robots[1].ctrl_set)
+    a0, a1 = ph._robots[0].ctrl, ph._robots[1].ctrl
+    assert (*a0.velocity, a0.angular_velocity) == pytest.approx((*a1.velocity, a1.angular_velocity))
     limited = Drive(R).twist(cmd(vx=twist[0], vy=twist[1], omega=twist[2]))
     assert max(abs(x) for x in Drive(R).wheel_speeds(*limited)) == pytest.approx(R.max_wheel_speed)
 
@@ -576,7 +577,7 @@ def _random_play(cfg: MatchConfig, ticks: int) -> list[tuple[list[BallEvent], ob
 
 
 def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
-    """`step_space`, `set_velocity`, `set_angular_velocity` and `BodyReader` (sim/physics/bodies.py) bit for bit.
+    """`step_space`, `BodyReader` and `ControlWriter` (sim/physics/bodies.py) bit for bit.
 
     The distances too: summed here after every substep, robot after robot, as `Physics.step` once did."""
     from pymunk import batch as pmbatch
@@ -627,15 +628,29 @@ def test_the_direct_chipmunk_calls_give_what_pymunks_api_gives(monkeypatch):
             self._each(self._space, None, None)
             return self.last
 
+    class Control:
+        """ControlWriter's call over pymunk's public API: robot i's control body gets values[3i:3i + 3]."""
+
+        def __init__(self, space: object) -> None:
+            self.space = space
+
+        def __call__(self, values: list[float]) -> None:
+            mine = [r for r in robots if r.ctrl.space is self.space]
+            assert len(values) == 3 * len(mine)
+            for i, r in enumerate(mine):
+                r.ctrl.velocity = values[3 * i], values[3 * i + 1]
+                r.ctrl.angular_velocity = values[3 * i + 2]
+                written.add(r.ctrl._body)
+
+    written: set = set()
     monkeypatch.setattr(world.WorldBuilding, "_build_world", build)
     monkeypatch.setattr(world, "BodyReader", Read)
     monkeypatch.setattr(model, "unpack", lambda reader, _num: reader.last)
     monkeypatch.setattr(model, "step_space", step_space)
-    monkeypatch.setattr(model, "set_velocity", lambda body_c, v: setattr(ctrls[body_c], "velocity", v))
-    monkeypatch.setattr(model, "set_angular_velocity", lambda body_c, w: setattr(ctrls[body_c], "angular_velocity", w))
+    monkeypatch.setattr(world, "ControlWriter", Control)
     public = _random_play(cfg, 600)
 
-    assert spaces and ctrls, "the public API was not used"
+    assert spaces and ctrls and written == set(ctrls), "the public API was not used"
     assert sum(len(events) for events, _, _ in fast) > 0, "nothing happened to the ball"
     assert len({(w.ball_x, w.ball_y) for _, w, _ in fast}) > 100, "the ball hardly moved"
     for tick, (a, b) in enumerate(zip(fast, public, strict=True), start=1):
