@@ -254,7 +254,7 @@ class EngineNode(Node):
                 yield pacer, k  # type: ignore[misc] - duck-types an Inbound: it only ever waits
             skip = k < skip_below
             ref_in.waited = k  # a wait not yielded (`Node.skip_below`)
-            if not (skip and ref_in.ready(k)):
+            if not (skip and k < ref_in.ready_below):  # `ref_in.ready(k)`, inlined (as below)
                 yield ref_in, k
             t0 = time.perf_counter()
             self.apply_referee(self.ref_in.take(k), k)
@@ -268,11 +268,11 @@ class EngineNode(Node):
             work = time.perf_counter() - t0
             for r, ib in self.cmd_in.items():
                 ib.waited = k  # a wait not yielded (`Node.skip_below`)
-                if not (skip and ib.ready(k)):
+                if not (skip and k < ib.ready_below):
                     yield ib, k
                 frames = ib.take(k)
                 if frames:
-                    ph.set_command(r[0], r[1], frames[-1])
+                    ph.command(r, frames[-1])
                 elif ib.dead and r not in self.parked:
                     self.park(r, k)
             if self.director is not None:

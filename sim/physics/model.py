@@ -98,7 +98,11 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
 
         A kick fires at most once per call (when the ball is, or becomes, in reach).
         """
-        r = self._by_id[(team, n)]
+        self.command((team, n), cmd)
+
+    def command(self, robot: tuple[str, int], cmd: Cmd) -> None:
+        """`set_command(*robot, cmd)`, for a caller that holds the (team, n) pair (the engine, six times a tick)."""
+        r = self._by_id[robot]
         if r.parked:
             return
         r.cmd = cmd
