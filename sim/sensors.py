@@ -93,17 +93,16 @@ def sense_every(
     physics: Physics, tick: int, robots: list[tuple[tuple[str, int], NormalStream]], p: SensorParams
 ) -> list[Sense]:
     """`sense()` of each (robot, its noise stream) of `robots`, in that order, the world read once."""
-    states = physics.robot_states()
-    index = {(st[0], st[1]): st for st in states}
+    states, index = physics.robot_states(), physics.robot_index
     n_z = 3 + 2 * len(states)
     picks = []
     for r, rng in robots:
         i, j = rng._i, rng._i + n_z  # NormalStream.take(n_z), its usual case inlined
         if j <= len(rng._buf):
             rng._i = j
-            picks.append((index[r], rng._buf[i:j]))
+            picks.append((states[index[r]], rng._buf[i:j]))
         else:
-            picks.append((index[r], rng.take(n_z)))
+            picks.append((states[index[r]], rng.take(n_z)))
     return _sense(states, picks, physics.ball_state(), physics.holder(), tick, p)
 
 

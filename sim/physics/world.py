@@ -108,6 +108,9 @@ class WorldBuilding:
                 if self._robots[j].team != r.team:
                     space.on_collision(_ROBOT_TYPE0 + i, _ROBOT_TYPE0 + j, begin=self._on_impact, data=(i, j))
         self._by_id = {(r.team, r.n): r for r in self._robots}
+        self.robot_index = {
+            (r.team, r.n): i for i, r in enumerate(self._robots)
+        }  # (team, n) -> its place in `robot_ids`
         self._batch_io(space, controls)
 
     def _batch_io(self, space: pymunk.Space, controls: pymunk.Space) -> None:
