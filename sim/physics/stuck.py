@@ -30,17 +30,21 @@ class StuckWatch:
         """ROBOT_STUCK for every robot of `ph` (a Physics) stuck as of its current tick."""
         if self.ticks <= 0:
             return []
-        k, out = ph.tick, []
-        parked = set(ph.parked())
-        for t, n, x, y, *_ in ph.robot_states():
+        if not ph.in_play:
+            self.anchor.clear()  # every clock restarts
+            return []
+        k, out, anchor = ph.tick, [], self.anchor
+        parked = ph.parked()
+        for st in ph.robot_states():
+            t, n, x, y = st[0], st[1], st[2], st[3]
             r = (t, n)
-            if r in parked or not ph.in_play or ph.commanded_speed(t, n) <= DRIVEN_SPEED:
-                self.anchor.pop(r, None)
+            if (parked and r in parked) or ph.commanded_speed(t, n) <= DRIVEN_SPEED:
+                anchor.pop(r, None)
                 continue
-            a = self.anchor.get(r)
+            a = anchor.get(r)
             if a is None or math.hypot(x - a[0], y - a[1]) > self.radius:
-                self.anchor[r] = (x, y, k)
+                anchor[r] = (x, y, k)
             elif k - a[2] >= self.ticks:
                 out.append(BallEvent(kind="ROBOT_STUCK", tick=k, team=t, robot=n, x=x, y=y))
-                self.anchor[r] = (x, y, k)
+                anchor[r] = (x, y, k)
         return out
