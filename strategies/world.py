@@ -35,7 +35,9 @@ estimated motion).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cache
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
@@ -198,6 +200,23 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
+@cache  # one function per window length, per process
+def _unrolled_sums(n: int) -> Callable[[list[float], list[float]], Vec]:
+    """For a consecutive track of n detections, a function of its xs and ys giving `_regression_velocity`'s
+    sums sum(d * (x - mean x)) and sum(d * (y - mean y)): the loop written out, term by term from 0.0 in the same
+    order with the same offsets d, so the same floats, without the loop's per-item interpreter work."""
+    ds, _ = _CONSECUTIVE[n]
+    xs, ys = (", ".join(f"{c}{i}" for i in range(n)) for c in "xy")
+    sx, sy = (" + ".join(f"{d!r} * ({c}{i} - m{c})" for i, d in enumerate(ds)) for c in "xy")
+    src = (
+        f"def sums(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
+        f"    return 0.0 + {sx}, 0.0 + {sy}\n"
+    )
+    scope: dict = {}
+    exec(compile(src, f"<_unrolled_sums({n})>", "exec"), scope)  # our own text, from numbers only
+    return scope["sums"]
+
+
 def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
     """[m/s] The least-squares slope of x and y over the ticks ts (rising); (0, 0) with fewer than 3 points."""
     n = len(ts)
@@ -264,6 +283,8 @@ class RobotView:
             n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
             for n, (ds, stt) in _CONSECUTIVE.items()
         }
+        window = p.track_window
+        self._window_sums = (window, _unrolled_sums(window)) if window in _CONSECUTIVE else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
@@ -415,6 +436,7 @@ class RobotView:
         if self._now is not None:
             return self._now
         ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
+        window, window_sums = self._window_sums
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
         for k, (ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
@@ -431,12 +453,15 @@ class RobotView:
                     out_y = abs(ys[-1] - y) - rng
                     if out_y > 0.0 and out_y > reach * _spread(ys):
                         continue
-                    mx = sum(xs) / n
-                    my = sum(ys) / n
-                    sxt = syt = 0.0
-                    for d, u, v in zip(ds, xs, ys):
-                        sxt += d * (u - mx)
-                        syt += d * (v - my)
+                    if n == window:  # a full window: the usual case
+                        sxt, syt = window_sums(xs, ys)
+                    else:
+                        mx = sum(xs) / n
+                        my = sum(ys) / n
+                        sxt = syt = 0.0
+                        for d, u, v in zip(ds, xs, ys):
+                            sxt += d * (u - mx)
+                            syt += d * (v - my)
                     vx, vy = sxt / stt_dt, syt / stt_dt
                 p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
             out.append(p)
