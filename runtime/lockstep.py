@@ -611,7 +611,14 @@ class Inbound(Generic[M]):
         return out
 
     def latest_by(self, k: int) -> M | None:
+        """`take(k)`, for a receiver that reads only `latest`: no list of the frames taken."""
         pending = self._pending
-        if pending and pending[0][0] <= k:
-            self.take(k)
-        return self.latest
+        if not pending or pending[0][0] > k:
+            return self.latest
+        latest = self.latest
+        while pending and pending[0][0] <= k:
+            msg = _heappop(pending)[2]
+            if latest is None or msg.tick > latest.tick:
+                latest = msg
+        self.latest = latest
+        return latest
