@@ -600,12 +600,15 @@ class Inbound(Generic[M]):
         pending = self._pending
         if not pending or pending[0][0] > k:
             return []  # nothing due: the usual case for most links at most ticks
-        out: list[M] = []
-        while pending and pending[0][0] <= k:
-            out.append(_heappop(pending)[2])
+        msg = _heappop(pending)[2]
         latest = self.latest
-        for msg in out:
-            if latest is None or msg.tick > latest.tick:
+        if latest is None or msg.tick > latest.tick:
+            latest = msg
+        out = [msg]  # one frame due: the usual case when there is any
+        while pending and pending[0][0] <= k:
+            msg = _heappop(pending)[2]
+            out.append(msg)
+            if msg.tick > latest.tick:
                 latest = msg
         self.latest = latest
         return out
