@@ -440,8 +440,7 @@ class ConfigError(ValueError):
     """A configuration or command-line value that cannot be used."""
 
 
-@dataclass(frozen=True, order=True)
-class ProcessId:
+class ProcessId(msgspec.Struct, frozen=True, order=True):
     """Who a process is: kind, and for team processes the team and robot number."""
 
     kind: str

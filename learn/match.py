@@ -136,6 +136,7 @@ class Gate:
     """Where a learner's robot waits for its action; duck-types the `Inbound` a cooperative task parks on."""
 
     __slots__ = ("key", "sender", "paired", "released", "waiter", "channel", "waited")
+    ready_below = -1  # no bound kept: a driver asks `ready(k)` (runtime/drivers.py `advance`)
 
     def __init__(self, name: str):
         self.key = f"action/{name}"

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Protocol
+
+import msgspec
 
 if TYPE_CHECKING:
     from arena.config import MatchConfig, ProcessId
@@ -26,8 +27,7 @@ class Engine(Protocol):
     def play(self, cfg: MatchConfig, *, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult: ...
 
 
-@dataclass(frozen=True)
-class InProcess:
+class InProcess(msgspec.Struct, frozen=True):
     """Every node of the match on this thread, driven cooperatively (lockstep only)."""
 
     name: ClassVar[str] = "inprocess"
@@ -51,8 +51,7 @@ class InProcess:
         return Stepped(cfg, watch=watch, only=only, match=match)
 
 
-@dataclass(frozen=True)
-class Processes:
+class Processes(msgspec.Struct, frozen=True):
     """Every process its own OS process over zenoh, supervised (match/launcher.py `play_match`
     says what each option does). `watch` is read back from the recording (a temporary one if no
     `record` is given)."""

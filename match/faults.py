@@ -30,7 +30,6 @@ The outcome:
 from __future__ import annotations
 
 import signal
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import msgspec
@@ -53,8 +52,7 @@ class Fault(msgspec.Struct):
     reason: str  # "exited with code -9 (SIGKILL)", "stopped responding: ...", ...
 
 
-@dataclass(frozen=True)
-class Verdict:
+class Verdict(msgspec.Struct, frozen=True):
     """What `outcome` finds: the match result's `outcome`, `void`, `outcome_reasons`, `dead`,
     `faults`, `conflicts` and `forged`."""
 

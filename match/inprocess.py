@@ -73,6 +73,7 @@ class Stepped:
                 self.recorder = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, path=record)
             else:
                 self.nodes[str(p)] = node_class(p.kind)(p, cfg, MemoryTransport(bus), keys, driver=Task(str(p)))
+        bus.straighten(ob for node in self.nodes.values() for ob in node.outbound)  # one call less a frame
 
     def frames(self, name: str) -> list[bytes]:
         """What arrived on the watched key `name` since the last call, in order."""

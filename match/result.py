@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import hashlib
 from collections import Counter
-from dataclasses import dataclass, field
 from typing import Any
 
 import msgspec
@@ -49,18 +48,17 @@ class JoinError(MatchError):
     """An `--external` process never joined (a user's or a network's matter: exit 2)."""
 
 
-@dataclass
-class Collected:
-    summaries: dict[str, Summary] = field(default_factory=dict)
-    pids: dict[str, int] = field(default_factory=dict)
-    forged: Counter = field(default_factory=Counter)  # rejected summaries per key
+class Collected(msgspec.Struct):
+    summaries: dict[str, Summary] = msgspec.field(default_factory=dict)
+    pids: dict[str, int] = msgspec.field(default_factory=dict)
+    forged: Counter = msgspec.field(default_factory=Counter)  # rejected summaries per key
     started: float = 0.0
     ended: float = 0.0
-    crashed: dict[str, str] = field(default_factory=dict)  # name -> why (exit code)
-    lost: dict[str, str] = field(default_factory=dict)  # liveliness gone before the summary
-    missing: dict[str, str] = field(default_factory=dict)  # no summary within the bound
+    crashed: dict[str, str] = msgspec.field(default_factory=dict)  # name -> why (exit code)
+    lost: dict[str, str] = msgspec.field(default_factory=dict)  # liveliness gone before the summary
+    missing: dict[str, str] = msgspec.field(default_factory=dict)  # no summary within the bound
     void: str = ""  # why the match is void, found while supervising
-    lapsed: set[str] = field(default_factory=set)  # tokens that vanished under load, frames kept coming
+    lapsed: set[str] = msgspec.field(default_factory=set)  # tokens that vanished under load, frames kept coming
     last_referee: Referee | None = None  # the newest referee frame the launcher saw (a void match's ticks, score)
 
 

@@ -254,7 +254,7 @@ class EngineNode(Node):
                 yield pacer, k  # type: ignore[misc] - duck-types an Inbound: it only ever waits
             skip = k < skip_below
             ref_in.waited = k  # a wait not yielded (`Node.skip_below`)
-            if not (skip and k < ref_in.ready_below):  # `ref_in.ready(k)`, inlined (as below)
+            if not (skip and k < ref_in.ready_below):  # `ref_in.ready(k)`, one call less
                 yield ref_in, k
             t0 = time.perf_counter()
             self.apply_referee(self.ref_in.take(k), k)
@@ -268,7 +268,7 @@ class EngineNode(Node):
             work = time.perf_counter() - t0
             for r, ib in self.cmd_in.items():
                 ib.waited = k  # a wait not yielded (`Node.skip_below`)
-                if not (skip and k < ib.ready_below):
+                if not (skip and k < ib.ready_below):  # `ib.ready(k)`, one call less
                     yield ib, k
                 frames = ib.take(k)
                 if frames:

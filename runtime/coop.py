@@ -110,6 +110,9 @@ class CoopBus(MemoryBus):
         self.runnable: deque[Task] = deque()
         self._targets: dict[str, list[tuple[object, CoopChannel | CoopLink]]] = {}
         self._puts: dict[str, list[Callable[[bytes], None]]] = {}  # key -> its targets' `put`s (`putter`)
+        self._putters: dict[Callable[[bytes], None], str] = {}  # every `putter` handed out -> its key
+        # key -> (holder, putter, target): a holder whose `_put` was set to the key's one target (`straighten`)
+        self._straight: dict[str, list[tuple[Any, Callable[[bytes], None], Callable[[bytes], None]]]] = {}
 
     def _targets_of(self, key: str) -> list[tuple[object, CoopChannel | CoopLink]]:
         targets = self._targets.get(key)
@@ -134,12 +137,31 @@ class CoopBus(MemoryBus):
             for p in puts:
                 p(payload)
 
+        self._putters[put] = key
         return put
+
+    def straighten(self, outbound: Iterable[Any]) -> None:
+        """Let each of `outbound` (an `Outbound`, or what it puts through: `Latest`, `WireGate`) whose
+        key has one target now put straight into that target, not through its `putter`'s loop: one
+        call less a frame. A later subscriber to that key puts the putter back (`_subscribed`)."""
+        for holder in outbound:
+            while (put := getattr(holder, "_put", None)) is not None and put not in self._putters:
+                holder = put  # a wrapper: what it puts through
+            if put is None:
+                continue
+            key = self._putters[put]
+            puts = self._puts[key]
+            if len(puts) == 1:
+                holder._put = puts[0]
+                self._straight.setdefault(key, []).append((holder, put, puts[0]))
 
     def _subscribed(self, owner: object, key: str, ch: CoopChannel | CoopLink) -> None:
         self._subs[key].append((owner, ch))  # type: ignore[arg-type]
         for k in [k for k in self._targets if self.matches(key, k)]:
             del self._targets[k]
+            for holder, put, target in self._straight.pop(k, ()):
+                if holder._put is target:  # (not muted since: `Outbound.mute`)
+                    holder._put = put
             puts = self._puts.get(k)
             if puts is not None:  # in place: the publishers' `put`s hold these lists
                 puts[:] = [c.put for _, c in self._targets_of(k)]

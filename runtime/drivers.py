@@ -84,7 +84,10 @@ def advance(
     while True:
         if waiting is not None:
             ib, k = waiting
-            if not ib.ready(k) and not settle(ib, k):
+            # `ib.ready(k)` of a link is `k < ib.ready_below`: a comparison, not a call. What duck-types
+            # a link without keeping that bound (ready_below -1: the engine's pacer, a learner's gate) is asked.
+            below = ib.ready_below
+            if k >= below and (below >= 0 or not ib.ready(k)) and not settle(ib, k):
                 if before_wait is not None and not ib.paired:
                     before_wait()
                 return waiting

@@ -95,6 +95,7 @@ class Pacer:
     key = "control"
     paired = False  # a held tick is a wait like any other: the engine puts its held `sense` batches first
     schedule = EVERY_TICK  # the Reactor's bound on a wait names the tick waited for (runtime/drivers.py `_look`)
+    ready_below = -1  # no bound kept: a driver asks `ready(k)` (runtime/drivers.py `advance`)
 
     def __init__(
         self,

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
+
+import msgspec
 
 from arena.schemas import messages as m
 from arena.schemas.vocabulary import TEAMS
@@ -28,8 +29,7 @@ def check_match_id(match: str) -> str:
 DEFAULT_PERIODS: dict[str, int] = {"tick": 1, "comm": 5, "referee": 5, "world": 1}
 
 
-@dataclass(frozen=True)
-class Timing:
+class Timing(msgspec.Struct, frozen=True):
     """A link's schedule and lag, as data.
 
     The sender sends one frame at every tick phase, phase + P, phase + 2P, ...,
@@ -52,8 +52,7 @@ class Timing:
         return p, self.phase % p
 
 
-@dataclass(frozen=True)
-class KeySpec:
+class KeySpec(msgspec.Struct, frozen=True):
     name: str  # short name used in code and docs
     pattern: str  # relative to arena/<match>/, with <team> and <n> placeholders
     message: type[m.Base]

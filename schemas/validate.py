@@ -68,7 +68,9 @@ def nonfinite(raw: bytes, msg: Base) -> str | None:
 
 def suspect(raw: bytes) -> bool:
     """Whether `raw` holds a msgpack float header followed by the first byte of a non-finite value."""
-    return b"\x01\x02" in raw.translate(_CLASSES)
+    # `find`, not `in`: bytes' `in` first tries its operand as an integer, and builds and drops a
+    # TypeError's message for every other operand (~1,800 instructions a call, more than the scan).
+    return raw.translate(_CLASSES).find(b"\x01\x02") >= 0
 
 
 def safe_default(msg: Base, previous: Base | None) -> Base | None:

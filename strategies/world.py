@@ -35,7 +35,9 @@ estimated motion).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cache
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
@@ -198,6 +200,23 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
+@cache  # one function per window length, per process
+def _unrolled_sums(n: int) -> Callable[[list[float], list[float]], Vec]:
+    """For a consecutive track of n detections, a function of its xs and ys giving `_regression_velocity`'s
+    sums sum(d * (x - mean x)) and sum(d * (y - mean y)): the loop written out, term by term from 0.0 in the same
+    order with the same offsets d, so the same floats, without the loop's per-item interpreter work."""
+    ds, _ = _CONSECUTIVE[n]
+    xs, ys = (", ".join(f"{c}{i}" for i in range(n)) for c in "xy")
+    sx, sy = (" + ".join(f"{d!r} * ({c}{i} - m{c})" for i, d in enumerate(ds)) for c in "xy")
+    src = (
+        f"def sums(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
+        f"    return 0.0 + {sx}, 0.0 + {sy}\n"
+    )
+    scope: dict = {}
+    exec(compile(src, f"<_unrolled_sums({n})>", "exec"), scope)  # our own text, from numbers only
+    return scope["sums"]
+
+
 def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
     """[m/s] The least-squares slope of x and y over the ticks ts (rising); (0, 0) with fewer than 3 points."""
     n = len(ts)
@@ -264,14 +283,17 @@ class RobotView:
             n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
             for n, (ds, stt) in _CONSECUTIVE.items()
         }
+        window = p.track_window
+        self._window_sums = (window, _unrolled_sums(window)) if window in _CONSECUTIVE else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
         self.dt = dt
         self.own_ball = BallFilter(p, dt)
         self.pose: tuple[float, float, float] | None = None
-        self._vel: Vec | None = (0.0, 0.0)  # see `vel`
-        self._moving: Sense | None = None  # the latest sense, whose velocity `vel` turns into the field frame
+        self.vel: Vec = (0.0, 0.0)  # [m/s] the robot's velocity in the field frame (odometry, sensed in the body frame)
+        # [m] Where the robot is now: its sensed position moved on by `latency` ticks at its odometry velocity
+        self.pose_now: Vec | None = None
         self.omega = 0.0  # [rad/s] odometry
         self.ball: Vec | None = None
         self.ball_vel: Vec = (0.0, 0.0)
@@ -290,12 +312,16 @@ class RobotView:
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
-    def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:  # noqa: PLR0912 - one branch per frame part of the world model
+    def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
         own_ball = self.own_ball
         if sense is not None:
             p = sense.pose
-            self.pose = (p.x, p.y, p.theta)
-            self._moving, self._vel = sense, None  # turned into the field frame when asked for (`vel`)
+            x, y, theta = self.pose = (p.x, p.y, p.theta)
+            c, s = math.cos(theta), math.sin(theta)
+            svx, svy = sense.vx, sense.vy
+            vx, vy = self.vel = (c * svx - s * svy, s * svx + c * svy)
+            lead = self.lead
+            self.pose_now = (x + vx * lead, y + vy * lead) if lead != 0.0 else (x, y)
             self.omega = sense.omega
             self.has_ball = sense.has_ball
             b = sense.ball
@@ -305,6 +331,9 @@ class RobotView:
             for tp in order.own:
                 if tp.robot == self.n:
                     self.pose = (tp.x, tp.y, tp.theta)
+                    vx, vy = self.vel
+                    lead = self.lead
+                    self.pose_now = (tp.x + vx * lead, tp.y + vy * lead) if lead != 0.0 else (tp.x, tp.y)
         track = own_ball.track
         own_age = tick - track.tick if track is not None else 1 << 30
         order_ball = order is not None and order.ball_valid
@@ -318,17 +347,7 @@ class RobotView:
         self.ball_age = age
         self.ball = None if age > self._ball_memory else ball
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
-            self._order = order
-            if order is not None:
-                n = self.n
-                self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != n}
-                self._order_opponents = [(tp.age, (tp.x, tp.y)) for tp in order.opponents]
-            else:
-                self.mates = {}
-                self._order_opponents = []
-            self._order_opponent_xy = [xy for _, xy in self._order_opponents]
-            self._order_opponent_oldest = max((age for age, _ in self._order_opponents), default=0)
-            self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
+            self._take_order(order)
         seen: list[Vec] = []  # own detections: opponents ...
         near: list[Vec] = []  # ... and teammates
         if sense is not None:
@@ -352,6 +371,20 @@ class RobotView:
             self._track(sense.tick, seen)
             self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
             self._ahead = [None] * len(self._tracks)
+
+    def _take_order(self, order: Order | None) -> None:
+        """What follows from a new order alone: the teammates and the base station's opponents."""
+        self._order = order
+        if order is not None:
+            n = self.n
+            self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != n}
+            self._order_opponents = [(tp.age, (tp.x, tp.y)) for tp in order.opponents]
+        else:
+            self.mates = {}
+            self._order_opponents = []
+        self._order_opponent_xy = [xy for _, xy in self._order_opponents]
+        self._order_opponent_oldest = max((age for age, _ in self._order_opponents), default=0)
+        self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
@@ -403,6 +436,7 @@ class RobotView:
         if self._now is not None:
             return self._now
         ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
+        window, window_sums = self._window_sums
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
         for k, (ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
@@ -419,38 +453,20 @@ class RobotView:
                     out_y = abs(ys[-1] - y) - rng
                     if out_y > 0.0 and out_y > reach * _spread(ys):
                         continue
-                    mx = sum(xs) / n
-                    my = sum(ys) / n
-                    sxt = syt = 0.0
-                    for d, u, v in zip(ds, xs, ys):
-                        sxt += d * (u - mx)
-                        syt += d * (v - my)
+                    if n == window:  # a full window: the usual case
+                        sxt, syt = window_sums(xs, ys)
+                    else:
+                        mx = sum(xs) / n
+                        my = sum(ys) / n
+                        sxt = syt = 0.0
+                        for d, u, v in zip(ds, xs, ys):
+                            sxt += d * (u - mx)
+                            syt += d * (v - my)
                     vx, vy = sxt / stt_dt, syt / stt_dt
                 p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
             out.append(p)
         out.extend(self.opponents[len(self._seen) :])
         return out
-
-    @property
-    def pose_now(self) -> tuple[float, float]:
-        """[m] Where the robot is now: its sensed position moved on by `latency` ticks at its odometry velocity."""
-        x, y, _ = self.pose  # type: ignore[misc]
-        if self.lead == 0.0:
-            return x, y
-        vx, vy = self.vel
-        return x + vx * self.lead, y + vy * self.lead
-
-    @property
-    def vel(self) -> Vec:
-        """[m/s] The robot's velocity in the field frame (odometry, sensed in the body frame)."""
-        vel = self._vel
-        if vel is None:  # worked out only when asked for: only the navigator needs it
-            sense = self._moving
-            theta = sense.pose.theta  # type: ignore[union-attr]
-            c, s = math.cos(theta), math.sin(theta)
-            svx, svy = sense.vx, sense.vy  # type: ignore[union-attr]
-            vel = self._vel = (c * svx - s * svy, s * svx + c * svy)
-        return vel
 
     @property
     def mate_obstacles(self) -> list[Vec]:

@@ -136,3 +136,33 @@ def test_a_cooperative_link_takes_a_frame_in_as_it_is_put_and_wakes_its_task_onl
     assert log == pulled and len(log) == 7
     for h in (a2, b2):
         h.close()
+
+
+def test_a_straightened_publisher_puts_into_its_one_target_and_a_later_subscriber_still_gets_every_frame():
+    """`CoopBus.straighten`: a key with one target is put straight into it; a subscriber that comes
+    later puts the publisher back on its putter (so it gets every frame after), and a muted key stays muted."""
+    import hashlib
+
+    from arena.runtime.coop import CoopBus
+    from arena.runtime.lockstep import Latest, Outbound
+    from arena.schemas.messages import Cmd, encode
+
+    bus = CoopBus()
+    first = bus.subscribe("a", "arena/t/x")
+    plain = Outbound("arena/t/x", "x", bus.putter("arena/t/x"), hashlib.blake2b())
+    served = Outbound("arena/t/x", "x", bus.putter("arena/t/x"), hashlib.blake2b())
+    latest = Latest()
+    served.put_through(latest.wrap)
+    muted = Outbound("arena/t/x", "x", bus.putter("arena/t/x"), hashlib.blake2b())
+    bus.straighten([plain, served, muted])
+    assert plain._put == first.put and latest._put == first.put, "straight into the one target"
+    muted.mute()
+    for ob in (plain, served, muted):
+        ob.send(Cmd(tick=0))
+    later = bus.subscribe("b", "arena/t/**")
+    for ob in (plain, served, muted):
+        ob.send(Cmd(tick=1))
+    got = [first.try_recv() for _ in range(6)]
+    assert got[:2] == [encode(Cmd(tick=0))] * 2 and got[2:4] == [encode(Cmd(tick=1))] * 2 and got[4:] == [None] * 2
+    assert [later.try_recv() for _ in range(3)] == [encode(Cmd(tick=1))] * 2 + [None], "the later subscriber too"
+    assert latest.get() == encode(Cmd(tick=1))

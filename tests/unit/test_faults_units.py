@@ -203,3 +203,28 @@ def test_forged_counts_are_said_to_be_messages():
         "possible spoofing on arena/m/cmd/a/1 (3 forged messages)",
         "possible spoofing on arena/m/referee (1 forged message, 2 conflicting frames)",
     ]
+
+
+@pytest.mark.parametrize("period", [1, 5])
+def test_a_different_frame_is_a_conflict_within_the_last_recent_frames_and_out_of_sequence_long_before(period):
+    """The kept window (runtime/lockstep.py `RECENT`): a different frame for any of (at least) the last
+    RECENT accepted ticks is a conflict, a repeat of one is not; a frame far older is only out of sequence."""
+    from arena.runtime.lockstep import RECENT, Schedule
+
+    h = Harness(schedule=Schedule(period, 0))
+    last = 4 * RECENT * period  # frames: far more than the window keeps
+    for i in range(last + 1):
+        h.put(encode(Cmd(tick=i * period, vx=1.0)))
+    oldest = (last - RECENT + 1) * period  # the oldest tick of the last RECENT frames
+    h.put(encode(Cmd(tick=oldest, vx=2.0)))  # a conflict
+    h.put(encode(Cmd(tick=oldest, vx=1.0)))  # a repeat: out of sequence
+    h.put(encode(Cmd(tick=last * period, vx=2.0)))  # a conflict
+    h.put(encode(Cmd(tick=period, vx=2.0)))  # long before the window: out of sequence
+    if period > 1:
+        h.put(encode(Cmd(tick=oldest + 1, vx=2.0)))  # never a tick of the link: out of sequence
+    h.inbound.sync(last * period + 1)
+    h.inbound.drain()  # what came after
+    h.close()
+    assert h.inbound.last_seen == last * period
+    assert h.rej.conflicts == {h.inbound.key: 2}, h.rej.by_reason
+    assert h.rej.by_reason == {"conflict": 2, "out-of-sequence": 3 if period > 1 else 2}
