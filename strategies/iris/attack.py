@@ -31,6 +31,8 @@ from arena.strategies.iris.params import Vec
 class AttackMixin:
     """Mixin of `IrisRobot`: attack."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def basic_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
         """Paper 2, basic strategy: dribble towards the goal, kick from a set distance."""
         aim = (goal[0], self.open_side(goal[0]))

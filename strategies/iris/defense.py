@@ -30,6 +30,8 @@ from arena.strategies.iris.params import Vec
 class DefenseMixin:
     """Mixin of `IrisRobot`: defense."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def without_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
         view, p = self.view, self.p
         x, y, _ = view.pose  # type: ignore[misc]

@@ -25,6 +25,8 @@ from arena.strategies.iris.params import Vec
 class HandlingMixin:
     """Mixin of `IrisRobot`: the ball."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def is_chaser(self, order: Order, ball: Vec) -> bool:
         """Nearest to the ball among our outfield robots whose area holds it (a fresh passer leaves it)."""
         mem = self.mem

@@ -18,6 +18,8 @@ from arena.strategies.iris.params import Vec
 class KeeperMixin:
     """Mixin of `IrisRobot`: goalkeeper."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def goalkeeper(self, tick: int, order: Order, ball: Vec) -> Cmd:
         view = self.view
         if view.has_ball:

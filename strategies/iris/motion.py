@@ -32,6 +32,8 @@ from arena.strategies.iris.params import Vec
 class MotionMixin:
     """Mixin of `IrisRobot`: going somewhere."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def goal(self, order: Order) -> Vec:
         return order.attack_dir * self.half_length, 0.0
 

@@ -15,6 +15,8 @@ from arena.strategies.iris.params import Vec
 class PositionsMixin:
     """Mixin of `IrisRobot`: positions off the ball."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def home(self, order: Order, ball: Vec) -> Vec:
         """Where a robot waits while it does not go for the ball, by role and team mode.
 

@@ -23,6 +23,8 @@ from arena.strategies.iris.params import WALL_PIECES, Vec
 class SetPieceMixin:
     """Mixin of `IrisRobot`: set pieces."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def position_for_restart(self, tick: int, order: Order) -> Cmd:
         fixed = self._restart
         if fixed is not None and fixed[0] is order:  # the keeper's place or the home of this order, as last tick
