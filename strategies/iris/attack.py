@@ -130,7 +130,7 @@ class AttackMixin:
 
     def lead_point(self, order: Order, mate: Vec) -> Vec:
         """`pass_lead` in front of a teammate, towards the goal: it runs onto the ball facing the goal."""
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         a = S.angle_to(mate, goal)
         return self.inside((mate[0] + self.p.pass_lead * math.cos(a), mate[1] + self.p.pass_lead * math.sin(a)), -0.5)
 

@@ -34,12 +34,6 @@ class MotionMixin:
 
     __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
 
-    def goal(self, order: Order) -> Vec:
-        return order.attack_dir * self.half_length, 0.0
-
-    def own_goal(self, order: Order) -> Vec:
-        return -order.attack_dir * self.half_length, 0.0
-
     def u(self, order: Order, x: float) -> float:
         return order.attack_dir * x
 

@@ -134,4 +134,6 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
             areas=areas,
             attacking=R.is_attacking(order.role_state),
             team=self.view.mates,  # a new dict with every order (`RobotView.update`)
+            goal=(order.attack_dir * self.half_length, 0.0),
+            own=(-order.attack_dir * self.half_length, 0.0),
         )
