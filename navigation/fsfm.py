@@ -50,6 +50,7 @@ from arena.navigation.sfm import SFMParams, command_velocity, goal_force
 
 _PI = math.pi
 _TAU = 2.0 * _PI
+atan2, exp, hypot, remainder = math.atan2, math.exp, math.hypot, math.remainder
 
 
 @dataclass(frozen=True)
@@ -152,6 +153,24 @@ class FIS:
         object.__setattr__(self, "table", tuple(tuple(getattr(self.outputs, lab) for lab in row) for row in self.rules))
         for name, sets in (("distance_mf", self.distance_sets), ("direction_mf", self.direction_sets)):
             object.__setattr__(self, name, tuple((i, s.u, s.v, s.w, s.v - s.u, s.w - s.v) for i, s in enumerate(sets)))
+        # not a field: both inputs' `_spans` for `step`, None unless both are Ruspini partitions (the paper's are)
+        spans = _spans(self.distance_mf), _spans(self.direction_mf)
+        object.__setattr__(self, "partition", None if None in spans else spans)
+
+
+def _spans(mf: tuple[tuple[int, float, float, float, float, float], ...]) -> tuple | None:
+    """Sets that form a Ruspini partition (a left shoulder, triangles, a right shoulder, each reaching to its
+    neighbours' centres, the centres increasing) as (first centre, last centre, spans); spans[k] =
+    (w_k, w_k - v_k, u_k+1, v_k+1 - u_k+1) between the centres of sets k and k + 1, where only those two sets
+    have a degree: (w_k - x) / (w_k - v_k) and (x - u_k+1) / (v_k+1 - u_k+1) by eq. 8. None for other sets."""
+    if len(mf) < 2 or mf[0][1] != mf[0][2] or mf[-1][2] != mf[-1][3]:
+        return None
+    spans = []
+    for (_, _, v, w, _, wv), (_, u2, v2, _, vu2, _) in zip(mf, mf[1:]):
+        if not (v < v2 and w == v2 and u2 == v):
+            return None
+        spans.append((w, wv, u2, vu2))
+    return mf[0][2], mf[-1][2], tuple(spans)
 
 
 @dataclass(frozen=True)
@@ -160,6 +179,18 @@ class FSFMParams:
     fis: FIS = FIS()  # eq. 8-10
     front: Literal["goal", "velocity"] = "goal"  # what "front" means for the direction input
     min_speed_for_front: float = 0.05  # [m/s] below this, front="velocity" falls back to the goal direction
+
+    def __post_init__(self) -> None:
+        # not a field: what `step` reads every call, None for a FIS that is not a Ruspini partition
+        sfm = self.sfm
+        flat = None
+        if self.fis.partition is not None:
+            flat = (
+                *(sfm.mass / sfm.tau, sfm.max_speed, sfm.r_ij, sfm.sigma, sfm.cutoff_distance),
+                *(sfm.tau / sfm.mass, sfm.integrate, self.front == "velocity", self.min_speed_for_front),
+                *(*self.fis.partition, self.fis.table),
+            )
+        object.__setattr__(self, "flat", flat)
 
     @property
     def max_speed(self) -> float:
@@ -290,6 +321,101 @@ def step(
     obstacles: Sequence[Sequence[float]],
     params: FSFMParams = DEFAULT,
 ) -> Vec2:
-    """Navigator contract (see :mod:`arena.navigation.base`): SFM with FIS-adapted gains."""
-    v = xy(vel)
-    return command_velocity(v, navigation_force(pos, v, goal, obstacles, params), params.sfm)
+    """Navigator contract (see :mod:`arena.navigation.base`): SFM with FIS-adapted gains,
+    `command_velocity` of `navigation_force`.
+
+    With the paper's Ruspini partitions this runs flattened (it runs per robot and tick): `xy`, `points`,
+    `goal_force`, `command_velocity` and `clip_speed` inlined on the constants `FSFMParams.flat`, `gain` as
+    `_partition_gain`, each the very float operations of what it stands for, in the same order.
+    """
+    flat = params.flat  # type: ignore[attr-defined]
+    if flat is None:
+        v = xy(vel)
+        return command_velocity(v, navigation_force(pos, v, goal, obstacles, params), params.sfm)
+    c_goal, v0, r_ij, sigma, cutoff, tau_m, integrate, velocity_front, min_speed, dist, dirn, table = flat
+    x, y = float(pos[0]), float(pos[1])
+    vx, vy = float(vel[0]), float(vel[1])
+    gx, gy = float(goal[0]), float(goal[1])
+    ex, ey = gx - x, gy - y  # eq. 4, `goal_force`
+    dg = hypot(ex, ey)
+    if dg < EPS_DISTANCE:
+        ex = ey = 0.0
+    else:
+        ex, ey = ex / dg, ey / dg
+    fx, fy = c_goal * (v0 * ex - vx), c_goal * (v0 * ey - vy)
+    if velocity_front and hypot(vx, vy) >= min_speed:
+        front = atan2(vy, vx)
+    else:
+        front = atan2(gy - y, gx - x)  # beta, eq. 13
+    for o in obstacles if type(obstacles) is list else points(obstacles):
+        dx, dy = x - float(o[0]), y - float(o[1])  # along e_ij
+        d = hypot(dx, dy)  # eq. 12
+        if d < EPS_DISTANCE or d > cutoff:
+            continue
+        phi = remainder(atan2(-dy, -dx) - front, _TAU)  # gamma (eq. 14) relative to the front
+        k = _partition_gain(d, abs(phi), dist, dirn, table)  # eq. 8-10
+        overlap = r_ij - d
+        c = k * (exp(overlap / sigma) + (overlap if overlap > 0.0 else 0.0)) / d  # eq. 5-7
+        fx += c * dx
+        fy += c * dy
+    fx, fy = fx * tau_m, fy * tau_m  # eq. 17-20, `command_velocity`
+    if integrate:
+        fx += vx
+        fy += vy
+    speed = hypot(fx, fy)  # `clip_speed`
+    if speed > v0:
+        s = v0 / speed
+        return fx * s, fy * s
+    return fx, fy
+
+
+def _partition_gain(  # noqa: C901, PLR0912 - eq. 8-10 flattened: two inputs' neighbours, the four rules they fire
+    d: float, x: float, dist: tuple, dirn: tuple, table: tuple[tuple[float, ...], ...]
+) -> float:
+    """`gain(d, x, fis)` for x >= 0 on Ruspini partitions (`_spans` of the distance and direction sets): each input
+    has a degree in at most two neighbouring sets (a, a + 1) and (b, b + 1), found from the centres; the same
+    degrees, products and sums in the same order as `gain`, which tries every set."""
+    first, last, spans = dist
+    if d <= first:
+        a, da, da1 = 0, 1.0, 0.0
+    elif not d <= last:  # beyond the last centre (or NaN): the right shoulder alone
+        a, da, da1 = len(spans), 1.0, 0.0
+    else:
+        for a, (w, wv, u, vu) in enumerate(spans):  # noqa: B007 - the span found is used below
+            if d <= w:
+                break
+        da, da1 = (w - d) / wv, (d - u) / vu
+    first, last, spans = dirn
+    if x <= first:
+        b, gb, gb1 = 0, 1.0, 0.0
+    elif not x <= last:
+        b, gb, gb1 = len(spans), 1.0, 0.0
+    else:
+        for b, (w, wv, u, vu) in enumerate(spans):  # noqa: B007
+            if x <= w:
+                break
+        gb, gb1 = (w - x) / wv, (x - u) / vu
+    num = den = 0.0
+    if gb > 0.0:  # direction set b, then b + 1; in each, distance set a, then a + 1
+        row = table[b]
+        if da > 0.0:
+            fire = gb * da  # B_ab, eq. 9
+            num += fire * row[a]
+            den += fire
+        if da1 > 0.0:
+            fire = gb * da1
+            num += fire * row[a + 1]
+            den += fire
+    if gb1 > 0.0:
+        row = table[b + 1]
+        if da > 0.0:
+            fire = gb1 * da
+            num += fire * row[a]
+            den += fire
+        if da1 > 0.0:
+            fire = gb1 * da1
+            num += fire * row[a + 1]
+            den += fire
+    if den == 0.0:
+        raise ValueError(f"no rule fires for d={d}, phi={x}: the input sets do not cover it")
+    return num / den

@@ -20,8 +20,8 @@ One module per concern:
   `attack.py`, `defense.py`, `positions.py`, `keeper.py` and `setpieces.py`;
 * `memory.py`: what a robot remembers between ticks and the plan of an order.
 
-Cost: what depends only on the order (areas, roles, teammates, a restart's
-fixed place) is worked out once per order (`Plan`, `support_point`,
+Cost: what depends only on the order (areas, roles, teammates, the goal
+centres, a restart's fixed place) is worked out once per order (`Plan`, `support_point`,
 `position_for_restart`), not once per tick; with no robot
 within `obstacle_range` the navigator is not called (F-SFM then gives the
 straight line at cruise speed). The per-tick path (`step`, `drive`, the

@@ -31,6 +31,8 @@ from arena.strategies.iris.params import Vec
 class AttackMixin:
     """Mixin of `IrisRobot`: attack."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def basic_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
         """Paper 2, basic strategy: dribble towards the goal, kick from a set distance."""
         aim = (goal[0], self.open_side(goal[0]))
@@ -128,7 +130,7 @@ class AttackMixin:
 
     def lead_point(self, order: Order, mate: Vec) -> Vec:
         """`pass_lead` in front of a teammate, towards the goal: it runs onto the ball facing the goal."""
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         a = S.angle_to(mate, goal)
         return self.inside((mate[0] + self.p.pass_lead * math.cos(a), mate[1] + self.p.pass_lead * math.sin(a)), -0.5)
 

@@ -30,11 +30,13 @@ from arena.strategies.iris.params import Vec
 class DefenseMixin:
     """Mixin of `IrisRobot`: defense."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def without_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
         view, p = self.view, self.p
         x, y, _ = view.pose  # type: ignore[misc]
         pos = (x, y)
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         if (tick - self.mem.lost_at) * self._dt < p.regroup and self.carrier(ball) is not None:
             # Lost the ball to a tackle: step back instead of wrestling for it, then challenge again;
             # basic: aside; advance: goal-side, onto the carrier's kick line (Fig. 7b).
@@ -44,7 +46,7 @@ class DefenseMixin:
             elif self.p.advance:
                 back = S.behind_point(ball, goal, self.p.regroup_distance)
             else:
-                back = S.aside_point(ball, self.own_goal(order), pos, self.p.regroup_distance)
+                back = S.aside_point(ball, self.plan.own, pos, self.p.regroup_distance)  # type: ignore[union-attr]
             return self.drive(tick, back, S.angle_to(pos, ball), self.p.cruise, avoid=False)
         attacking = self.plan.attacking  # type: ignore[union-attr]
         if attacking:
@@ -86,7 +88,7 @@ class DefenseMixin:
         robots ... will always block opposing attacker to score goal").
         """
         sp = self.p.skills
-        own = self.own_goal(order)
+        own = self.plan.own  # type: ignore[union-attr]
         carrier = self.carrier(ball)
         d_carrier = S.dist(carrier, own) if carrier is not None else 0.0  # [m] the carrier to our goal centre
         if carrier is not None and d_carrier < self.p.block_zone:
@@ -152,7 +154,7 @@ class DefenseMixin:
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
         """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""
-        own = self.own_goal(order)
+        own = self.plan.own  # type: ignore[union-attr]
         best, found = self.p.mark_zone, None
         for o in self.view.opponents:
             if S.dist(o, carrier) < 0.3:

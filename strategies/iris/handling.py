@@ -25,6 +25,8 @@ from arena.strategies.iris.params import Vec
 class HandlingMixin:
     """Mixin of `IrisRobot`: the ball."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def is_chaser(self, order: Order, ball: Vec) -> bool:
         """Nearest to the ball among our outfield robots whose area holds it (a fresh passer leaves it)."""
         mem = self.mem
@@ -129,7 +131,7 @@ class HandlingMixin:
     def with_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
         x, y, _ = self.view.pose  # type: ignore[misc]
         pos = (x, y)
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         carried = S.dist(pos, self.mem.carry_from) if self.mem.carry_from is not None else 0.0
         at_limit = carried > self.p.carry_limit
         if (tick - self.mem.hold_since) * self.cfg.timing.dt > self.p.stall_hold:
@@ -145,7 +147,7 @@ class HandlingMixin:
         if math.cos(th) * order.attack_dir > -0.3:
             self.mem.kicked_at = tick
             return self.drive(tick, (x, y), th, 0.0, dribbler=True, kick=self.p.unstall_speed, avoid=False)
-        return self.turn_and_kick(tick, self.goal(order), self.p.unstall_speed)
+        return self.turn_and_kick(tick, self.plan.goal, self.p.unstall_speed)  # type: ignore[union-attr]
 
     def nudge_point(self, pos: Vec, goal: Vec, opponents: list[Vec]) -> Vec:
         """Where to push the ball ahead at the carry limit: goal-ward, turned away from the nearest opponent."""

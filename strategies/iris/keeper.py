@@ -18,11 +18,13 @@ from arena.strategies.iris.params import Vec
 class KeeperMixin:
     """Mixin of `IrisRobot`: goalkeeper."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def goalkeeper(self, tick: int, order: Order, ball: Vec) -> Cmd:
         view = self.view
         if view.has_ball:
             return self.clear(tick, order, ball)
-        own_x = self.own_goal(order)[0]
+        own_x = self.plan.own[0]  # type: ignore[union-attr]
         x, y, _ = view.pose  # type: ignore[misc]
         bx, by = ball
         d_ball = hypot(x - bx, y - by)  # S.dist(pos, ball)
@@ -34,7 +36,7 @@ class KeeperMixin:
                 if dd < opp:
                     opp = dd
             if d_ball < (opp if opp < 1.5 else 1.5):  # min(1.5, opp)
-                return self.get_ball(tick, ball, self.goal(order))
+                return self.get_ball(tick, ball, self.plan.goal)  # type: ignore[union-attr]
         target, _ = S.keeper_target(ball, view.ball_vel, own_x, self.goal_half, self.p.skills)
         return self.drive(
             tick,
@@ -52,6 +54,6 @@ class KeeperMixin:
         target = self.pass_target(order)
         if target is not None:
             return self.pass_to(tick, target)
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         aim = (goal[0], S.clamp(y, -2.0, 2.0))
         return self.turn_and_kick(tick, aim, self.p.kick_speed)

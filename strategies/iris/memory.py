@@ -35,6 +35,8 @@ class Plan:
     areas: dict[int, tuple[float, float]]  # of every outfield teammate with a role
     attacking: bool  # Fig. 6: the team is in attacking mode
     team: dict[int, tuple[float, float, str]]  # the order's teammates: n -> (x [m], y [m], role)
+    goal: Vec  # [m] the centre of the goal we attack ...
+    own: Vec  # [m] ... and of ours
 
     @property
     def mates(self) -> tuple[Vec, ...]:

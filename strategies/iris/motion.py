@@ -32,11 +32,7 @@ from arena.strategies.iris.params import Vec
 class MotionMixin:
     """Mixin of `IrisRobot`: going somewhere."""
 
-    def goal(self, order: Order) -> Vec:
-        return order.attack_dir * self.half_length, 0.0
-
-    def own_goal(self, order: Order) -> Vec:
-        return -order.attack_dir * self.half_length, 0.0
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
 
     def u(self, order: Order, x: float) -> float:
         return order.attack_dir * x
@@ -96,12 +92,15 @@ class MotionMixin:
             vx, vy = tx * k, ty * k
         if avoid and d > p.direct_range:
             near = p.obstacle_range
+            nnear = -near
             obstacles = []  # every other robot (view.others(): opponents, then teammates) and the extras within reach
             for group in (view.opponents, view.mate_obstacles, extra_obstacles):
                 for o in group:
-                    dx, dy = o[0] - x, o[1] - y
-                    if -near < dx < near and -near < dy < near and hypot(dx, dy) < near:
-                        obstacles.append(o)
+                    dx = o[0] - x
+                    if nnear < dx < near:
+                        dy = o[1] - y
+                        if nnear < dy < near and hypot(dx, dy) < near:
+                            obstacles.append(o)
             if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
                 vx, vy = self.nav((x, y), view.vel, (gx, gy), obstacles, self.nav_params)
         speed = hypot(vx, vy)

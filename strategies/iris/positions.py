@@ -15,6 +15,8 @@ from arena.strategies.iris.params import Vec
 class PositionsMixin:
     """Mixin of `IrisRobot`: positions off the ball."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def home(self, order: Order, ball: Vec) -> Vec:
         """Where a robot waits while it does not go for the ball, by role and team mode.
 
@@ -41,7 +43,7 @@ class PositionsMixin:
         if attacking:  # cover behind the play, little moved by the ball: the defender's area is its own half
             u = S.clamp(self.p.cover_depth + shift, lo + 1.5, hi - 0.3)
             return d * u, 0.25 * ball[1]
-        own = self.own_goal(order)
+        own = self.plan.own  # type: ignore[union-attr]
         r = min(3.2 + max(shift, 0.0), 0.5 * S.dist(own, ball) + 1.0)
         a = S.angle_to(own, ball)
         hx, hy = own[0] + r * math.cos(a), own[1] + r * math.sin(a)
@@ -57,8 +59,7 @@ class PositionsMixin:
         bu = d * ball[0]
         us = {S.clamp(bu + k, max(lo + 1.0, 0.5), min(hi - 1.5, 4.5)) for k in (1.5, 3.0)}
         cands = [(d * u, yy) for u in sorted(us) for yy in (-1.5, 0.0, 1.5)]
-        pt = S.open_point(
-            ball, cands, self.view.opponents, self.goal(order)[0], self.goal_half, self.p.skills.clear_margin
-        )
+        goal_x = self.plan.goal[0]  # type: ignore[union-attr]
+        pt = S.open_point(ball, cands, self.view.opponents, goal_x, self.goal_half, self.p.skills.clear_margin)
         self._support = (self.order, pt)
         return pt

@@ -29,6 +29,16 @@ from arena.strategies.world import RobotView
 class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMixin, SetPieceMixin, PositionsMixin):
     """Robot brain: perception, skills and the referee, for every role."""
 
+    # Slots: the brain reads these attributes and calls its own methods many times a tick. An instance dict
+    # past 29 keys is no longer shared (CPython 3.11), and every `self.method()` then costs ~250 more
+    # instructions; "__dict__" keeps room for attributes a test or a wrapper adds.
+    __slots__ = (
+        *("cfg", "team", "n", "p", "half_length", "half_width", "goal_half", "view", "nav", "nav_params"),
+        *("area_params", "mem", "role", "order", "plan", "_support", "_restart", "_planned", "_may_keep_away"),
+        *("_ticks_2s", "tick", "ball_reach", "_commit_ticks", "_dt", "_defense_area", "_areas", "_drive_hx"),
+        *("_drive_hy", "_penalty_half_width", "_near_ball", "_pid", "_guard", "_static_area", "__dict__"),
+    )
+
     def __init__(self, ctx: RobotContext, p: IrisParams):
         cfg = ctx.cfg
         self.cfg = cfg
@@ -124,4 +134,6 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
             areas=areas,
             attacking=R.is_attacking(order.role_state),
             team=self.view.mates,  # a new dict with every order (`RobotView.update`)
+            goal=(order.attack_dir * self.half_length, 0.0),
+            own=(-order.attack_dir * self.half_length, 0.0),
         )

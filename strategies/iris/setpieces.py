@@ -23,15 +23,17 @@ from arena.strategies.iris.params import WALL_PIECES, Vec
 class SetPieceMixin:
     """Mixin of `IrisRobot`: set pieces."""
 
+    __slots__ = ()  # the robot's attributes are `IrisRobot`'s slots
+
     def position_for_restart(self, tick: int, order: Order) -> Cmd:
         fixed = self._restart
         if fixed is not None and fixed[0] is order:  # the keeper's place or the home of this order, as last tick
             _, target, heading, extra = fixed
             return self.drive(tick, target, heading, self.p.cruise, extra_obstacles=extra)
         spot = (order.spot_x, order.spot_y)
-        goal = self.goal(order)
+        goal = self.plan.goal  # type: ignore[union-attr]
         if self.role == "goalkeeper":
-            own = self.own_goal(order)
+            own = self.plan.own  # type: ignore[union-attr]
             target = (own[0] + order.attack_dir * self.p.skills.keeper_depth, 0.0)
             self._restart = (order, target, S.angle_to(target, spot), ())
             return self.drive(tick, target, self._restart[2], self.p.cruise)
@@ -57,7 +59,8 @@ class SetPieceMixin:
         home = self.home(order, spot)
         keep = self.p.setpiece_distance + 0.2 if order.command_team != self.team else 1.2
         if S.dist(home, spot) < keep:
-            a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, self.own_goal(order))
+            own = self.plan.own  # type: ignore[union-attr]
+            a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, own)
             home = self.inside((spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a)), margin=-0.2)
         if not ours and not (self.p.advance and order.command in WALL_PIECES):  # no taker nor wall: fixed for the order
             self._restart = (order, home, S.angle_to(home, spot), (spot,))
@@ -74,7 +77,7 @@ class SetPieceMixin:
         (`arena.strategies.skills.mark_point`), kept out of the 2 m circle too. None: no mark
         for it (it takes its usual place).
         """
-        own = self.own_goal(order)
+        own = self.plan.own  # type: ignore[union-attr]
         keep = self.p.setpiece_distance + self.p.wall_margin
         d = S.dist(spot, own)
         r = max(min(self.p.skills.retreat_radius - 1.0, d), d - keep)

@@ -74,9 +74,17 @@ class IrisTeam:
         ]
         opponents = [TeamPose(robot=-1, x=o.x, y=o.y, age=tick - o.tick) for o in self.model.opponents]
         ball = self.model.ball_xy(tick)
-        common = dict(  # the fields every robot's order shares
+        # What every robot's order shares, the robot's own fields left at their defaults. Keywords spelled out, not
+        # `**c`: a call with more than 15 keywords or a `**` goes through a dict, which msgspec takes ~8 x slower.
+        common = Order(
             tick=tick,
-            **c,
+            robot=0,
+            command=c["command"],
+            command_team=c["command_team"],
+            spot_x=c["spot_x"],
+            spot_y=c["spot_y"],
+            attack_dir=c["attack_dir"],
+            strategy=c["strategy"],
             own=own_poses,
             opponents=opponents,
             ball_valid=ball is not None,
@@ -85,9 +93,8 @@ class IrisTeam:
             ball_age=self.model.ball.age(tick) if ball is not None else 0,
         )
         state = self.roles.state
-        first = Order(robot=0, role=role_of.get(0, "defender"), role_state=state.get(0, 0), **common)
-        # the others copy the first in C (`replace`), three times cheaper than parsing the keywords again
+        # each robot's order is a copy of `common` made in C (`replace`), cheaper than parsing the keywords again
         return {
-            n: replace(first, robot=n, role=role_of.get(n, "defender"), role_state=state.get(n, 0)) if n else first
+            n: replace(common, robot=n, role=role_of.get(n, "defender"), role_state=state.get(n, 0))
             for n in range(self.cfg.robots)
         }

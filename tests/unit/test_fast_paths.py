@@ -40,6 +40,47 @@ def test_fis_gain_is_bit_identical_to_the_membership_functions():
             assert fsfm.gain(d, phi, fis) == _gain_reference(d, phi, fis)
 
 
+def test_partition_gain_is_bit_identical_to_gain():
+    """`fsfm.step`'s gain on the paper's Ruspini partitions gives what `gain`, trying every set, gives."""
+    rng = random.Random(8)
+    edges = [0.0, 0.45, 0.9, 1.2, 1.5, 3.6, 5.7, 9.0, math.pi / 3, 2 * math.pi / 3, math.pi, 5e-324, math.inf]
+    for fis in (fsfm.FIS(), fsfm.FIS(outputs=fsfm.SCHEME_6)):
+        dist, dirn = fis.partition
+        for _ in range(20000):
+            d = rng.choice(edges) if rng.random() < 0.2 else rng.uniform(0.0, 8.0)
+            phi = rng.choice(edges) if rng.random() < 0.2 else rng.uniform(0.0, math.pi)
+            assert fsfm._partition_gain(d, phi, dist, dirn, fis.table) == fsfm.gain(d, phi, fis)
+
+
+def test_fsfm_step_is_bit_identical_to_command_velocity_of_navigation_force():
+    """The flattened `fsfm.step` gives what its parts give (`sfm.command_velocity` of `navigation_force`)."""
+    from arena.navigation.sfm import SFMParams, command_velocity
+
+    social = fsfm.TriangularMF(0.9, 1.5, 6.0)  # reaches past the public set's centre
+    shifted = fsfm.FIS(distance_sets=(*fsfm.DISTANCE_SETS[:2], social, fsfm.DISTANCE_SETS[3]))
+    assert shifted.partition is None  # not a Ruspini partition: `step` takes the plain path
+    params = (
+        fsfm.FSFMParams(sfm=SFMParams(max_speed=2.5, robot_radius=0.5, sigma=0.3)),  # the IRIS robots'
+        fsfm.SCHEME_6_PARAMS,
+        fsfm.FSFMParams(sfm=SFMParams(cutoff_distance=2.0, integrate=False), front="velocity"),
+        fsfm.FSFMParams(fis=shifted),
+    )
+    rng = random.Random(9)
+    for p in params:
+        assert (p.flat is None) == (p.fis is shifted)
+        for _ in range(5000):
+            pos = (rng.uniform(-6, 6), rng.uniform(-4, 4))
+            vel = rng.choice([(0.0, 0.0), (0.01, -0.02), (rng.uniform(-3, 3), rng.uniform(-3, 3))])
+            goal = pos if rng.random() < 0.05 else (rng.uniform(-6, 6), rng.uniform(-4, 4))
+            obstacles = []
+            for _ in range(rng.randrange(0, 6)):  # some at the distance sets' centres, some on the robot
+                r, a = rng.choice([0.0, 0.9, 1.5, 5.7, rng.uniform(0.0, 6.0)]), rng.uniform(-math.pi, math.pi)
+                obstacles.append((pos[0] + r * math.cos(a), pos[1] + r * math.sin(a)))
+            want = command_velocity(vel, fsfm.navigation_force(pos, vel, goal, obstacles, p), p.sfm)
+            assert fsfm.step(pos, vel, goal, obstacles, p) == want
+            assert fsfm.step(pos, vel, goal, tuple(obstacles), p) == want
+
+
 def _pid_reference(state: pid.PIDState, beta: float, theta: float, p: pid.PIDParams) -> tuple[float, pid.PIDState]:
     """Eq. 15-16 as written in the module docstring."""
     err = wrap_angle(beta - theta)
