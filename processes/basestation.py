@@ -19,6 +19,9 @@ from arena.strategies.base import TeamContext
 
 
 class BaseStationNode(Node):
+    # slots: see `Peer` (runtime/node.py)
+    __slots__ = "order_schedule report_in ref_in order_out brain via latest".split()
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         cfg = self.cfg

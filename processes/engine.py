@@ -79,6 +79,13 @@ def check_cmd(cmd: Cmd, wheels: int) -> str | None:
 
 
 class EngineNode(Node):
+    # slots: see `Peer` (runtime/node.py)
+    __slots__ = (
+        "robots physics restarts director operator wheels sensor_rng cmd_in ref_in sense_out sense_plan "
+        "world_out events_out field_out events_schedule world_schedule pending_events stuck parked world_gate "
+        "pacer"
+    ).split()
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         cfg = self.cfg

@@ -19,6 +19,9 @@ from arena.sim.director import check_action, operator_inbox, referee_steps
 
 
 class RefereeNode(Node):
+    # slots: see `Peer` (runtime/node.py)
+    __slots__ = "ref_schedule events_in ref_out box follower decide forced operator".split()
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self.ref_schedule = self.schedule("referee")

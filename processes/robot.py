@@ -18,6 +18,9 @@ from arena.strategies.base import RobotContext
 
 
 class RobotNode(Node):
+    # slots: see `Peer` (runtime/node.py)
+    __slots__ = "report_schedule sense_in order_in cmd_out report_out brain".split()
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         cfg = self.cfg

@@ -86,6 +86,14 @@ class Peer:
     A subclass is a `Node` (in the lockstep) or an `Observer` (outside it).
     """
 
+    # slots (a subclass adds its own): an instance dict of 30 keys or more loses CPython 3.11's shared keys,
+    # and every method call on the instance then costs ~250 instructions more
+    __slots__ = (
+        "pid clock name cfg transport keys log keyring digest rejections silent outbound inbound gone dead "
+        "dead_at _alive _alive_cond _work_s last_tick _wall_s play_started _collector on_waiting tap "
+        "_tap_handoff _spoofing_tokens __dict__"
+    ).split()
+
     cooperative = False  # True: played by a cooperative scheduler (runtime/drivers.py `Driver`)
 
     def __init__(self, pid: ProcessId, cfg: MatchConfig, transport: Transport, keys: Keys, clock: Clock = MONOTONIC):
@@ -348,6 +356,9 @@ class Node(Peer):
     `driver`: `Pull` (blocking on this thread) unless given; a zenoh match in lockstep
     gives a `Reactor` (match/run.py), a cooperative match a `coop.Task`.
     """
+
+    # slots: see `Peer`
+    __slots__ = "driver links skip_below".split()
 
     def __init__(
         self,

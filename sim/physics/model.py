@@ -43,6 +43,18 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
     switched by `stop_play` and `start_play`.
     """
 
+    # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
+    # on the instance then costs ~250 instructions more
+    __slots__ = (
+        "cfg attack_dir_a no_progress_s in_play tick _dt _substeps _h _half_len _half_wid _half_goal "
+        "_goal_height _robot_height _ball_r _ball_e _face _hold_dist _challenge _no_catch_ticks "
+        "_no_challenge_ticks _drive _push_speed _dribble_limit _progress_radius _space _ball _ball_shape "
+        "_ball_mask _roll _roll_force _robots _by_id robot_index _read _controls _set_controls _positions "
+        "_space_c _ball_off _snap _dirty _states_of _states _z _vz _airborne _holder _dead _out _cross_high "
+        "_prev_ax _idle_ticks _idle_fired _anchor _last _touch_armed _carry_fouled _pin _contacts _impacts "
+        "_events"
+    ).split()
+
     def __init__(self, cfg: MatchConfig, no_progress_s: float | None = None) -> None:
         self.cfg = cfg
         self.attack_dir_a = 1
