@@ -1,4 +1,4 @@
-"""Start-up of a distributed match: what keeps it short (docs/performance.md, session 6)."""
+"""Start-up of a distributed match: what keeps it short (docs/performance.md)."""
 
 from arena.runtime.session import NetConfig
 
