@@ -155,7 +155,7 @@ def best_aim(
         aim = (goal_x, y)
         room = segment_room(near, ball, aim)
         if heading is not None and room >= margin:
-            cost = turn_cost * abs(wrap_angle(angle_to(ball, aim) - heading)) - min(room, 1.5)
+            cost = turn_cost * abs(wrap_angle(math.atan2(y - by, goal_x - bx) - heading)) - min(room, 1.5)  # angle_to
             if best_room < margin or cost < best_turn:
                 best, best_room, best_turn = aim, room, cost
         elif room > best_room + 1e-9 and (heading is None or best_room < margin):
