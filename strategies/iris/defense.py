@@ -145,9 +145,9 @@ class DefenseMixin:
         # cost(pt) = S.dist(pt, block) + (penalty if S.dist(pt, own) > limit else 0.0), inlined
         mine = hypot(x - bx, y - by) + (penalty if hypot(x - ox, y - oy) > limit else 0.0)
         mine -= self.p.chase_hysteresis if mem.blocking else 0.0
-        me = self.n
+        me, dynamic = self.n, self.p.dynamic  # dynamic roles: `in_area` holds for all, not asked per teammate
         for n, (mx, my, _) in self.view.mates.items():
-            if n != 0 and self.in_area(order, block, n):
+            if n != 0 and (dynamic or self.in_area(order, block, n)):
                 cost = hypot(mx - bx, my - by) + (penalty if hypot(mx - ox, my - oy) > limit else 0.0)
                 if not (cost > mine or cost == mine and n > me):  # not (cost, n) > (mine, me)
                     mem.blocking = False

@@ -112,8 +112,9 @@ class SetPieceMixin:
         x, y, _ = self.view.pose  # type: ignore[misc]
         wx, wy = wall
         mine, me = hypot(x - wx, y - wy), self.n  # S.dist((x, y), wall)
+        dynamic = self.p.dynamic  # dynamic roles: `in_area` holds for all, not asked per teammate
         for n, (mx, my, _) in self.view.mates.items():
-            if n != 0 and self.in_area(order, wall, n):
+            if n != 0 and (dynamic or self.in_area(order, wall, n)):
                 dm = hypot(mx - wx, my - wy)
                 if not (dm > mine or dm == mine and n > me):  # not (dm, n) > (mine, me)
                     return False
@@ -127,10 +128,12 @@ class SetPieceMixin:
         x, y, _ = self.view.pose  # type: ignore[misc]
         sx, sy = spot
         mine, me = hypot(x - sx, y - sy), self.n  # S.dist((x, y), spot)
+        dynamic = self.p.dynamic
         for n, (mx, my, _) in self.view.mates.items():
             if n != 0:
                 dm = hypot(mx - sx, my - sy)
-                if (dm < mine or dm == mine and n < me) and self.in_area(order, spot, n):  # (dm, n) < (mine, me)
+                # (dm, n) < (mine, me); dynamic roles: `in_area` holds for all, not asked per teammate
+                if (dm < mine or dm == mine and n < me) and (dynamic or self.in_area(order, spot, n)):
                     return False
         return True
 
