@@ -155,7 +155,7 @@ def best_aim(
         aim = (goal_x, y)
         room = segment_room(near, ball, aim)
         if heading is not None and room >= margin:
-            cost = turn_cost * abs(wrap_angle(angle_to(ball, aim) - heading)) - min(room, 1.5)
+            cost = turn_cost * abs(wrap_angle(math.atan2(y - by, goal_x - bx) - heading)) - min(room, 1.5)  # angle_to
             if best_room < margin or cost < best_turn:
                 best, best_room, best_turn = aim, room, cost
         elif room > best_room + 1e-9 and (heading is None or best_room < margin):
@@ -275,17 +275,21 @@ def block_point(carrier: Vec, own_goal: Vec, p: SkillParams, ball: Vec | None = 
         a = angle_to(own_goal, carrier)
         r = max(p.retreat_radius, d - p.block_distance)
         return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
-    d = dist(ball, own_goal)
-    a = angle_to(own_goal, ball)
-    gap = max(p.block_gap, p.block_distance - dist(carrier, ball))
+    # dist and angle_to written out: the advance defense asks this every tick
+    gx, gy = own_goal
+    bx, by = ball
+    d = math.hypot(bx - gx, by - gy)  # dist(ball, own_goal)
+    a = math.atan2(by - gy, bx - gx)  # angle_to(own_goal, ball)
+    gap = max(p.block_gap, p.block_distance - math.hypot(carrier[0] - bx, carrier[1] - by))  # dist(carrier, ball)
     r = max(p.retreat_radius, d - gap)
-    return own_goal[0] + r * math.cos(a), own_goal[1] + r * math.sin(a)
+    return gx + r * math.cos(a), gy + r * math.sin(a)
 
 
 def mark_point(opponent: Vec, own_goal: Vec, distance: float) -> Vec:
     """Man-to-man marking: `distance` [m] from the opponent towards our goal centre (goal-side)."""
-    a = angle_to(opponent, own_goal)
-    return opponent[0] + distance * math.cos(a), opponent[1] + distance * math.sin(a)
+    ox, oy = opponent
+    a = math.atan2(own_goal[1] - oy, own_goal[0] - ox)  # angle_to(opponent, own_goal)
+    return ox + distance * math.cos(a), oy + distance * math.sin(a)
 
 
 def predict_crossing(ball: Vec, vel: Vec, line_x: float) -> float | None:

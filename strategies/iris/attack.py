@@ -22,6 +22,7 @@
 from __future__ import annotations
 
 import math
+from math import atan2, hypot
 
 from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
@@ -52,7 +53,8 @@ class AttackMixin:
     def advance_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
         """Paper 2, Fig. 7a: feed the attacker, sidestep blockers with the back to them, shoot when clear."""
         opponents = self.view.opponents
-        d_goal = S.dist(pos, goal)
+        gx, gy = goal
+        d_goal = hypot(pos[0] - gx, pos[1] - gy)  # S.dist(pos, goal)
         sp = self.p.skills
         if tick <= self.mem.shot_until:  # a shot once decided is carried through (the line may flicker)
             return self.turn_and_kick(tick, self.mem.shot_aim, self.p.kick_speed)
@@ -77,7 +79,8 @@ class AttackMixin:
             if target is not None:
                 return self.pass_to(tick, target)
             return self.turn_and_kick(tick, self.nudge_point(pos, goal, opponents), self.p.nudge_speed)
-        field_players = [o for o in opponents if S.dist(o, goal) > self.p.keeper_zone]  # the keeper is no blocker
+        keeper_zone = self.p.keeper_zone  # the keeper is no blocker
+        field_players = [o for o in opponents if hypot(o[0] - gx, o[1] - gy) > keeper_zone]  # S.dist(o, goal)
         blocker = S.blocker_ahead(pos, goal, field_players, sp.path_corridor, sp.path_lookahead)
         if blocker is not None:
             if S.dist(blocker, pos) < self.p.pressure_range:
@@ -91,7 +94,8 @@ class AttackMixin:
             self.mem.circle_tick = tick
             return self.drive(tick, way, heading, self.p.dribble_speed, dribbler=True, avoid=False)
         ahead = (goal[0] - order.attack_dir * min(self.p.advance_shoot_distance - 0.5, d_goal), aim[1] * 0.5)
-        return self.drive(tick, ahead, S.angle_to(pos, aim), self.p.dribble_speed, dribbler=True, avoid=False)
+        face = atan2(aim[1] - pos[1], aim[0] - pos[0])  # S.angle_to(pos, aim)
+        return self.drive(tick, ahead, face, self.p.dribble_speed, dribbler=True, avoid=False)
 
     def open_side(self, goal_x: float) -> float:
         """Basic aim: 0.6 of the goal half-width on the side away from the keeper."""

@@ -19,7 +19,7 @@
 from __future__ import annotations
 
 import math
-from math import hypot
+from math import atan2, hypot
 
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
@@ -57,7 +57,7 @@ class DefenseMixin:
                         home = self.support_point(order, ball)
                     else:
                         home = self.home(order, ball)
-                    return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
+                    return self.drive(tick, home, atan2(by - home[1], bx - home[0]), p.cruise)  # S.angle_to(home, ball)
         chaser = self.is_chaser(order, ball)
         if p.advance and not attacking:
             cmd = self.advance_defense(tick, order, ball, pos, chaser)
@@ -66,7 +66,7 @@ class DefenseMixin:
         if chaser:
             return self.get_ball(tick, ball, goal)
         home = self.home(order, ball)
-        return self.drive(tick, home, S.angle_to(home, ball), p.cruise)
+        return self.drive(tick, home, atan2(ball[1] - home[1], ball[0] - home[0]), p.cruise)  # S.angle_to(home, ball)
 
     def advance_defense(self, tick: int, order: Order, ball: Vec, pos: Vec, chaser: bool) -> Cmd | None:
         """Paper 2, Fig. 7b, for an outfield robot while the team defends; None: play the ball as usual.
@@ -90,7 +90,9 @@ class DefenseMixin:
         sp = self.p.skills
         own = self.plan.own  # type: ignore[union-attr]
         carrier = self.carrier(ball)
-        d_carrier = S.dist(carrier, own) if carrier is not None else 0.0  # [m] the carrier to our goal centre
+        ox, oy = own
+        # [m] the carrier to our goal centre, S.dist(carrier, own)
+        d_carrier = hypot(carrier[0] - ox, carrier[1] - oy) if carrier is not None else 0.0
         if carrier is not None and d_carrier < self.p.block_zone:
             block = S.block_point(carrier, own, sp, ball)
             if self.is_blocker(order, block, d_carrier - 0.2, own):
@@ -115,7 +117,8 @@ class DefenseMixin:
             self.mem.blocking = False
             if chaser:
                 return None
-        if self.role == "attacker" and S.dist(ball, own) > self.p.drop_back:
+        bx, by = ball
+        if self.role == "attacker" and hypot(bx - ox, by - oy) > self.p.drop_back:  # S.dist(ball, own)
             return None
         target = self.marking_target(order, carrier if carrier is not None else ball)
         if target is None:
@@ -123,7 +126,7 @@ class DefenseMixin:
         mark = S.mark_point(target, own, sp.mark_distance)
         if not self.in_area(order, mark):  # static roles: a mark outside its Fig. 5 area is not its job
             return None
-        return self.drive(tick, mark, S.angle_to(mark, ball), self.p.cruise)
+        return self.drive(tick, mark, atan2(by - mark[1], bx - mark[0]), self.p.cruise)  # S.angle_to(mark, ball)
 
     def is_blocker(self, order: Order, block: Vec, limit: float, own: Vec) -> bool:
         """Advance defense: of our outfield robots, the one that gets onto the kick line soonest blocks:
@@ -142,9 +145,9 @@ class DefenseMixin:
         # cost(pt) = S.dist(pt, block) + (penalty if S.dist(pt, own) > limit else 0.0), inlined
         mine = hypot(x - bx, y - by) + (penalty if hypot(x - ox, y - oy) > limit else 0.0)
         mine -= self.p.chase_hysteresis if mem.blocking else 0.0
-        me = self.n
+        me, dynamic = self.n, self.p.dynamic  # dynamic roles: `in_area` holds for all, not asked per teammate
         for n, (mx, my, _) in self.view.mates.items():
-            if n != 0 and self.in_area(order, block, n):
+            if n != 0 and (dynamic or self.in_area(order, block, n)):
                 cost = hypot(mx - bx, my - by) + (penalty if hypot(mx - ox, my - oy) > limit else 0.0)
                 if not (cost > mine or cost == mine and n > me):  # not (cost, n) > (mine, me)
                     mem.blocking = False
@@ -154,12 +157,13 @@ class DefenseMixin:
 
     def marking_target(self, order: Order, carrier: Vec) -> Vec | None:
         """The opponent other than the carrier nearest our goal, if it is within `mark_zone` of it."""
-        own = self.plan.own  # type: ignore[union-attr]
+        ox, oy = self.plan.own  # type: ignore[union-attr]
+        cx, cy = carrier
         best, found = self.p.mark_zone, None
         for o in self.view.opponents:
-            if S.dist(o, carrier) < 0.3:
+            if hypot(o[0] - cx, o[1] - cy) < 0.3:  # S.dist(o, carrier)
                 continue
-            d = S.dist(o, own)
+            d = hypot(o[0] - ox, o[1] - oy)  # S.dist(o, own)
             if d < best:
                 best, found = d, o
         return found

@@ -70,9 +70,12 @@ class HandlingMixin:
             return self.drive(tick, ball, to_ball, p.approach_speed, dribbler=True, avoid=False)
         a = math.atan2(target[1] - by, target[0] - bx)  # S.angle_to(ball, target) ...
         off = sp.behind_ball  # ... for S.behind_point(ball, target, behind_ball)
-        behind = self.inside((bx - off * cos(a), by - off * sin(a)), margin=0.1)
-        heading = a if hypot(x - behind[0], y - behind[1]) < 1.0 else to_ball
-        return self.drive(tick, behind, heading, p.cruise, dribbler=d < 1.0, extra_obstacles=(ball,))
+        hx, hy = self.half_length + 0.1, self.half_width + 0.1  # self.inside(..., margin=0.1), inlined
+        px, py = bx - off * cos(a), by - off * sin(a)
+        px = -hx if px < -hx else hx if px > hx else px
+        py = -hy if py < -hy else hy if py > hy else py
+        heading = a if hypot(x - px, y - py) < 1.0 else to_ball
+        return self.drive(tick, (px, py), heading, p.cruise, dribbler=d < 1.0, extra_obstacles=(ball,))
 
     def carrier(self, ball: Vec) -> Vec | None:
         """The opponent nearest the ball if it is close enough to have it (min of (distance, position))."""

@@ -29,7 +29,8 @@ class KeeperMixin:
         bx, by = ball
         d_ball = hypot(x - bx, y - by)  # S.dist(pos, ball)
         near_goal = abs(bx - own_x) < self.cfg.field.penalty_area_depth and abs(by) < self._penalty_half_width
-        if near_goal and hypot(*view.ball_vel) < 1.0:  # near our goal and slow: the keeper may take it
+        vbx, vby = view.ball_vel
+        if near_goal and hypot(vbx, vby) < 1.0:  # near our goal and slow: the keeper may take it
             opp = math.inf  # the nearest opponent's distance to the ball
             for ox, oy in view.opponents:
                 dd = hypot(ox - bx, oy - by)

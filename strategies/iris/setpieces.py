@@ -13,6 +13,7 @@ the table of rules is docs/rules.md.
 from __future__ import annotations
 
 import math
+from math import atan2, hypot
 
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
@@ -58,13 +59,16 @@ class SetPieceMixin:
                 return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise, extra_obstacles=(spot,))
         home = self.home(order, spot)
         keep = self.p.setpiece_distance + 0.2 if order.command_team != self.team else 1.2
-        if S.dist(home, spot) < keep:
+        sx, sy = spot
+        d = hypot(home[0] - sx, home[1] - sy)  # S.dist(home, spot)
+        if d < keep:
             own = self.plan.own  # type: ignore[union-attr]
-            a = S.angle_to(spot, home) if S.dist(home, spot) > 1e-6 else S.angle_to(spot, own)
-            home = self.inside((spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a)), margin=-0.2)
+            a = S.angle_to(spot, home) if d > 1e-6 else S.angle_to(spot, own)
+            home = self.inside((sx + keep * math.cos(a), sy + keep * math.sin(a)), margin=-0.2)
+        heading = atan2(sy - home[1], sx - home[0])  # S.angle_to(home, spot)
         if not ours and not (self.p.advance and order.command in WALL_PIECES):  # no taker nor wall: fixed for the order
-            self._restart = (order, home, S.angle_to(home, spot), (spot,))
-        return self.drive(tick, home, S.angle_to(home, spot), self.p.cruise, extra_obstacles=(spot,))
+            self._restart = (order, home, heading, (spot,))
+        return self.drive(tick, home, heading, self.p.cruise, extra_obstacles=(spot,))
 
     def setpiece_defense(self, order: Order, spot: Vec) -> Vec | None:
         """Advance defense at the opponents' set piece: Fig. 7b before the ball is in play.
@@ -83,18 +87,14 @@ class SetPieceMixin:
         r = max(min(self.p.skills.retreat_radius - 1.0, d), d - keep)
         a = S.angle_to(own, spot)
         wall = self.inside((own[0] + r * math.cos(a), own[1] + r * math.sin(a)), margin=-0.3)
-        x, y, _ = self.view.pose  # type: ignore[misc]
-        mine = (S.dist((x, y), wall), self.n)
-        mates = self.view.mates.items()  # static roles: only robots whose Fig. 5 area holds the wall point
-        walls = self.in_area(order, wall) and all(
-            (S.dist((mx, my), wall), n) > mine for n, (mx, my, _) in mates if n != 0 and self.in_area(order, wall, n)
-        )
-        if walls:
+        if self._walls(order, wall):
             return wall
         best, found = self.p.mark_zone + 1.0, None
+        ox, oy = own
+        sx, sy = spot
         for o in self.view.opponents:
-            dd = S.dist(o, own)
-            if S.dist(o, spot) > 1.0 and dd < best:
+            dd = hypot(o[0] - ox, o[1] - oy)  # S.dist(o, own)
+            if hypot(o[0] - sx, o[1] - sy) > 1.0 and dd < best:  # S.dist(o, spot)
                 best, found = dd, o
         if found is None:
             return None
@@ -104,16 +104,37 @@ class SetPieceMixin:
             mark = (spot[0] + keep * math.cos(b), spot[1] + keep * math.sin(b))
         return self.inside(mark, margin=-0.3)
 
+    def _walls(self, order: Order, wall: Vec) -> bool:
+        """`setpiece_defense`: this robot is the outfield robot nearest the wall point (robot number breaks ties);
+        static roles: of those whose Fig. 5 area holds it."""
+        if not self.in_area(order, wall):
+            return False
+        x, y, _ = self.view.pose  # type: ignore[misc]
+        wx, wy = wall
+        mine, me = hypot(x - wx, y - wy), self.n  # S.dist((x, y), wall)
+        dynamic = self.p.dynamic  # dynamic roles: `in_area` holds for all, not asked per teammate
+        for n, (mx, my, _) in self.view.mates.items():
+            if n != 0 and (dynamic or self.in_area(order, wall, n)):
+                dm = hypot(mx - wx, my - wy)
+                if not (dm > mine or dm == mine and n > me):  # not (dm, n) > (mine, me)
+                    return False
+        return True
+
     def is_taker(self, order: Order, spot: Vec) -> bool:
         """The outfield robot of ours nearest the spot takes the set piece (robot number breaks ties);
         static roles: of those whose Fig. 5 area holds the spot."""
         if not self.in_area(order, spot):
             return False
         x, y, _ = self.view.pose  # type: ignore[misc]
-        mine = (S.dist((x, y), spot), self.n)
+        sx, sy = spot
+        mine, me = hypot(x - sx, y - sy), self.n  # S.dist((x, y), spot)
+        dynamic = self.p.dynamic
         for n, (mx, my, _) in self.view.mates.items():
-            if n != 0 and (S.dist((mx, my), spot), n) < mine and self.in_area(order, spot, n):
-                return False
+            if n != 0:
+                dm = hypot(mx - sx, my - sy)
+                # (dm, n) < (mine, me); dynamic roles: `in_area` holds for all, not asked per teammate
+                if (dm < mine or dm == mine and n < me) and (dynamic or self.in_area(order, spot, n)):
+                    return False
         return True
 
     def keep_setpiece_distance(self, tick: int, order: Order, ball: Vec) -> bool:
