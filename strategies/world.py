@@ -383,17 +383,28 @@ class RobotView:
 
     def _take_order(self, order: Order | None) -> None:
         """What follows from a new order alone: the teammates and the base station's opponents."""
+        # plain loops, one pass per list: for three or so entries cheaper than comprehensions and max()
         self._order = order
+        mates: dict[int, tuple[float, float, str]] = {}
+        mate_xy: list[Vec] = []
+        entries: list[tuple[int, Vec]] = []
+        xys: list[Vec] = []
+        oldest = 0
         if order is not None:
             n = self.n
-            self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != n}
-            self._order_opponents = [(tp.age, (tp.x, tp.y)) for tp in order.opponents]
-        else:
-            self.mates = {}
-            self._order_opponents = []
-        self._order_opponent_xy = [xy for _, xy in self._order_opponents]
-        self._order_opponent_oldest = max((age for age, _ in self._order_opponents), default=0)
-        self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
+            for tp in order.own:
+                if tp.robot != n:
+                    mates[tp.robot] = (tp.x, tp.y, tp.role)
+            for x, y, _ in mates.values():  # a robot listed twice: its last entry, as the dict holds
+                mate_xy.append((x, y))
+            for tp in order.opponents:
+                xy, age = (tp.x, tp.y), tp.age
+                entries.append((age, xy))
+                xys.append(xy)
+                if age > oldest:  # never below 0: the filter in `update` then runs, with the same result
+                    oldest = age
+        self.mates, self._mate_xy = mates, mate_xy
+        self._order_opponents, self._order_opponent_xy, self._order_opponent_oldest = entries, xys, oldest
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
