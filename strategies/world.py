@@ -292,7 +292,7 @@ class RobotView:
             n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
             for n, (ds, stt) in _CONSECUTIVE.items()
         }
-        window = p.track_window
+        self._window = window = p.track_window
         self._window_sums = (window, _unrolled_sums(window)) if window in _CONSECUTIVE else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
@@ -323,7 +323,12 @@ class RobotView:
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
         own_ball = self.own_ball
+        seen: list[Vec] = []  # own detections: opponents ...
+        near: list[Vec] = []  # ... and teammates
         if sense is not None:
+            other = self.other
+            for r in sense.robots:
+                (seen if r.team == other else near).append((r.x, r.y))
             p = sense.pose
             x, y, theta = self.pose = (p.x, p.y, p.theta)
             c, s = math.cos(theta), math.sin(theta)
@@ -357,12 +362,6 @@ class RobotView:
         self.ball = None if age > self._ball_memory else ball
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
             self._take_order(order)
-        seen: list[Vec] = []  # own detections: opponents ...
-        near: list[Vec] = []  # ... and teammates
-        if sense is not None:
-            other = self.other
-            for r in sense.robots:
-                (seen if r.team == other else near).append((r.x, r.y))
         # The base station's entries that no own detection within merge_radius explains.
         merge2 = self._merge2
         opponents = seen[:]
@@ -377,27 +376,38 @@ class RobotView:
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
         if self.lead > 0.0 and sense is not None:
-            self._track(sense.tick, seen)
+            if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
+                self._track(sense.tick, seen)
             self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
-            self._ahead = [None] * len(self._tracks)
 
     def _take_order(self, order: Order | None) -> None:
         """What follows from a new order alone: the teammates and the base station's opponents."""
+        # plain loops, one pass per list: for three or so entries cheaper than comprehensions and max()
         self._order = order
+        mates: dict[int, tuple[float, float, str]] = {}
+        mate_xy: list[Vec] = []
+        entries: list[tuple[int, Vec]] = []
+        xys: list[Vec] = []
+        oldest = 0
         if order is not None:
             n = self.n
-            self.mates = {tp.robot: (tp.x, tp.y, tp.role) for tp in order.own if tp.robot != n}
-            self._order_opponents = [(tp.age, (tp.x, tp.y)) for tp in order.opponents]
-        else:
-            self.mates = {}
-            self._order_opponents = []
-        self._order_opponent_xy = [xy for _, xy in self._order_opponents]
-        self._order_opponent_oldest = max((age for age, _ in self._order_opponents), default=0)
-        self._mate_xy = [(x, y) for x, y, _ in self.mates.values()]
+            for tp in order.own:
+                if tp.robot != n:
+                    mates[tp.robot] = (tp.x, tp.y, tp.role)
+            for x, y, _ in mates.values():  # a robot listed twice: its last entry, as the dict holds
+                mate_xy.append((x, y))
+            for tp in order.opponents:
+                xy, age = (tp.x, tp.y), tp.age
+                entries.append((age, xy))
+                xys.append(xy)
+                if age > oldest:  # never below 0: the filter in `update` then runs, with the same result
+                    oldest = age
+        self.mates, self._mate_xy = mates, mate_xy
+        self._order_opponents, self._order_opponent_xy, self._order_opponent_oldest = entries, xys, oldest
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
-        old, merge2, window = self._tracks, self._merge2, self.p.track_window
+        old, merge2, window = self._tracks, self._merge2, self._window
         tracks: list[Columns] = []
         for x, y in seen:
             best, best_d2 = None, merge2
@@ -405,22 +415,23 @@ class RobotView:
                 d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
                 if d2 < best_d2:
                     best, best_d2 = t, d2
-            if best is not None:
-                old.remove(best)
-                ts, xs, ys = best
-                if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
-                    ts.pop()
-                    xs.pop()
-                    ys.pop()
-                ts.append(tick)
-                xs.append(x)
-                ys.append(y)
-                if len(ts) > window:
-                    del ts[0], xs[0], ys[0]
-                tracks.append(best)
-            else:
+            if best is None:
                 tracks.append(([tick], [x], [y]))
+                continue
+            old.remove(best)
+            ts, xs, ys = best
+            if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
+                ts.pop()
+                xs.pop()
+                ys.pop()
+            elif len(ts) >= window:  # a full window: its oldest detection goes (before the append: no regrowth)
+                del ts[0], xs[0], ys[0]
+            ts.append(tick)
+            xs.append(x)
+            ys.append(y)
+            tracks.append(best)
         self._tracks = tracks
+        self._ahead = [None] * len(tracks)
 
     @property
     def opponents_now(self) -> list[Vec]:

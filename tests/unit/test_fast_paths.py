@@ -149,6 +149,19 @@ def test_robot_view_merges_the_order_with_own_detections():
     assert view.others() == view.opponents + view.mate_obstacles
 
 
+def test_an_order_listing_a_robot_twice_gives_its_last_entry_once():
+    cfg = MatchConfig()
+    view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams())
+    own = [TeamPose(robot=2, x=2.0, y=1.0, role="attacker"), TeamPose(robot=0, x=-5.5, y=0.0)]
+    own.append(TeamPose(robot=2, x=3.0, y=-1.0, role="defender"))
+    opponents = [TeamPose(robot=-1, x=1.0, y=0.0, age=-5), TeamPose(robot=-1, x=4.0, y=2.0, age=-1)]
+    order = Order(tick=10, robot=1, command="START", own=own, opponents=opponents)
+    view.update(12, Sense(tick=12, pose=Pose(x=0.0, y=0.0, theta=0.0)), order)
+    assert view.mates == {2: (3.0, -1.0, "defender"), 0: (-5.5, 0.0, "")}
+    assert view.mate_obstacles == [(3.0, -1.0), (-5.5, 0.0)]
+    assert view.opponents == [(1.0, 0.0), (4.0, 2.0)]  # negative ages (a bad order): none too old
+
+
 def test_the_unrolled_window_sums_are_the_regression_loops_bit_for_bit():
     """`_unrolled_sums(n)` gives the sums of `_regression_velocity`'s loop for a consecutive track of n, bit for bit."""
     rng = random.Random(3)
