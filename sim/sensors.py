@@ -117,6 +117,8 @@ def _sense(
     """Each (robot `me` of `states`, its normals `z`: 3 + 2 per robot of `states`) of `picks` at `tick`.
 
     One loop over the robots rather than a call per robot: the engine senses six robots a tick.
+    The messages are built with positional arguments in their fields' order (~40 a tick; a keyword
+    costs msgspec a name lookup).
     """
     cos, sin, remainder, hypot, pi = math.cos, math.sin, math.remainder, math.hypot, math.pi
     heading_sigma, pose_sigma, det, per_m = p.heading_sigma, p.pose_sigma, p.det_sigma, p.det_sigma_per_m
@@ -127,11 +129,11 @@ def _sense(
         team, n, x, y, theta, vx, vy, omega = me
         c, s = cos(theta), sin(theta)
         heading = remainder(theta + heading_sigma * z[2], TAU)  # wrap_angle, inlined
-        pose = Pose(x=x + pose_sigma * z[0], y=y + pose_sigma * z[1], theta=pi if heading == -pi else heading)
+        pose = Pose(x + pose_sigma * z[0], y + pose_sigma * z[1], pi if heading == -pi else heading)  # x, y, theta
         d_ball = hypot(bx - x, by - y)
         if d_ball <= ball_range:
             sigma = det + per_m * d_ball
-            ball = BallSeen(visible=True, x=bx + sigma * z[3], y=by + sigma * z[4])
+            ball = BallSeen(True, bx + sigma * z[3], by + sigma * z[4])  # visible, x, y
         else:
             ball = BallSeen()
         near = []
@@ -148,17 +150,18 @@ def _sense(
         near.sort()
         seen = []
         for _, t, nx, ny in near:
-            seen.append(RobotSeen(team=t, x=nx, y=ny))
+            seen.append(RobotSeen(t, nx, ny))  # team, x, y
+        # tick, pose, vx, vy, omega, ball, robots, has_ball
         out.append(
             Sense(
-                tick=tick,
-                pose=pose,
-                vx=c * vx + s * vy,
-                vy=c * vy - s * vx,
-                omega=omega,
-                ball=ball,
-                robots=seen,
-                has_ball=holder is not None and holder[1] == n and holder[0] == team,
+                tick,
+                pose,
+                c * vx + s * vy,
+                c * vy - s * vx,
+                omega,
+                ball,
+                seen,
+                holder is not None and holder[1] == n and holder[0] == team,
             )
         )
     return out

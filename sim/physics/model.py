@@ -46,7 +46,7 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "cfg attack_dir_a no_progress_s in_play tick _dt _substeps _h _half_len _half_wid _half_goal "
+        "cfg attack_dir_a no_progress_s in_play tick _dt _substeps _h _half_len _half_wid _half_goal _touch_reach "
         "_goal_height _robot_height _ball_r _ball_e _face _hold_dist _challenge _no_catch_ticks "
         "_no_challenge_ticks _drive _push_speed _dribble_limit _progress_radius _space _ball _ball_shape "
         "_ball_mask _roll _roll_force _robots _by_id robot_index _read _controls _set_controls _positions "
@@ -75,6 +75,9 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
         self._face = rp.size / 2 + bp.radius  # [m] robot centre to a touching ball's centre
         self._hold_dist = self._face + HOLD_GAP
         self._challenge = rp.size / 2 + bp.radius + CHALLENGE_DIST  # [m] centre to centre
+        # [m] centre to centre beyond which a robot's footprint (a square of side size, circumscribed
+        # radius size / sqrt(2)) cannot touch the ball; 0.75 and 1 cm keep it well on the safe side
+        self._touch_reach = 0.75 * rp.size + bp.radius + 0.01
         self._no_catch_ticks = math.ceil(NO_CATCH_S / self._dt)
         self._no_challenge_ticks = math.ceil(NO_CHALLENGE_S / self._dt)
         self._drive = Drive(rp)

@@ -96,15 +96,20 @@ class Possession:
 
     def _challenged(self, holder: RobotBody, s: list[float]) -> bool:
         """Another robot touches the held ball, or wants it (dribbler on) and is close."""
-        bx, by, tick = s[self._ball_off], s[self._ball_off + 1], self.tick
+        bx, by, tick, reach = s[self._ball_off], s[self._ball_off + 1], self.tick, self._touch_reach
+        near = False  # another robot's centre within `reach` of the ball's on both axes
         for r in self._robots:
+            if r is holder:
+                continue
             if (
-                r is not holder
-                and r.dribbler
+                r.dribbler
                 and tick >= r.challenge_from
                 and math.hypot(s[r.off] - bx, s[r.off + 1] - by) < self._challenge
             ):
                 return True
+            near = near or (abs(s[r.off] - bx) <= reach and abs(s[r.off + 1] - by) <= reach)
+        if not near:
+            return False  # no footprint can touch the ball: the shape query (~8 k instructions) would find none
         for hit in self._space.shape_query(self._ball_shape):
             t = hit.shape.collision_type - _ROBOT_TYPE0
             if t >= 0 and hit.shape.body is not holder.body and tick >= self._robots[t].challenge_from:

@@ -71,20 +71,21 @@ class State:
         """Ground truth as the G_V message."""
         states = self.robot_states()
         s, b, holder, last = self._snap, self._ball_off, self._holder, self._last
-        robots = [
-            RobotState(team=t, robot=n, x=x, y=y, theta=theta, vx=vx, vy=vy, omega=w, has_ball=r is holder)
-            for r, (t, n, x, y, theta, vx, vy, w) in zip(self._robots, states)
-        ]
+        # positional arguments in the fields' order (every tick; a keyword costs msgspec a name lookup)
+        robots = []
+        for r, (t, n, x, y, theta, vx, vy, w) in zip(self._robots, states):
+            robots.append(RobotState(t, n, x, y, theta, vx, vy, w, r is holder))  # ..., omega, has_ball
+        # tick, t, ball x y z vx vy vz, robots, last_team, last_robot
         return World(
-            tick=tick,
-            t=tick * self._dt,
-            ball_x=s[b],
-            ball_y=s[b + 1],
-            ball_z=self._z,
-            ball_vx=s[b + 3],
-            ball_vy=s[b + 4],
-            ball_vz=self._vz,
-            robots=robots,
-            last_team=last.team if last else "",
-            last_robot=last.n if last else -1,
+            tick,
+            tick * self._dt,
+            s[b],
+            s[b + 1],
+            self._z,
+            s[b + 3],
+            s[b + 4],
+            self._vz,
+            robots,
+            last.team if last else "",
+            last.n if last else -1,
         )

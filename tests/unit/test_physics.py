@@ -356,6 +356,28 @@ def test_another_robot_touching_the_held_ball_knocks_it_loose():
     assert ph.holder() is None
 
 
+def test_a_robot_corner_on_knocks_the_held_ball_loose():
+    # a corner reaches size / sqrt(2) from the centre, further than a face
+    ph = make()
+    ph.place_robot("a", 0, 0.0, 0.0, 0.0)
+    ph.place_robot("b", 0, 1.5, 0.0, 1.25 * math.pi)  # a corner leads towards -x
+    ball_in_front(ph, "a", 0)
+    ph.set_command("a", 0, cmd(dribbler=True))
+    ph.set_command("b", 0, cmd(vx=math.sqrt(0.5), vy=-math.sqrt(0.5)))  # field -x, no dribbler
+    ph.step()
+    assert ph.holder() == ("a", 0)
+    events = run(ph, 100)
+    assert ("TOUCH", "b", 0) in [(e.kind, e.team, e.robot) for e in events]
+    assert ph.holder() is None
+
+
+@pytest.mark.parametrize("robot", [CFG.robot, ROBOTINO], ids=lambda r: r.model)
+def test_the_touch_reach_covers_a_footprint_corner_and_the_ball(robot):
+    # the holder's challenge check skips its shape query when no other robot is within `_touch_reach`
+    ph = Physics(CFG.replace(robot=robot))
+    assert ph._touch_reach > robot.size / math.sqrt(2) + CFG.ball.radius
+
+
 def test_kick_from_the_dribbler():
     ph = make()
     ph.place_robot("a", 0, -3.0, 0.0, 0.0)
