@@ -8,6 +8,7 @@ collision type `_ROBOT_TYPE0 + i`, so that a contact names its robot.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import pymunk
 from pymunk import batch as pmbatch
@@ -62,6 +63,15 @@ step_space = lib.cpSpaceStep  # (space._space, dt): `Space.step` without its add
 unpack = ffi.unpack
 
 
+def _batched(buf: pmbatch.Buffer, fields: pmbatch.BodyFields) -> Any:
+    """pymunk.batch's descriptor of `buf`'s C arrays for `fields`, as its get/set functions build it per call."""
+    data = ffi.new("pmBatchedData *")
+    data.fields = fields.value
+    data.floatArray = buf._float_arr
+    data.intArray = buf._int_arr
+    return data
+
+
 class BodyReader:
     """Every body's (x, y, angle, vx, vy, omega), flat, in one C call.
 
@@ -79,11 +89,7 @@ class BodyReader:
     def __init__(self, space: pymunk.Space, fields: pmbatch.BodyFields = _ALL_FIELDS) -> None:
         self._space = space._space
         self._buf = pmbatch.Buffer()  # owns the C arrays the reads fill
-        data = ffi.new("pmBatchedData *")
-        data.fields = fields.value
-        data.floatArray = self._buf._float_arr
-        data.intArray = self._buf._int_arr
-        self._data = data
+        self._data = _batched(self._buf, fields)
         self._arr = self._buf._float_arr
         self._each = lib.cpSpaceEachBody
         self._iterate = ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")
@@ -112,11 +118,7 @@ class ControlWriter:
         self._space = space._space
         self._buf = pmbatch.Buffer()
         pmbatch.get_space_bodies(space, _CONTROL, self._buf)  # sizes the C array: three floats a body
-        data = ffi.new("pmBatchedData *")
-        data.fields = _CONTROL.value
-        data.floatArray = self._buf._float_arr
-        data.intArray = self._buf._int_arr
-        self._data = data
+        self._data = _batched(self._buf, _CONTROL)
         self._arr = self._buf._float_arr
         self._n = self._arr.num
         self._each = lib.cpSpaceEachBody
