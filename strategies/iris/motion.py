@@ -114,17 +114,20 @@ class MotionMixin:
         if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
             nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
             near = view.opponents_near(nx, ny, guard[0])  # those surely outside the guard's box left out
-            vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
+            if near:  # with none near, `_guard_push` leaves the velocity as it is
+                vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
             if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
                 # the held ball is part of the body: do not push it into an opponent either
                 reach = self.ball_reach
                 bx, by = nx + reach * c, ny + reach * s
                 near = view.opponents_near(bx, by, guard[0])
-                vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
+                if near:
+                    vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
         omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
         omega = -limit if omega < -limit else limit if omega > limit else omega
-        return Cmd(tick=tick, vx=c * vx + s * vy, vy=-s * vx + c * vy, omega=omega, dribbler=dribbler, kick_speed=kick)
+        # positional, in the fields' order (msgspec looks each keyword's name up): mode "body", no wheel speeds
+        return Cmd(tick, "body", c * vx + s * vy, -s * vx + c * vy, omega, [], dribbler, kick)
 
     def _heading_pid(self, beta: float, theta: float) -> float:
         """The heading PID (paper 1 eq. 15-16) on the robot's memory: `arena.navigation.pid.update` inlined,
