@@ -113,14 +113,26 @@ class MotionMixin:
         guard = self._guard
         if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
             nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
-            near = view.opponents_near(nx, ny, guard[0])  # those surely outside the guard's box left out
+            rng = past = guard[0]  # [m] the guard's box; `past`: how far beyond contact it may cap
+            if self._guard_shrinks:
+                # The guard's cap at distance d, sqrt(push_guard^2 + 2 brake (d - contact)), exceeds the robot's
+                # speed v beyond d = contact + (v^2 - push_guard^2) / (2 brake): farther opponents, which it
+                # would leave be (its caps only ever slow the robot), are not asked for (v + 1 ppm and 1 mm
+                # more for rounding); a slow robot (arriving, standing at a set piece) asks for few or none.
+                v = (speed if speed < cap else cap) * 1.000001  # [m/s] the speed after the cap above
+                past = (v * v - guard[2]) / guard[1]
+                past = (past if past > 0.0 else 0.0) + 0.001
+                rng = p.contact_range + past
+                rng = rng if rng < guard[0] else guard[0]
+            near = view.opponents_near(nx, ny, rng)  # those surely outside the box left out
             if near:  # with none near, `_guard_push` leaves the velocity as it is
                 vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
             if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
                 # the held ball is part of the body: do not push it into an opponent either
                 reach = self.ball_reach
                 bx, by = nx + reach * c, ny + reach * s
-                near = view.opponents_near(bx, by, guard[0])
+                rng = p.ball_contact_range + past
+                near = view.opponents_near(bx, by, rng if rng < guard[0] else guard[0])
                 if near:
                     vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
         omega = self._heading_pid(heading, th)

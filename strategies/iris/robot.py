@@ -36,7 +36,8 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         *("cfg", "team", "n", "p", "half_length", "half_width", "goal_half", "view", "nav", "nav_params"),
         *("area_params", "mem", "role", "order", "plan", "_support", "_restart", "_planned", "_may_keep_away"),
         *("_ticks_2s", "tick", "ball_reach", "_commit_ticks", "_dt", "_defense_area", "_areas", "_drive_hx"),
-        *("_drive_hy", "_penalty_half_width", "_near_ball", "_pid", "_guard", "_static_area", "__dict__"),
+        *("_drive_hy", "_penalty_half_width", "_near_ball", "_pid", "_guard", "_guard_shrinks", "_static_area"),
+        "__dict__",
     )
 
     def __init__(self, ctx: RobotContext, p: IrisParams):
@@ -75,6 +76,8 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         pid = p.heading_pid
         self._pid = (pid.k_p, pid.k_i, pid.k_d, pid.max_integral, pid.max_output)  # `_heading_pid`
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
+        # `drive` narrows the guard's box to the opponents it may cap: not with a cap that pushes back (below 0)
+        self._guard_shrinks = p.contact_push >= 0.0 and p.brake > 0.0
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
 
     def report(self, tick: int, sense: Sense | None) -> Report:
