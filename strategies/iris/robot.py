@@ -25,6 +25,8 @@ from arena.strategies.iris.positions import PositionsMixin
 from arena.strategies.iris.setpieces import SetPieceMixin
 from arena.strategies.world import RobotView
 
+_ATTACKING = (R.ATTACKING_ATTACKER, R.ATTACKING_DEFENDER)  # `R.is_attacking`: the states of attacking mode
+
 
 class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMixin, SetPieceMixin, PositionsMixin):
     """Robot brain: perception, skills and the referee, for every role."""
@@ -124,22 +126,27 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         return self.without_ball(tick, order, ball)
 
     def make_plan(self, order: Order) -> Plan:
-        roles = {}  # a plain loop: a comprehension costs more for the three teammates
-        for n, (_, _, r) in self.view.mates.items():
-            if n != 0 and r in ("attacker", "defender"):
-                roles[n] = r
+        key = []  # the teammates' roles, (n, role); a plain loop: a comprehension costs more for three teammates
+        for n, mate in self.view.mates.items():
+            r = mate[2]
+            if n != 0 and (r == "attacker" or r == "defender"):
+                key.append((n, r))
         if self.n != 0:
-            roles[self.n] = self.role
-        key = tuple(roles.items())  # the areas follow from the roles alone: worked out once per set of roles
+            key.append((self.n, self.role))
+        key = tuple(key)  # the areas follow from the roles alone: worked out once per set of roles
         areas = self._areas.get(key)
         if areas is None:
-            areas = self._areas[key] = R.areas(roles, self.area_params)
+            areas = self._areas[key] = R.areas(dict(key), self.area_params)
+        d = order.attack_dir
+        # positional, in the fields' order (a dataclass __init__ called with keywords costs twice as much):
+        # role, area, areas, attacking (`R.is_attacking`), team (a new dict with every order, `RobotView.update`),
+        # goal and own goal centres
         return Plan(
-            role=self.role,
-            area=areas.get(self.n, self._defense_area),
-            areas=areas,
-            attacking=R.is_attacking(order.role_state),
-            team=self.view.mates,  # a new dict with every order (`RobotView.update`)
-            goal=(order.attack_dir * self.half_length, 0.0),
-            own=(-order.attack_dir * self.half_length, 0.0),
+            self.role,
+            areas.get(self.n, self._defense_area),
+            areas,
+            order.role_state in _ATTACKING,
+            self.view.mates,
+            (d * self.half_length, 0.0),
+            (-d * self.half_length, 0.0),
         )
