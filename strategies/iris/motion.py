@@ -28,6 +28,8 @@ from arena.schemas.messages import Cmd, Order
 from arena.strategies import skills as S
 from arena.strategies.iris.params import Vec
 
+_NEG_PI = -pi  # `_heading_pid`: a wrapped angle of -pi is taken as pi
+
 
 class MotionMixin:
     """Mixin of `IrisRobot`: going somewhere."""
@@ -143,26 +145,27 @@ class MotionMixin:
 
     def _heading_pid(self, beta: float, theta: float) -> float:
         """The heading PID (paper 1 eq. 15-16) on the robot's memory: `arena.navigation.pid.update` inlined,
-        the same float operations in the same order, with its gains read once (`_pid`); this runs every tick."""
+        the same float operations in the same order, with its gains and bounds read once (`_pid`); this runs
+        every tick."""
         mem = self.mem
-        k_p, k_i, k_d, max_integral, max_output = self._pid
+        k_p, k_i, k_d, lo_integral, max_integral, lo_output, max_output = self._pid
         err = remainder(beta - theta, TAU)  # eq. 15
-        if err == -pi:
+        if err == _NEG_PI:
             err = pi
         integral = mem.pid_integral + err
-        if not -max_integral < integral < max_integral:
-            integral = max(-max_integral, min(max_integral, integral))
+        if not lo_integral < integral < max_integral:
+            integral = max(lo_integral, min(max_integral, integral))
         prev = mem.pid_error
         if prev is None:
             derivative = 0.0
         else:
             derivative = remainder(err - prev, TAU)
-            if derivative == -pi:
+            if derivative == _NEG_PI:
                 derivative = pi
         mem.pid_integral, mem.pid_error = integral, err
         out = k_p * err + k_i * integral + k_d * derivative  # eq. 16
-        if not -max_output < out < max_output:
-            out = max(-max_output, min(max_output, out))
+        if not lo_output < out < max_output:
+            out = max(lo_output, min(max_output, out))
         return out
 
     def guard_push(self, x: float, y: float, vx: float, vy: float, contact: float) -> Vec:

@@ -76,7 +76,8 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._penalty_half_width = cfg.field.penalty_area_width / 2  # [m]
         self._near_ball = p.skills.behind_ball + 0.3  # [m] `get_ball`: final approach within this
         pid = p.heading_pid
-        self._pid = (pid.k_p, pid.k_i, pid.k_d, pid.max_integral, pid.max_output)  # `_heading_pid`
+        # `_heading_pid`: the gains and the bounds of the integral and the output
+        self._pid = (pid.k_p, pid.k_i, pid.k_d, -pid.max_integral, pid.max_integral, -pid.max_output, pid.max_output)
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
         # `drive` narrows the guard's box to the opponents it may cap: not with a cap that pushes back (below 0)
         self._guard_shrinks = p.contact_push >= 0.0 and p.brake > 0.0

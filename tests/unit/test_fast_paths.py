@@ -113,7 +113,7 @@ def test_the_robots_heading_pid_is_bit_identical_to_pid_update():
     for p in (pid.PIDParams(), pid.PIDParams(max_output=2.0, max_integral=0.5)):
         robot = registry.get("AD").make_robot(RobotContext(cfg=cfg, team="a", n=1, rng=random.Random(0)))
         robot.p = replace(robot.p, heading_pid=p)
-        robot._pid = (p.k_p, p.k_i, p.k_d, p.max_integral, p.max_output)
+        robot._pid = (p.k_p, p.k_i, p.k_d, -p.max_integral, p.max_integral, -p.max_output, p.max_output)
         integral, prev = 0.0, None
         for _ in range(5000):
             beta, theta = rng.uniform(-4.0, 4.0), rng.choice([math.pi, -math.pi, rng.uniform(-4.0, 4.0)])
