@@ -126,16 +126,18 @@ class MotionMixin:
                 past = (past if past > 0.0 else 0.0) + 0.001
                 rng = p.contact_range + past
                 rng = rng if rng < guard[0] else guard[0]
+            if has_ball:  # the held ball's box (below) lies within this one grown by its reach: one ask for both
+                ball_rng = p.ball_contact_range + past
+                ball_rng = (ball_rng if ball_rng < guard[0] else guard[0]) + self.ball_reach
+                rng = ball_rng if ball_rng > rng else rng
             near = view.opponents_near(nx, ny, rng)  # those surely outside the box left out
-            if near:  # with none near, `_guard_push` leaves the velocity as it is
+            if near:  # with none near, `_guard_push` leaves the velocity as it is; the opponents farther
+                # than the guard asks for are no change to it (above)
                 vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
-            if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
-                # the held ball is part of the body: do not push it into an opponent either
-                reach = self.ball_reach
-                bx, by = nx + reach * c, ny + reach * s
-                rng = p.ball_contact_range + past
-                near = view.opponents_near(bx, by, rng if rng < guard[0] else guard[0])
-                if near:
+                if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
+                    # the held ball is part of the body: do not push it into an opponent either
+                    reach = self.ball_reach
+                    bx, by = nx + reach * c, ny + reach * s
                     vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
         omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega

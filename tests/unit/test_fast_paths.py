@@ -228,36 +228,40 @@ def test_opponents_near_leaves_out_only_opponents_outside_the_box():
 
 
 def test_drive_narrows_the_push_guard_to_the_opponents_it_may_cap():
-    """`drive` asks only for the opponents within the distance where the guard's cap rises above the robot's
-    speed: the same commands as with the guard's whole box, bit for bit, while fewer opponents are asked for."""
+    """`drive` asks once (for the robot and the ball it holds) and only for the opponents within the distance
+    where the guard's cap rises above the robot's speed: the same commands, bit for bit, as the guard over
+    every opponent, while fewer opponents are asked for."""
     import msgspec
 
     cfg = MatchConfig()
     rng = random.Random(12)
     make = registry.get("AD").make_robot
-    asked: list[list[int]] = [[], []]
-    for _ in range(300):
-        x0, y0, th, a = rng.uniform(-3, 3), rng.uniform(-2, 2), rng.uniform(-3, 3), rng.uniform(-3, 3)
-        vmax = rng.choice((0.3, 0.6, 1.0, 1.5, 2.0, 2.5))
-        edge = 0.65 + max(vmax * vmax - 0.25, 0.0) / 2.4  # [m] where the guard's cap passes vmax
-        r = edge * rng.uniform(0.97, 1.03)
-        movers = [(x0 + r * math.cos(a), y0 + r * math.sin(a), 0.0, 0.0)]  # ahead, about where the cap passes vmax
-        movers += [(x0 + rng.uniform(-3, 3), y0 + rng.uniform(-3, 3), rng.uniform(-2, 2), rng.uniform(-2, 2))]
+    asked: list[list[int]] = [[], []]  # per ask: how many opponents it got, and how many there are
+    for _ in range(500):
+        x0, y0 = rng.uniform(-3, 3), rng.uniform(-2, 2)
+        # headings and courses along an axis too: an opponent that far along it is at the edge of the box asked for
+        th = rng.choice((0.0, math.pi / 2, -math.pi, rng.uniform(-3, 3)))
         has_ball = rng.random() < 0.4
+        a = rng.choice((0.0, math.pi / 2, -math.pi, rng.uniform(-3, 3)))
+        a = th + rng.choice((0.0, rng.uniform(-0.3, 0.3))) if has_ball else a
+        vmax = rng.choice((0.3, 0.6, 1.0, 1.5, 2.0, 2.5))
+        past = max(vmax * vmax - 0.25, 0.0) / 2.4  # [m] beyond contact the guard's cap passes vmax
+        r, rb = (0.65 + past) * rng.uniform(0.99, 1.01), (0.4 + past) * rng.uniform(0.99, 1.01) + 0.335
+        movers = [(x0 + r * math.cos(a), y0 + r * math.sin(a), 0.0, 0.0)]  # ahead, about where the cap passes vmax
+        movers += [(x0 + rb * math.cos(th), y0 + rb * math.sin(th), 0.0, 0.0)]  # the same ahead of the ball
+        movers += [(x0 + rng.uniform(-3, 3), y0 + rng.uniform(-3, 3), rng.uniform(-2, 2), rng.uniform(-2, 2))]
         order = Order(tick=0, robot=1, command="START", attack_dir=1, own=[TeamPose(robot=1, x=x0, y=y0)])
         robots = [make(RobotContext(cfg=cfg, team="a", n=1, rng=random.Random(0))) for _ in range(2)]
-        robots[1]._guard_shrinks = False  # the guard's whole box
         for k in range(rng.randrange(3, 12)):  # tracks of 3 detections or more: the box applies
             seen = [RobotSeen(team="b", x=x + vx * 0.02 * k, y=y + vy * 0.02 * k) for x, y, vx, vy in movers]
             sense = Sense(tick=k, pose=Pose(x=x0, y=y0, theta=th), robots=seen, has_ball=has_ball)
             for robot in robots:
                 robot.view.update(k + 3, sense, order)
                 robot.order, robot.plan = order, robot.make_plan(order)
-        for count, robot in zip(asked, robots):
-            near = robot.view.opponents_near
-            robot.view.opponents_near = lambda x, y, r, near=near, count=count: (
-                count.append(len(z := near(x, y, r))) or z
-            )
+        view, every = robots[0].view, robots[1].view.opponents_now
+        near = view.opponents_near
+        view.opponents_near = lambda x, y, r, near=near: asked[0].append(len(z := near(x, y, r))) or z
+        robots[1].view.opponents_near = lambda x, y, r, every=every: asked[1].append(len(every)) or every
         target = (x0 + 4.0 * math.cos(a), y0 + 4.0 * math.sin(a))
         for gain in (0.0, 3.0):
             cmds = [robot.drive(5, target, a, vmax, avoid=False, gain=gain, dribbler=has_ball) for robot in robots]
