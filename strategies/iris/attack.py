@@ -58,11 +58,12 @@ class AttackMixin:
         sp = self.p.skills
         if tick <= self.mem.shot_until:  # a shot once decided is carried through (the line may flicker)
             return self.turn_and_kick(tick, self.mem.shot_aim, self.p.kick_speed)
-        heading = self.view.pose[2]  # type: ignore[index]
-        aim, clear = S.best_aim(pos, goal[0], self.goal_half, opponents, sp.clear_margin, heading=heading)
-        if (d_goal < self.p.advance_shoot_distance and clear) or d_goal < self.p.close_shot:
-            self.mem.shot_until, self.mem.shot_aim = tick + self._commit_ticks, aim
-            return self.turn_and_kick(tick, aim, self.p.kick_speed)
+        aim = None  # the aim point with its clear flag (`S.best_aim`), asked for only where the answer is used
+        if d_goal < self.p.advance_shoot_distance or d_goal < self.p.close_shot:
+            aim, clear = self.shot_aim(pos, goal[0], opponents)
+            if (d_goal < self.p.advance_shoot_distance and clear) or d_goal < self.p.close_shot:
+                self.mem.shot_until, self.mem.shot_aim = tick + self._commit_ticks, aim
+                return self.turn_and_kick(tick, aim, self.p.kick_speed)
         target = self.shooter_target(order, pos, goal)
         if target is not None:
             return self.pass_to(tick, target)
@@ -93,9 +94,16 @@ class AttackMixin:
             way, heading, self.mem.circle_rot = S.circle_past(pos, blocker, goal, sp.sidestep, rot=rot)
             self.mem.circle_tick = tick
             return self.drive(tick, way, heading, self.p.dribble_speed, dribbler=True, avoid=False)
+        if aim is None:
+            aim, _ = self.shot_aim(pos, goal[0], opponents)
         ahead = (goal[0] - order.attack_dir * min(self.p.advance_shoot_distance - 0.5, d_goal), aim[1] * 0.5)
         face = atan2(aim[1] - pos[1], aim[0] - pos[0])  # S.angle_to(pos, aim)
         return self.drive(tick, ahead, face, self.p.dribble_speed, dribbler=True, avoid=False)
+
+    def shot_aim(self, pos: Vec, goal_x: float, opponents: list[Vec]) -> tuple[Vec, bool]:
+        """`S.best_aim` from `pos` for this robot's heading: the aim point and whether its line is clear."""
+        heading = self.view.pose[2]  # type: ignore[index]
+        return S.best_aim(pos, goal_x, self.goal_half, opponents, self.p.skills.clear_margin, heading=heading)
 
     def open_side(self, goal_x: float) -> float:
         """Basic aim: 0.6 of the goal half-width on the side away from the keeper."""
