@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from arena.strategies.iris.params import Vec
 
@@ -37,13 +37,23 @@ class Plan:
     team: dict[int, tuple[float, float, str]]  # the order's teammates: n -> (x [m], y [m], role)
     goal: Vec  # [m] the centre of the goal we attack ...
     own: Vec  # [m] ... and of ours
+    # `mates` and `attackers`, worked out at the first ask (a holder asks every tick)
+    _mates: tuple[Vec, ...] | None = field(default=None, repr=False, compare=False)
+    _attackers: tuple[Vec, ...] | None = field(default=None, repr=False, compare=False)
 
     @property
     def mates(self) -> tuple[Vec, ...]:
         """Positions [m] of the outfield teammates, by robot number (asked for with the ball only)."""
-        return tuple((x, y) for n, (x, y, _) in sorted(self.team.items()) if n != 0)
+        mates = self._mates
+        if mates is None:
+            mates = self._mates = tuple((x, y) for n, (x, y, _) in sorted(self.team.items()) if n != 0)
+        return mates
 
     @property
     def attackers(self) -> tuple[Vec, ...]:
         """Positions [m] of the teammates that are attackers, by robot number."""
-        return tuple((x, y) for n, (x, y, r) in sorted(self.team.items()) if n != 0 and r == "attacker")
+        mates = self._attackers
+        if mates is None:
+            team = sorted(self.team.items())
+            mates = self._attackers = tuple((x, y) for n, (x, y, r) in team if n != 0 and r == "attacker")
+        return mates
