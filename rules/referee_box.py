@@ -457,11 +457,19 @@ class RefereeBox:
         """The commands of referee tick `tick`: a scenario's and an operator's forced ones, the engine's
         events, then the clock."""
         out: list[RefCommand] = []
-        changes = [*(Forced(tick, o) for o in forced), *(Forced(tick, o, "operator") for o in operator)]
-        for change in [*changes, *(Observed(tick, ev) for ev in events), Clock(tick)]:
+        # plain loops, no generators: most referee ticks have no forced change and no event
+        changes: list[Change] = []
+        for o in forced:
+            changes.append(Forced(tick, o))
+        for o in operator:
+            changes.append(Forced(tick, o, "operator"))
+        for ev in events:
+            changes.append(Observed(tick, ev))
+        changes.append(Clock(tick))
+        for change in changes:
             pre = self.state
             state, cmds = process(pre, change, self.rules)
-            if state == pre and not cmds:
+            if not cmds and (state is pre or state == pre):  # the same state: no field compared
                 continue
             self.state = state
             self.log.append(LogEntry(len(self.log), tick, change, pre, state, tuple(cmds)))
