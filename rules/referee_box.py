@@ -480,18 +480,10 @@ class RefereeBox:
     def frame(self, tick: int, commands: list[RefCommand]) -> Referee:
         """The `referee` message for tick `tick` (Re_G and to the base stations)."""
         st = self.state
-        return Referee(
-            tick=tick,
-            stage=st.stage,
-            command=st.command,
-            command_team=st.command_team,
-            spot_x=st.spot[0],
-            spot_y=st.spot[1],
-            score_a=st.score[0],
-            score_b=st.score[1],
-            attack_dir_a=st.attack_dir_a,
-            commands=commands,
-        )
+        (x, y), (a, b) = st.spot, st.score
+        # tick, stage, command, command_team, spot_x, spot_y, score_a, score_b, attack_dir_a, commands:
+        # positional, in the fields' order (a keyword costs msgspec a name lookup)
+        return Referee(tick, st.stage, st.command, st.command_team, x, y, a, b, st.attack_dir_a, commands)
 
     def summary(self) -> dict[str, object]:
         """Score, command counts and one log line per command, for the match summary."""
