@@ -47,7 +47,9 @@ class RefereeNode(Node):
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
-        events = [ev for frame in self.events_in.take(k) for ev in frame.events]
+        events = []  # a plain loop: usually one frame, often with no event
+        for frame in self.events_in.take(k):
+            events += frame.events
         due: tuple = ()
         if self.forced and self.forced[0][0] <= k:
             due = tuple(o for at, o in self.forced if at <= k)

@@ -457,11 +457,19 @@ class RefereeBox:
         """The commands of referee tick `tick`: a scenario's and an operator's forced ones, the engine's
         events, then the clock."""
         out: list[RefCommand] = []
-        changes = [*(Forced(tick, o) for o in forced), *(Forced(tick, o, "operator") for o in operator)]
-        for change in [*changes, *(Observed(tick, ev) for ev in events), Clock(tick)]:
+        # plain loops, no generators: most referee ticks have no forced change and no event
+        changes: list[Change] = []
+        for o in forced:
+            changes.append(Forced(tick, o))
+        for o in operator:
+            changes.append(Forced(tick, o, "operator"))
+        for ev in events:
+            changes.append(Observed(tick, ev))
+        changes.append(Clock(tick))
+        for change in changes:
             pre = self.state
             state, cmds = process(pre, change, self.rules)
-            if state == pre and not cmds:
+            if not cmds and (state is pre or state == pre):  # the same state: no field compared
                 continue
             self.state = state
             self.log.append(LogEntry(len(self.log), tick, change, pre, state, tuple(cmds)))
@@ -472,18 +480,10 @@ class RefereeBox:
     def frame(self, tick: int, commands: list[RefCommand]) -> Referee:
         """The `referee` message for tick `tick` (Re_G and to the base stations)."""
         st = self.state
-        return Referee(
-            tick=tick,
-            stage=st.stage,
-            command=st.command,
-            command_team=st.command_team,
-            spot_x=st.spot[0],
-            spot_y=st.spot[1],
-            score_a=st.score[0],
-            score_b=st.score[1],
-            attack_dir_a=st.attack_dir_a,
-            commands=commands,
-        )
+        (x, y), (a, b) = st.spot, st.score
+        # tick, stage, command, command_team, spot_x, spot_y, score_a, score_b, attack_dir_a, commands:
+        # positional, in the fields' order (a keyword costs msgspec a name lookup)
+        return Referee(tick, st.stage, st.command, st.command_team, x, y, a, b, st.attack_dir_a, commands)
 
     def summary(self) -> dict[str, object]:
         """Score, command counts and one log line per command, for the match summary."""

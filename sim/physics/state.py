@@ -32,6 +32,13 @@ class State:
         r = self._by_id[(team, n)]
         return 0.0 if r.parked else math.hypot(r.twist[0], r.twist[1])
 
+    def commanded_speeds(self) -> list[float]:
+        """`commanded_speed` of every robot, in `robot_states`' order (the stuck check's one call a period)."""
+        out, hypot = [], math.hypot
+        for r in self._robots:
+            out.append(0.0 if r.parked else hypot(r.twist[0], r.twist[1]))
+        return out
+
     def robot_pose(self, team: str, n: int) -> tuple[float, float, float]:
         """(x [m], y [m], theta [rad] in (-pi, pi]) in the field frame."""
         s, o = self._fresh(), self._by_id[(team, n)].off

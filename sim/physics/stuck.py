@@ -34,11 +34,11 @@ class StuckWatch:
             self.anchor.clear()  # every clock restarts
             return []
         k, out, anchor = ph.tick, [], self.anchor
-        parked = ph.parked()
-        for st in ph.robot_states():
+        # a parked robot's commanded speed is 0: it is never driven
+        for st, speed in zip(ph.robot_states(), ph.commanded_speeds()):
             t, n, x, y = st[0], st[1], st[2], st[3]
             r = (t, n)
-            if (parked and r in parked) or ph.commanded_speed(t, n) <= DRIVEN_SPEED:
+            if speed <= DRIVEN_SPEED:
                 anchor.pop(r, None)
                 continue
             a = anchor.get(r)
