@@ -38,6 +38,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
+from math import cos, sin
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
@@ -322,16 +323,16 @@ class RobotView:
         self._ball_memory = p.ball_memory
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
-        own_ball = self.own_ball
         seen: list[Vec] = []  # own detections: opponents ...
         near: list[Vec] = []  # ... and teammates
+        own_ball = self.own_ball
         if sense is not None:
             other = self.other
             for r in sense.robots:
                 (seen if r.team == other else near).append((r.x, r.y))
             p = sense.pose
             x, y, theta = self.pose = (p.x, p.y, p.theta)
-            c, s = math.cos(theta), math.sin(theta)
+            c, s = cos(theta), sin(theta)
             svx, svy = sense.vx, sense.vy
             vx, vy = self.vel = (c * svx - s * svy, s * svx + c * svy)
             lead = self.lead
@@ -341,20 +342,19 @@ class RobotView:
             b = sense.ball
             if b.visible:
                 own_ball.observe(tick, b.x, b.y)
+            if lead > 0.0:
+                if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
+                    self._track(sense.tick, seen)
+                self._seen = seen
+                self._now = None  # predicted when asked for (`opponents_now`, `opponents_near`)
         elif order is not None and self.pose is None:
-            for tp in order.own:
-                if tp.robot == self.n:
-                    self.pose = (tp.x, tp.y, tp.theta)
-                    vx, vy = self.vel
-                    lead = self.lead
-                    self.pose_now = (tp.x + vx * lead, tp.y + vy * lead) if lead != 0.0 else (tp.x, tp.y)
+            self._pose_from_order(order)
+        # The ball: the own detection or the order's, whichever is younger (the own one on a tie).
         track = own_ball.track
-        own_age = tick - track.tick if track is not None else 1 << 30
-        order_ball = order is not None and order.ball_valid
-        order_age = order.ball_age + (tick - order.tick) if order_ball else 1 << 30  # type: ignore[union-attr]
-        if own_age <= order_age and track is not None:
-            ball, self.ball_vel, age = (track.x, track.y), own_ball.vel, own_age
-        elif order_ball:
+        order_age = order.ball_age + (tick - order.tick) if order is not None and order.ball_valid else None
+        if track is not None and (order_age is None or tick - track.tick <= order_age):
+            ball, self.ball_vel, age = (track.x, track.y), own_ball.vel, tick - track.tick
+        elif order_age is not None:
             ball, self.ball_vel, age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age  # type: ignore[union-attr]
         else:
             ball, self.ball_vel, age = None, (0.0, 0.0), 1 << 30
@@ -363,22 +363,36 @@ class RobotView:
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
             self._take_order(order)
         # The base station's entries that no own detection within merge_radius explains.
-        merge2 = self._merge2
         opponents = seen[:]
         if order is not None:
             memory = self._opponent_memory - (tick - order.tick)
-            if self._order_opponent_oldest <= memory:  # none too old (the usual case): all of them
-                entries = self._order_opponent_xy
-            else:
-                entries = [xy for age, xy in self._order_opponents if age <= memory]
-            _add_unexplained(opponents, entries, seen, merge2)
+            # none too old (the usual case): all of them
+            entries = self._order_opponent_xy if self._order_opponent_oldest <= memory else self._younger(memory)
+            merge2 = self._merge2
+            for xy in entries:  # `_add_unexplained`, inlined: the view's hottest loop
+                ex, ey = xy
+                for ox, oy in seen:
+                    dx, dy = ex - ox, ey - oy
+                    if dx * dx + dy * dy < merge2:
+                        break
+                else:
+                    opponents.append(xy)
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
-        if self.lead > 0.0 and sense is not None:
-            if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
-                self._track(sense.tick, seen)
-            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
+
+    def _pose_from_order(self, order: Order) -> None:
+        """Before the first sense: the robot's own pose as the order lists it."""
+        for tp in order.own:
+            if tp.robot == self.n:
+                self.pose = (tp.x, tp.y, tp.theta)
+                vx, vy = self.vel
+                lead = self.lead
+                self.pose_now = (tp.x + vx * lead, tp.y + vy * lead) if lead != 0.0 else (tp.x, tp.y)
+
+    def _younger(self, memory: int) -> list[Vec]:
+        """The positions of the order's opponents no older than memory [ticks]."""
+        return [xy for age, xy in self._order_opponents if age <= memory]
 
     def _take_order(self, order: Order | None) -> None:
         """What follows from a new order alone: the teammates and the base station's opponents."""
