@@ -273,7 +273,7 @@ class RobotView:
     __slots__ = (
         "team other n p lead _tracks _now _slopes _window_sums _ahead _seen sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponents _order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _opponent_memory "
+        "_order_opponents _order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -319,6 +319,9 @@ class RobotView:
         self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
+        # [m] two points this far apart along one axis are not within merge_radius: d ** 2 >= _merge2 (pow errs
+        # by under an ulp, a sum of squares rounds up from either), so `_track` skips such a pair's distance
+        self._merge_far = abs(p.merge_radius) * (1 + 1e-9)
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
@@ -422,13 +425,17 @@ class RobotView:
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
         old, merge2, window = self._tracks, self._merge2, self._window
+        far = self._merge_far
+        nfar = -far
         tracks: list[Columns] = []
         for x, y in seen:
             best, best_d2 = None, merge2
             for t in old:
-                d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
-                if d2 < best_d2:
-                    best, best_d2 = t, d2
+                dx = t[1][-1] - x
+                if dx < far and dx > nfar:  # farther apart along x: surely not within merge_radius (`_merge_far`)
+                    d2 = dx**2 + (t[2][-1] - y) ** 2
+                    if d2 < best_d2:
+                        best, best_d2 = t, d2
             if best is None:
                 tracks.append(([tick], [x], [y]))
                 continue

@@ -225,3 +225,47 @@ def test_opponents_near_leaves_out_only_opponents_outside_the_box():
                     kept = near.opponents_near(cx, cy, r)
                     assert _guard_box(kept, cx, cy, r) == _guard_box(now, cx, cy, r)
                     assert all(p in now for p in kept)
+
+
+def _tracked_reference(old: list, seen: list, tick: int, merge2: float, window: int) -> list:
+    """`RobotView._track` as plain formulas: each detection continues the nearest track within merge_radius."""
+    old, out = [(list(ts), list(xs), list(ys)) for ts, xs, ys in old], []
+    for x, y in seen:
+        best, best_d2 = None, merge2
+        for t in old:
+            d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
+            if d2 < best_d2:
+                best, best_d2 = t, d2
+        if best is None:
+            out.append(([tick], [x], [y]))
+            continue
+        old.remove(best)
+        for col, v in zip(best, (tick, x, y)):
+            if len(col) >= window:
+                del col[0]
+            col.append(v)
+        out.append(best)
+    return out
+
+
+def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
+    """`_track` leaves out the distance of a pair farther apart along x than merge_radius; it continues the same
+    tracks as the plain nearest-within-merge_radius rule, pairs at the radius's edge included."""
+    cfg = MatchConfig()
+    rng = random.Random(9)
+    for radius in (0.5, 0.3, 1e-3):
+        view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams(merge_radius=radius), latency=3)
+        for tick in range(1, 400):
+            last = view._seen
+            seen = []
+            for _ in range(rng.randrange(0, 4)):
+                if last and rng.random() < 0.7:  # near a track's last detection, often at the radius along x
+                    a, b = rng.choice(last)
+                    dx = rng.choice((radius, -radius, math.nextafter(radius, 0), rng.uniform(-radius, radius)))
+                    seen.append((a + dx, b + rng.choice((0.0, rng.uniform(-0.01, 0.01)))))
+                else:
+                    seen.append((rng.uniform(-6, 6), rng.uniform(-4, 4)))
+            expected = _tracked_reference(view._tracks, seen, tick, view._merge2, view._window)
+            view._track(tick, seen)
+            view._seen = seen
+            assert view._tracks == expected
