@@ -201,21 +201,22 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
-@cache  # one function per window length, per process
-def _unrolled_sums(n: int) -> Callable[[list[float], list[float]], Vec]:
-    """For a consecutive track of n detections, a function of its xs and ys giving `_regression_velocity`'s
-    sums sum(d * (x - mean x)) and sum(d * (y - mean y)): the loop written out, term by term from 0.0 in the same
-    order with the same offsets d, so the same floats, without the loop's per-item interpreter work."""
+@cache  # one function per window length, period and latency, per process
+def _unrolled_ahead(n: int, stt_dt: float, lead: float) -> Callable[[list[float], list[float]], Vec]:
+    """For a consecutive track of n detections, a function of its xs and ys giving where `_regression_velocity`'s
+    velocity moves its last detection in lead [s]: (x_last + sum(d * (x - mean x)) / stt_dt * lead, the same in y),
+    with stt_dt = stt * dt. The loop written out, term by term from 0.0 in the same order with the same offsets d,
+    so the same floats, without the loop's per-item interpreter work."""
     ds, _ = _CONSECUTIVE[n]
     xs, ys = (", ".join(f"{c}{i}" for i in range(n)) for c in "xy")
     sx, sy = (" + ".join(f"{d!r} * ({c}{i} - m{c})" for i, d in enumerate(ds)) for c in "xy")
     src = (
-        f"def sums(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
-        f"    return 0.0 + {sx}, 0.0 + {sy}\n"
+        f"def ahead(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
+        f"    return x{n - 1} + (0.0 + {sx}) / {stt_dt!r} * {lead!r}, y{n - 1} + (0.0 + {sy}) / {stt_dt!r} * {lead!r}\n"
     )
     scope: dict = {}
-    exec(compile(src, f"<_unrolled_sums({n})>", "exec"), scope)  # our own text, from numbers only
-    return scope["sums"]
+    exec(compile(src, f"<_unrolled_ahead({n})>", "exec"), scope)  # our own text, from numbers only
+    return scope["ahead"]
 
 
 def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
@@ -244,12 +245,6 @@ def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: fl
     return sxt / (stt * dt), syt / (stt * dt)
 
 
-def _spread(values: list[float]) -> float:
-    """max - min (one sort of ten floats costs half of max() and min())."""
-    s = sorted(values)
-    return s[-1] - s[0]
-
-
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
     """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
     if not seen:  # nothing to explain them away: all of them
@@ -271,7 +266,7 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _slopes _window_sums _ahead _seen sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _slopes _window_ahead _ahead _seen sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
         "_order_opponents _order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
@@ -294,7 +289,11 @@ class RobotView:
             for n, (ds, stt) in _CONSECUTIVE.items()
         }
         self._window = window = p.track_window
-        self._window_sums = (window, _unrolled_sums(window)) if window in _CONSECUTIVE else (-1, None)
+        self._window_ahead = (
+            (window, _unrolled_ahead(window, self._slopes[window][1], self.lead))
+            if window in _CONSECUTIVE
+            else (-1, None)
+        )
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
@@ -477,7 +476,7 @@ class RobotView:
         if self._now is not None:
             return self._now
         ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
-        window, window_sums = self._window_sums
+        window, window_ahead = self._window_ahead
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
         for k, (ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
@@ -486,25 +485,33 @@ class RobotView:
                 c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
-                else:  # `_regression_velocity` of a consecutive track, inlined: the usual case
-                    ds, stt_dt, reach = c
-                    out_x = abs(xs[-1] - x) - rng  # [m] how far outside the box; the spread only then
-                    if out_x > 0.0 and out_x > reach * _spread(xs):
+                    p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+                    out.append(p)
+                    continue
+                # `_regression_velocity` of a consecutive track, inlined: the usual case
+                ds, stt_dt, reach = c
+                d = xs[-1] - x
+                out_x = (d if d >= 0.0 else -d) - rng  # [m] how far outside the box (abs, inline); the spread only then
+                if out_x > 0.0:
+                    s = sorted(xs)  # the spread: one sort of ten floats costs half of max() and min()
+                    if out_x > reach * (s[-1] - s[0]):
                         continue
-                    out_y = abs(ys[-1] - y) - rng
-                    if out_y > 0.0 and out_y > reach * _spread(ys):
+                d = ys[-1] - y
+                out_y = (d if d >= 0.0 else -d) - rng
+                if out_y > 0.0:
+                    s = sorted(ys)
+                    if out_y > reach * (s[-1] - s[0]):
                         continue
-                    if n == window:  # a full window: the usual case
-                        sxt, syt = window_sums(xs, ys)
-                    else:
-                        mx = sum(xs) / n
-                        my = sum(ys) / n
-                        sxt = syt = 0.0
-                        for d, u, v in zip(ds, xs, ys):
-                            sxt += d * (u - mx)
-                            syt += d * (v - my)
-                    vx, vy = sxt / stt_dt, syt / stt_dt
-                p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+                if n == window:  # a full window: the usual case
+                    p = ahead[k] = window_ahead(xs, ys)
+                else:
+                    mx = sum(xs) / n
+                    my = sum(ys) / n
+                    sxt = syt = 0.0
+                    for d, u, v in zip(ds, xs, ys):
+                        sxt += d * (u - mx)
+                        syt += d * (v - my)
+                    p = ahead[k] = (xs[-1] + sxt / stt_dt * lead, ys[-1] + syt / stt_dt * lead)
             out.append(p)
         out.extend(self.opponents[len(self._seen) :])
         return out

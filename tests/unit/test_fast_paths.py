@@ -12,7 +12,7 @@ from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
 from arena.strategies import registry
 from arena.strategies.base import RobotContext
-from arena.strategies.world import _CONSECUTIVE, FusionParams, RobotView, _regression_velocity, _unrolled_sums
+from arena.strategies.world import _CONSECUTIVE, FusionParams, RobotView, _regression_velocity, _unrolled_ahead
 
 
 def _gain_reference(d: float, phi: float, fis: fsfm.FIS) -> float:
@@ -162,20 +162,21 @@ def test_an_order_listing_a_robot_twice_gives_its_last_entry_once():
     assert view.opponents == [(1.0, 0.0), (4.0, 2.0)]  # negative ages (a bad order): none too old
 
 
-def test_the_unrolled_window_sums_are_the_regression_loops_bit_for_bit():
-    """`_unrolled_sums(n)` gives the sums of `_regression_velocity`'s loop for a consecutive track of n, bit for bit."""
+def test_the_unrolled_prediction_is_the_regression_loops_bit_for_bit():
+    """`_unrolled_ahead(n, ...)` moves a consecutive track's last detection by `_regression_velocity` bit for bit."""
     rng = random.Random(3)
-    dt = 0.02
     for n in range(3, 65):
-        sums = _unrolled_sums(n)
         _, stt = _CONSECUTIVE[n]
-        for _ in range(50):
-            t0 = rng.randrange(0, 100000)
-            x0, y0, vx, vy = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-3, 3), rng.uniform(-3, 3)
-            xs = [x0 + vx * dt * i + rng.gauss(0, 0.03) for i in range(n)]
-            ys = [y0 + vy * dt * i + rng.gauss(0, 0.03) for i in range(n)]
-            sxt, syt = sums(xs, ys)
-            assert (sxt / (stt * dt), syt / (stt * dt)) == _regression_velocity(list(range(t0, t0 + n)), xs, ys, dt)
+        for dt, latency in ((0.02, 3), (0.01, 1), (0.01, 7)):
+            lead = latency * dt
+            ahead = _unrolled_ahead(n, stt * dt, lead)
+            for _ in range(50):
+                t0 = rng.randrange(0, 100000)
+                x0, y0, vx, vy = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-3, 3), rng.uniform(-3, 3)
+                xs = [x0 + vx * dt * i + rng.gauss(0, 0.03) for i in range(n)]
+                ys = [y0 + vy * dt * i + rng.gauss(0, 0.03) for i in range(n)]
+                rvx, rvy = _regression_velocity(list(range(t0, t0 + n)), xs, ys, dt)
+                assert ahead(xs, ys) == (xs[-1] + rvx * lead, ys[-1] + rvy * lead)
 
 
 def test_segment_room_is_the_least_segment_distance_bit_for_bit():
