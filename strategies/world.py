@@ -282,18 +282,17 @@ class RobotView:
         self.lead = latency * dt  # [s] how far the view is behind the present
         self._tracks: list[Columns] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
-        # Per consecutive track length n: `_regression_velocity`'s tick offsets and stt * dt, and a bound:
-        # |prediction - last detection| <= reach * the spread of the detections (|sum d (x - mean)| <= sum |d| * spread)
-        self._slopes = {
-            n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
-            for n, (ds, stt) in _CONSECUTIVE.items()
-        }
         self._window = window = p.track_window
-        self._window_ahead = (
-            (window, _unrolled_ahead(window, self._slopes[window][1], self.lead))
-            if window in _CONSECUTIVE
-            else (-1, None)
-        )
+        # Per consecutive track length n (a list, indexed by n up to the longest track, for the cheapest lookup):
+        # `_regression_velocity`'s tick offsets and stt * dt, and a bound: |prediction - last detection| <= reach *
+        # the spread of the detections (|sum d (x - mean)| <= sum |d| * spread); None for n < 3 (no regression)
+        slopes: list[tuple[tuple[float, ...], float, float] | None] = [None] * (max(window, 1) + 1)
+        for k, (ds, stt) in _CONSECUTIVE.items():
+            if k < len(slopes):
+                slopes[k] = (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
+        self._slopes = slopes
+        full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
+        self._window_ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
@@ -440,11 +439,12 @@ class RobotView:
                 continue
             old.remove(best)
             ts, xs, ys = best
-            if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
+            n = len(ts)
+            if ts[n - 1] >= tick:  # the same sense again: the newer detection replaces it (n - 1: not the slow -1)
                 ts.pop()
                 xs.pop()
                 ys.pop()
-            elif len(ts) >= window:  # a full window: its oldest detection goes (before the append: no regrowth)
+            elif n >= window:  # a full window: its oldest detection goes (before the append: no regrowth)
                 del ts[0], xs[0], ys[0]
             ts.append(tick)
             xs.append(x)
@@ -482,7 +482,8 @@ class RobotView:
             p = ahead[k]
             if p is None:
                 n = len(ts)
-                c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
+                m = n - 1  # the last detection's index: a negative index takes the interpreter's slow path
+                c = slopes[n] if ts[m] - ts[0] == m else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
                     p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
@@ -490,17 +491,17 @@ class RobotView:
                     continue
                 # `_regression_velocity` of a consecutive track, inlined: the usual case
                 ds, stt_dt, reach = c
-                d = xs[-1] - x
+                d = xs[m] - x
                 out_x = (d if d >= 0.0 else -d) - rng  # [m] how far outside the box (abs, inline); the spread only then
                 if out_x > 0.0:
                     s = sorted(xs)  # the spread: one sort of ten floats costs half of max() and min()
-                    if out_x > reach * (s[-1] - s[0]):
+                    if out_x > reach * (s[m] - s[0]):
                         continue
-                d = ys[-1] - y
+                d = ys[m] - y
                 out_y = (d if d >= 0.0 else -d) - rng
                 if out_y > 0.0:
                     s = sorted(ys)
-                    if out_y > reach * (s[-1] - s[0]):
+                    if out_y > reach * (s[m] - s[0]):
                         continue
                 if n == window:  # a full window: the usual case
                     p = ahead[k] = window_ahead(xs, ys)
@@ -511,7 +512,7 @@ class RobotView:
                     for d, u, v in zip(ds, xs, ys):
                         sxt += d * (u - mx)
                         syt += d * (v - my)
-                    p = ahead[k] = (xs[-1] + sxt / stt_dt * lead, ys[-1] + syt / stt_dt * lead)
+                    p = ahead[k] = (xs[m] + sxt / stt_dt * lead, ys[m] + syt / stt_dt * lead)
             out.append(p)
         out.extend(self.opponents[len(self._seen) :])
         return out
