@@ -45,7 +45,8 @@ from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
-Columns = tuple[list[int], list[float], list[float]]  # a track's detections: their ticks, x and y
+# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y
+Tracked = tuple[float, float, list[int], list[float], list[float]]
 
 
 @dataclass(frozen=True)
@@ -280,7 +281,7 @@ class RobotView:
         self.n = n
         self.p = p
         self.lead = latency * dt  # [s] how far the view is behind the present
-        self._tracks: list[Columns] = []  # per opponent seen: its last detections
+        self._tracks: list[Tracked] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
         self._window = window = p.track_window
         # Per consecutive track length n (a list, indexed by n up to the longest track, for the cheapest lookup):
@@ -425,20 +426,20 @@ class RobotView:
         old, merge2, window = self._tracks, self._merge2, self._window
         far = self._merge_far
         nfar = -far
-        tracks: list[Columns] = []
+        tracks: list[Tracked] = []
         for x, y in seen:
             best, best_d2 = None, merge2
             for t in old:
-                dx = t[1][-1] - x
+                dx = t[0] - x
                 if dx < far and dx > nfar:  # farther apart along x: surely not within merge_radius (`_merge_far`)
-                    d2 = dx**2 + (t[2][-1] - y) ** 2
+                    d2 = dx**2 + (t[1] - y) ** 2
                     if d2 < best_d2:
                         best, best_d2 = t, d2
             if best is None:
-                tracks.append(([tick], [x], [y]))
+                tracks.append((x, y, [tick], [x], [y]))
                 continue
             old.remove(best)
-            ts, xs, ys = best
+            _, _, ts, xs, ys = best
             n = len(ts)
             if ts[n - 1] >= tick:  # the same sense again: the newer detection replaces it (n - 1: not the slow -1)
                 ts.pop()
@@ -449,7 +450,7 @@ class RobotView:
             ts.append(tick)
             xs.append(x)
             ys.append(y)
-            tracks.append(best)
+            tracks.append((x, y, ts, xs, ys))
         self._tracks = tracks
         self._ahead = [None] * len(tracks)
 
@@ -478,7 +479,7 @@ class RobotView:
         ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
         window, window_ahead = self._window_ahead
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
-        for k, (ts, xs, ys) in enumerate(self._tracks):
+        for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
             if p is None:
                 n = len(ts)
@@ -486,18 +487,18 @@ class RobotView:
                 c = slopes[n] if ts[m] - ts[0] == m else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
-                    p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+                    p = ahead[k] = (lx + vx * lead, ly + vy * lead)
                     out.append(p)
                     continue
                 # `_regression_velocity` of a consecutive track, inlined: the usual case
                 ds, stt_dt, reach = c
-                d = xs[m] - x
+                d = lx - x
                 out_x = (d if d >= 0.0 else -d) - rng  # [m] how far outside the box (abs, inline); the spread only then
                 if out_x > 0.0:
                     s = sorted(xs)  # the spread: one sort of ten floats costs half of max() and min()
                     if out_x > reach * (s[m] - s[0]):
                         continue
-                d = ys[m] - y
+                d = ly - y
                 out_y = (d if d >= 0.0 else -d) - rng
                 if out_y > 0.0:
                     s = sorted(ys)
@@ -512,7 +513,7 @@ class RobotView:
                     for d, u, v in zip(ds, xs, ys):
                         sxt += d * (u - mx)
                         syt += d * (v - my)
-                    p = ahead[k] = (xs[m] + sxt / stt_dt * lead, ys[m] + syt / stt_dt * lead)
+                    p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
         out.extend(self.opponents[len(self._seen) :])
         return out

@@ -230,7 +230,7 @@ def test_opponents_near_leaves_out_only_opponents_outside_the_box():
 
 def _tracked_reference(old: list, seen: list, tick: int, merge2: float, window: int) -> list:
     """`RobotView._track` as plain formulas: each detection continues the nearest track within merge_radius."""
-    old, out = [(list(ts), list(xs), list(ys)) for ts, xs, ys in old], []
+    old, out = [(list(ts), list(xs), list(ys)) for _, _, ts, xs, ys in old], []
     for x, y in seen:
         best, best_d2 = None, merge2
         for t in old:
@@ -238,14 +238,14 @@ def _tracked_reference(old: list, seen: list, tick: int, merge2: float, window: 
             if d2 < best_d2:
                 best, best_d2 = t, d2
         if best is None:
-            out.append(([tick], [x], [y]))
+            out.append((x, y, [tick], [x], [y]))
             continue
         old.remove(best)
         for col, v in zip(best, (tick, x, y)):
             if len(col) >= window:
                 del col[0]
             col.append(v)
-        out.append(best)
+        out.append((x, y, *best))
     return out
 
 
