@@ -269,7 +269,7 @@ class RobotView:
     __slots__ = (
         "team other n p lead _tracks _now _slopes _window_ahead _ahead _seen sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponents _order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
+        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -313,8 +313,7 @@ class RobotView:
         self._near: list[Vec] = []  # teammates seen this tick
         self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
-        self._order_opponents: list[tuple[int, Vec]] = []  # (age, position) of the order's P_B entries
-        self._order_opponent_xy: list[Vec] = []  # their positions ...
+        self._order_opponent_xy: list[Vec] = []  # the positions of the order's P_B entries ...
         self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
@@ -394,7 +393,7 @@ class RobotView:
 
     def _younger(self, memory: int) -> list[Vec]:
         """The positions of the order's opponents no older than memory [ticks]."""
-        return [xy for age, xy in self._order_opponents if age <= memory]
+        return [xy for tp, xy in zip(self._order.opponents, self._order_opponent_xy) if tp.age <= memory]  # type: ignore[union-attr]
 
     def _take_order(self, order: Order | None) -> None:
         """What follows from a new order alone: the teammates and the base station's opponents."""
@@ -402,7 +401,6 @@ class RobotView:
         self._order = order
         mates: dict[int, tuple[float, float, str]] = {}
         mate_xy: list[Vec] = []
-        entries: list[tuple[int, Vec]] = []
         xys: list[Vec] = []
         oldest = 0
         if order is not None:
@@ -413,13 +411,11 @@ class RobotView:
             for x, y, _ in mates.values():  # a robot listed twice: its last entry, as the dict holds
                 mate_xy.append((x, y))
             for tp in order.opponents:
-                xy, age = (tp.x, tp.y), tp.age
-                entries.append((age, xy))
-                xys.append(xy)
-                if age > oldest:  # never below 0: the filter in `update` then runs, with the same result
-                    oldest = age
+                xys.append((tp.x, tp.y))
+                if tp.age > oldest:  # never below 0: the filter in `update` then runs, with the same result
+                    oldest = tp.age
         self.mates, self._mate_xy = mates, mate_xy
-        self._order_opponents, self._order_opponent_xy, self._order_opponent_oldest = entries, xys, oldest
+        self._order_opponent_xy, self._order_opponent_oldest = xys, oldest
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
