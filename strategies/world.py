@@ -158,12 +158,20 @@ class TeamModel:
                 if r.team == other:
                     s = det + per_m * hypot(r.x - px, r.y - py)
                     seen.append((r.x, r.y, 1.0 / (s * s)))
-        if balls:
-            bx, by, _ = cluster(balls, math.inf)[0]
-            self.ball.observe(newest, bx, by)
+        if balls:  # `cluster(balls, math.inf)[0]`, inlined: the first detection and every later one that joins it
+            x, y, sw = balls[0]
+            sx, sy = sw * x, sw * y
+            for x, y, w in balls[1:]:
+                if hypot(sx / sw - x, sy / sw - y) < math.inf:
+                    sx += w * x
+                    sy += w * y
+                    sw += w
+            self.ball.observe(newest, sx / sw, sy / sw)
         robots, merge = self.robots, self.p.merge_radius
         fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
-        tracks = [Track(x, y, tick) for x, y, _ in fresh]
+        tracks: list[Track] = []
+        for x, y, _ in fresh:  # a plain loop: for three or so, cheaper than a comprehension
+            tracks.append(Track(x, y, tick))
         oldest = tick - self.p.opponent_memory
         for old in self.opponents:
             if len(tracks) >= robots or old.tick < oldest:

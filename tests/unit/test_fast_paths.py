@@ -270,3 +270,24 @@ def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
             view._track(tick, seen)
             view._seen = seen
             assert view._tracks == expected
+
+
+def test_the_base_stations_ball_is_the_first_cluster_of_its_detections_bit_for_bit():
+    """`TeamModel.update`'s inlined ball fusion gives `cluster(detections, inf)[0]`, weights as `detection_sigma`'s."""
+    from arena.config import SensorParams
+    from arena.schemas.messages import Report
+    from arena.strategies.world import TeamModel, cluster, detection_sigma
+
+    rng = random.Random(13)
+    sensor = SensorParams()
+    for _ in range(500):
+        m = TeamModel("a", 3, sensor, 0.02)
+        reports, balls = {}, []
+        for n in range(rng.randrange(1, 4)):
+            px, py, bx, by = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-6, 6), rng.uniform(-4, 4)
+            pose = Pose(x=px, y=py, theta=0.0)
+            reports[n] = Report(tick=10, robot=n, pose=pose, ball=BallSeen(visible=True, x=bx, y=by))
+            s = detection_sigma(sensor, math.hypot(bx - px, by - py))
+            balls.append((bx, by, 1.0 / (s * s)))
+        m.update(10, reports)
+        assert m.ball_xy(10) == cluster(balls, math.inf)[0][:2]
