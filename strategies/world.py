@@ -185,8 +185,11 @@ class TeamModel:
         self.opponents = tracks
 
     def holder(self) -> int | None:
-        held = [n for n, h in sorted(self.has_ball.items()) if h]
-        return held[0] if held else None
+        has_ball = self.has_ball
+        for n in sorted(has_ball):  # the lowest-numbered robot holding the ball; a plain loop, no list
+            if has_ball[n]:
+                return n
+        return None
 
     def ball_xy(self, tick: int) -> Vec | None:
         t = self.ball.track
