@@ -164,7 +164,10 @@ class RoleAssigner:
         self.swaps = 0  # role changes so far (a/d pairs)
 
     def roles(self) -> dict[int, str]:
-        return {n: role_name(s) for n, s in self.state.items()}
+        out: dict[int, str] = {}
+        for n, s in self.state.items():  # a plain loop, `role_name` inline: the team brain asks every step
+            out[n] = "attacker" if s in (ATTACKING_ATTACKER, DEFENDING_ATTACKER) else "defender"
+        return out
 
     def apply(self, n: int, inp: str) -> None:
         self.state[n] = transition(self.state[n], inp)
