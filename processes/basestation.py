@@ -50,8 +50,11 @@ class BaseStationNode(Node):
 
     def act(self, k: int) -> None:
         t0 = time.perf_counter()
-        # Each robot's newest report, if a new one arrived since the last order.
-        reports = {n: ib.latest for n, ib in self.report_in.items() if ib.take(k)}
+        # Each robot's newest report, if a new one arrived since the last order (a plain loop: no comprehension frame).
+        reports: dict = {}
+        for n, ib in self.report_in.items():
+            if ib.take(k):
+                reports[n] = ib.latest
         referee = self.ref_in.latest_by(k)
         if self.via is not None:
             referee = self.via.referee(k, reports)

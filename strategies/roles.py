@@ -164,7 +164,10 @@ class RoleAssigner:
         self.swaps = 0  # role changes so far (a/d pairs)
 
     def roles(self) -> dict[int, str]:
-        return {n: role_name(s) for n, s in self.state.items()}
+        out: dict[int, str] = {}
+        for n, s in self.state.items():  # a plain loop, `role_name` inline: the team brain asks every step
+            out[n] = "attacker" if s in (ATTACKING_ATTACKER, DEFENDING_ATTACKER) else "defender"
+        return out
 
     def apply(self, n: int, inp: str) -> None:
         self.state[n] = transition(self.state[n], inp)
@@ -201,8 +204,9 @@ class RoleAssigner:
         """
         if possession in ("own", "opponent"):
             inp = B if possession == "own" else B_BAR
-            for n in self.state:
-                self.apply(n, inp)
+            state = self.state
+            for n, s in state.items():  # `apply` inline: every step; a key's value replaced, none added
+                state[n] = TRANSITIONS.get((s, inp), s)
         captured = holder is not None and holder != self.holder
         self.holder = holder
         if not self.dynamic or holder is None or holder not in self.state or holder not in u:
@@ -210,15 +214,17 @@ class RoleAssigner:
         att_lo = self.p.attack[0]
         def_hi = self.p.defense[1]
         mine = self.state[holder]
-        if is_attacker(mine):
+        attacker = is_attacker(mine)
+        if attacker:
             swap = (captured and u[holder] < def_hi) or u[holder] < att_lo
-            partners = [n for n, s in self.state.items() if not is_attacker(s)]
             out_inp, in_inp = D, A
         else:
             swap = (captured and u[holder] > att_lo) or u[holder] > def_hi
-            partners = [n for n, s in self.state.items() if is_attacker(s)]
             out_inp, in_inp = A, D
-        partners = [n for n in partners if n in xy]
+        partners: list[int] = []  # the robots of the other role with a position (a plain loop: no comprehension frames)
+        for n, s in self.state.items():
+            if is_attacker(s) is not attacker and n in xy:
+                partners.append(n)
         if not swap or not partners or holder not in xy:
             return
         hx, hy = xy[holder]

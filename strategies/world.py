@@ -38,13 +38,15 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
+from math import cos, sin
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
-Columns = tuple[list[int], list[float], list[float]]  # a track's detections: their ticks, x and y
+# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y
+Tracked = tuple[float, float, list[int], list[float], list[float]]
 
 
 @dataclass(frozen=True)
@@ -116,7 +118,10 @@ def cluster(detections: list[tuple[float, float, float]], radius: float) -> list
                 break
         else:
             out.append([w * x, w * y, w])
-    return [(c[0] / c[2], c[1] / c[2], c[2]) for c in out]
+    clusters: list[tuple[float, float, float]] = []
+    for c in out:  # a plain loop: for a few clusters cheaper than a comprehension's frame
+        clusters.append((c[0] / c[2], c[1] / c[2], c[2]))
+    return clusters
 
 
 class TeamModel:
@@ -156,12 +161,20 @@ class TeamModel:
                 if r.team == other:
                     s = det + per_m * hypot(r.x - px, r.y - py)
                     seen.append((r.x, r.y, 1.0 / (s * s)))
-        if balls:
-            bx, by, _ = cluster(balls, math.inf)[0]
-            self.ball.observe(newest, bx, by)
+        if balls:  # `cluster(balls, math.inf)[0]`, inlined: the first detection and every later one that joins it
+            x, y, sw = balls[0]
+            sx, sy = sw * x, sw * y
+            for x, y, w in balls[1:]:
+                if hypot(sx / sw - x, sy / sw - y) < math.inf:
+                    sx += w * x
+                    sy += w * y
+                    sw += w
+            self.ball.observe(newest, sx / sw, sy / sw)
         robots, merge = self.robots, self.p.merge_radius
         fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
-        tracks = [Track(x, y, tick) for x, y, _ in fresh]
+        tracks: list[Track] = []
+        for x, y, _ in fresh:  # a plain loop: for three or so, cheaper than a comprehension
+            tracks.append(Track(x, y, tick))
         oldest = tick - self.p.opponent_memory
         for old in self.opponents:
             if len(tracks) >= robots or old.tick < oldest:
@@ -175,8 +188,11 @@ class TeamModel:
         self.opponents = tracks
 
     def holder(self) -> int | None:
-        held = [n for n, h in sorted(self.has_ball.items()) if h]
-        return held[0] if held else None
+        has_ball = self.has_ball
+        for n in sorted(has_ball):  # the lowest-numbered robot holding the ball; a plain loop, no list
+            if has_ball[n]:
+                return n
+        return None
 
     def ball_xy(self, tick: int) -> Vec | None:
         t = self.ball.track
@@ -200,21 +216,22 @@ def _consecutive(n: int) -> tuple[tuple[float, ...], float]:
 _CONSECUTIVE = {n: _consecutive(n) for n in range(3, 65)}
 
 
-@cache  # one function per window length, per process
-def _unrolled_sums(n: int) -> Callable[[list[float], list[float]], Vec]:
-    """For a consecutive track of n detections, a function of its xs and ys giving `_regression_velocity`'s
-    sums sum(d * (x - mean x)) and sum(d * (y - mean y)): the loop written out, term by term from 0.0 in the same
-    order with the same offsets d, so the same floats, without the loop's per-item interpreter work."""
+@cache  # one function per window length, period and latency, per process
+def _unrolled_ahead(n: int, stt_dt: float, lead: float) -> Callable[[list[float], list[float]], Vec]:
+    """For a consecutive track of n detections, a function of its xs and ys giving where `_regression_velocity`'s
+    velocity moves its last detection in lead [s]: (x_last + sum(d * (x - mean x)) / stt_dt * lead, the same in y),
+    with stt_dt = stt * dt. The loop written out, term by term from 0.0 in the same order with the same offsets d,
+    so the same floats, without the loop's per-item interpreter work."""
     ds, _ = _CONSECUTIVE[n]
     xs, ys = (", ".join(f"{c}{i}" for i in range(n)) for c in "xy")
     sx, sy = (" + ".join(f"{d!r} * ({c}{i} - m{c})" for i, d in enumerate(ds)) for c in "xy")
     src = (
-        f"def sums(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
-        f"    return 0.0 + {sx}, 0.0 + {sy}\n"
+        f"def ahead(xs, ys):\n    {xs}, = xs\n    {ys}, = ys\n    mx = sum(xs) / {n}\n    my = sum(ys) / {n}\n"
+        f"    return x{n - 1} + (0.0 + {sx}) / {stt_dt!r} * {lead!r}, y{n - 1} + (0.0 + {sy}) / {stt_dt!r} * {lead!r}\n"
     )
     scope: dict = {}
-    exec(compile(src, f"<_unrolled_sums({n})>", "exec"), scope)  # our own text, from numbers only
-    return scope["sums"]
+    exec(compile(src, f"<_unrolled_ahead({n})>", "exec"), scope)  # our own text, from numbers only
+    return scope["ahead"]
 
 
 def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: float) -> Vec:
@@ -243,12 +260,6 @@ def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: fl
     return sxt / (stt * dt), syt / (stt * dt)
 
 
-def _spread(values: list[float]) -> float:
-    """max - min (one sort of ten floats costs half of max() and min())."""
-    s = sorted(values)
-    return s[-1] - s[0]
-
-
 def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
     """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
     if not seen:  # nothing to explain them away: all of them
@@ -270,9 +281,9 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _slopes _window_sums _ahead _seen sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _slopes _window_ahead _ahead _seen sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponents _order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _opponent_memory "
+        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -284,16 +295,19 @@ class RobotView:
         self.n = n
         self.p = p
         self.lead = latency * dt  # [s] how far the view is behind the present
-        self._tracks: list[Columns] = []  # per opponent seen: its last detections
+        self._tracks: list[Tracked] = []  # per opponent seen: its last detections
         self._now: list[Vec] | None = []  # see `opponents_now`
-        # Per consecutive track length n: `_regression_velocity`'s tick offsets and stt * dt, and a bound:
-        # |prediction - last detection| <= reach * the spread of the detections (|sum d (x - mean)| <= sum |d| * spread)
-        self._slopes = {
-            n: (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
-            for n, (ds, stt) in _CONSECUTIVE.items()
-        }
         self._window = window = p.track_window
-        self._window_sums = (window, _unrolled_sums(window)) if window in _CONSECUTIVE else (-1, None)
+        # Per consecutive track length n (a list, indexed by n up to the longest track, for the cheapest lookup):
+        # `_regression_velocity`'s tick offsets and stt * dt, and a bound: |prediction - last detection| <= reach *
+        # the spread of the detections (|sum d (x - mean)| <= sum |d| * spread); None for n < 3 (no regression)
+        slopes: list[tuple[tuple[float, ...], float, float] | None] = [None] * (max(window, 1) + 1)
+        for k, (ds, stt) in _CONSECUTIVE.items():
+            if k < len(slopes):
+                slopes[k] = (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
+        self._slopes = slopes
+        full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
+        self._window_ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._seen: list[Vec] = []  # own opponent detections of this tick
         self.sensor = sensor
@@ -313,25 +327,27 @@ class RobotView:
         self._near: list[Vec] = []  # teammates seen this tick
         self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
-        self._order_opponents: list[tuple[int, Vec]] = []  # (age, position) of the order's P_B entries
-        self._order_opponent_xy: list[Vec] = []  # their positions ...
+        self._order_opponent_xy: list[Vec] = []  # the positions of the order's P_B entries ...
         self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
+        # [m] two points this far apart along one axis are not within merge_radius: d ** 2 >= _merge2 (pow errs
+        # by under an ulp, a sum of squares rounds up from either), so `_track` skips such a pair's distance
+        self._merge_far = abs(p.merge_radius) * (1 + 1e-9)
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
     def update(self, tick: int, sense: Sense | None, order: Order | None) -> None:
-        own_ball = self.own_ball
         seen: list[Vec] = []  # own detections: opponents ...
         near: list[Vec] = []  # ... and teammates
+        own_ball = self.own_ball
         if sense is not None:
             other = self.other
             for r in sense.robots:
                 (seen if r.team == other else near).append((r.x, r.y))
             p = sense.pose
             x, y, theta = self.pose = (p.x, p.y, p.theta)
-            c, s = math.cos(theta), math.sin(theta)
+            c, s = cos(theta), sin(theta)
             svx, svy = sense.vx, sense.vy
             vx, vy = self.vel = (c * svx - s * svy, s * svx + c * svy)
             lead = self.lead
@@ -341,20 +357,19 @@ class RobotView:
             b = sense.ball
             if b.visible:
                 own_ball.observe(tick, b.x, b.y)
+            if lead > 0.0:
+                if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
+                    self._track(sense.tick, seen)
+                self._seen = seen
+                self._now = None  # predicted when asked for (`opponents_now`, `opponents_near`)
         elif order is not None and self.pose is None:
-            for tp in order.own:
-                if tp.robot == self.n:
-                    self.pose = (tp.x, tp.y, tp.theta)
-                    vx, vy = self.vel
-                    lead = self.lead
-                    self.pose_now = (tp.x + vx * lead, tp.y + vy * lead) if lead != 0.0 else (tp.x, tp.y)
+            self._pose_from_order(order)
+        # The ball: the own detection or the order's, whichever is younger (the own one on a tie).
         track = own_ball.track
-        own_age = tick - track.tick if track is not None else 1 << 30
-        order_ball = order is not None and order.ball_valid
-        order_age = order.ball_age + (tick - order.tick) if order_ball else 1 << 30  # type: ignore[union-attr]
-        if own_age <= order_age and track is not None:
-            ball, self.ball_vel, age = (track.x, track.y), own_ball.vel, own_age
-        elif order_ball:
+        order_age = order.ball_age + (tick - order.tick) if order is not None and order.ball_valid else None
+        if track is not None and (order_age is None or tick - track.tick <= order_age):
+            ball, self.ball_vel, age = (track.x, track.y), own_ball.vel, tick - track.tick
+        elif order_age is not None:
             ball, self.ball_vel, age = (order.ball_x, order.ball_y), (0.0, 0.0), order_age  # type: ignore[union-attr]
         else:
             ball, self.ball_vel, age = None, (0.0, 0.0), 1 << 30
@@ -363,22 +378,36 @@ class RobotView:
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
             self._take_order(order)
         # The base station's entries that no own detection within merge_radius explains.
-        merge2 = self._merge2
         opponents = seen[:]
         if order is not None:
             memory = self._opponent_memory - (tick - order.tick)
-            if self._order_opponent_oldest <= memory:  # none too old (the usual case): all of them
-                entries = self._order_opponent_xy
-            else:
-                entries = [xy for age, xy in self._order_opponents if age <= memory]
-            _add_unexplained(opponents, entries, seen, merge2)
+            # none too old (the usual case): all of them
+            entries = self._order_opponent_xy if self._order_opponent_oldest <= memory else self._younger(memory)
+            merge2 = self._merge2
+            for xy in entries:  # `_add_unexplained`, inlined: the view's hottest loop
+                ex, ey = xy
+                for ox, oy in seen:
+                    dx, dy = ex - ox, ey - oy
+                    if dx * dx + dy * dy < merge2:
+                        break
+                else:
+                    opponents.append(xy)
         self.opponents = opponents
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
-        if self.lead > 0.0 and sense is not None:
-            if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
-                self._track(sense.tick, seen)
-            self._seen, self._now = seen, None  # predicted when asked for (`opponents_now`, `opponents_near`)
+
+    def _pose_from_order(self, order: Order) -> None:
+        """Before the first sense: the robot's own pose as the order lists it."""
+        for tp in order.own:
+            if tp.robot == self.n:
+                self.pose = (tp.x, tp.y, tp.theta)
+                vx, vy = self.vel
+                lead = self.lead
+                self.pose_now = (tp.x + vx * lead, tp.y + vy * lead) if lead != 0.0 else (tp.x, tp.y)
+
+    def _younger(self, memory: int) -> list[Vec]:
+        """The positions of the order's opponents no older than memory [ticks]."""
+        return [xy for tp, xy in zip(self._order.opponents, self._order_opponent_xy) if tp.age <= memory]  # type: ignore[union-attr]
 
     def _take_order(self, order: Order | None) -> None:
         """What follows from a new order alone: the teammates and the base station's opponents."""
@@ -386,7 +415,6 @@ class RobotView:
         self._order = order
         mates: dict[int, tuple[float, float, str]] = {}
         mate_xy: list[Vec] = []
-        entries: list[tuple[int, Vec]] = []
         xys: list[Vec] = []
         oldest = 0
         if order is not None:
@@ -397,39 +425,42 @@ class RobotView:
             for x, y, _ in mates.values():  # a robot listed twice: its last entry, as the dict holds
                 mate_xy.append((x, y))
             for tp in order.opponents:
-                xy, age = (tp.x, tp.y), tp.age
-                entries.append((age, xy))
-                xys.append(xy)
-                if age > oldest:  # never below 0: the filter in `update` then runs, with the same result
-                    oldest = age
+                xys.append((tp.x, tp.y))
+                if tp.age > oldest:  # never below 0: the filter in `update` then runs, with the same result
+                    oldest = tp.age
         self.mates, self._mate_xy = mates, mate_xy
-        self._order_opponents, self._order_opponent_xy, self._order_opponent_oldest = entries, xys, oldest
+        self._order_opponent_xy, self._order_opponent_oldest = xys, oldest
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
         old, merge2, window = self._tracks, self._merge2, self._window
-        tracks: list[Columns] = []
+        far = self._merge_far
+        nfar = -far
+        tracks: list[Tracked] = []
         for x, y in seen:
             best, best_d2 = None, merge2
             for t in old:
-                d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
-                if d2 < best_d2:
-                    best, best_d2 = t, d2
+                dx = t[0] - x
+                if dx < far and dx > nfar:  # farther apart along x: surely not within merge_radius (`_merge_far`)
+                    d2 = dx**2 + (t[1] - y) ** 2
+                    if d2 < best_d2:
+                        best, best_d2 = t, d2
             if best is None:
-                tracks.append(([tick], [x], [y]))
+                tracks.append((x, y, [tick], [x], [y]))
                 continue
             old.remove(best)
-            ts, xs, ys = best
-            if ts[-1] >= tick:  # the same sense again: the newer detection replaces it
+            _, _, ts, xs, ys = best
+            n = len(ts)
+            if ts[n - 1] >= tick:  # the same sense again: the newer detection replaces it (n - 1: not the slow -1)
                 ts.pop()
                 xs.pop()
                 ys.pop()
-            elif len(ts) >= window:  # a full window: its oldest detection goes (before the append: no regrowth)
+            elif n >= window:  # a full window: its oldest detection goes (before the append: no regrowth)
                 del ts[0], xs[0], ys[0]
             ts.append(tick)
             xs.append(x)
             ys.append(y)
-            tracks.append(best)
+            tracks.append((x, y, ts, xs, ys))
         self._tracks = tracks
         self._ahead = [None] * len(tracks)
 
@@ -456,34 +487,43 @@ class RobotView:
         if self._now is not None:
             return self._now
         ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
-        window, window_sums = self._window_sums
+        window, window_ahead = self._window_ahead
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
-        for k, (ts, xs, ys) in enumerate(self._tracks):
+        for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
             if p is None:
                 n = len(ts)
-                c = slopes.get(n) if ts[-1] - ts[0] == n - 1 else None
+                m = n - 1  # the last detection's index: a negative index takes the interpreter's slow path
+                c = slopes[n] if ts[m] - ts[0] == m else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
-                else:  # `_regression_velocity` of a consecutive track, inlined: the usual case
-                    ds, stt_dt, reach = c
-                    out_x = abs(xs[-1] - x) - rng  # [m] how far outside the box; the spread only then
-                    if out_x > 0.0 and out_x > reach * _spread(xs):
+                    p = ahead[k] = (lx + vx * lead, ly + vy * lead)
+                    out.append(p)
+                    continue
+                # `_regression_velocity` of a consecutive track, inlined: the usual case
+                ds, stt_dt, reach = c
+                d = lx - x
+                out_x = (d if d >= 0.0 else -d) - rng  # [m] how far outside the box (abs, inline); the spread only then
+                if out_x > 0.0:
+                    s = sorted(xs)  # the spread: one sort of ten floats costs half of max() and min()
+                    if out_x > reach * (s[m] - s[0]):
                         continue
-                    out_y = abs(ys[-1] - y) - rng
-                    if out_y > 0.0 and out_y > reach * _spread(ys):
+                d = ly - y
+                out_y = (d if d >= 0.0 else -d) - rng
+                if out_y > 0.0:
+                    s = sorted(ys)
+                    if out_y > reach * (s[m] - s[0]):
                         continue
-                    if n == window:  # a full window: the usual case
-                        sxt, syt = window_sums(xs, ys)
-                    else:
-                        mx = sum(xs) / n
-                        my = sum(ys) / n
-                        sxt = syt = 0.0
-                        for d, u, v in zip(ds, xs, ys):
-                            sxt += d * (u - mx)
-                            syt += d * (v - my)
-                    vx, vy = sxt / stt_dt, syt / stt_dt
-                p = ahead[k] = (xs[-1] + vx * lead, ys[-1] + vy * lead)
+                if n == window:  # a full window: the usual case
+                    p = ahead[k] = window_ahead(xs, ys)
+                else:
+                    mx = sum(xs) / n
+                    my = sum(ys) / n
+                    sxt = syt = 0.0
+                    for d, u, v in zip(ds, xs, ys):
+                        sxt += d * (u - mx)
+                        syt += d * (v - my)
+                    p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
         out.extend(self.opponents[len(self._seen) :])
         return out

@@ -12,7 +12,7 @@ from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import BallSeen, Order, Pose, RobotSeen, Sense, TeamPose
 from arena.strategies import registry
 from arena.strategies.base import RobotContext
-from arena.strategies.world import _CONSECUTIVE, FusionParams, RobotView, _regression_velocity, _unrolled_sums
+from arena.strategies.world import _CONSECUTIVE, FusionParams, RobotView, _regression_velocity, _unrolled_ahead
 
 
 def _gain_reference(d: float, phi: float, fis: fsfm.FIS) -> float:
@@ -162,20 +162,21 @@ def test_an_order_listing_a_robot_twice_gives_its_last_entry_once():
     assert view.opponents == [(1.0, 0.0), (4.0, 2.0)]  # negative ages (a bad order): none too old
 
 
-def test_the_unrolled_window_sums_are_the_regression_loops_bit_for_bit():
-    """`_unrolled_sums(n)` gives the sums of `_regression_velocity`'s loop for a consecutive track of n, bit for bit."""
+def test_the_unrolled_prediction_is_the_regression_loops_bit_for_bit():
+    """`_unrolled_ahead(n, ...)` moves a consecutive track's last detection by `_regression_velocity` bit for bit."""
     rng = random.Random(3)
-    dt = 0.02
     for n in range(3, 65):
-        sums = _unrolled_sums(n)
         _, stt = _CONSECUTIVE[n]
-        for _ in range(50):
-            t0 = rng.randrange(0, 100000)
-            x0, y0, vx, vy = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-3, 3), rng.uniform(-3, 3)
-            xs = [x0 + vx * dt * i + rng.gauss(0, 0.03) for i in range(n)]
-            ys = [y0 + vy * dt * i + rng.gauss(0, 0.03) for i in range(n)]
-            sxt, syt = sums(xs, ys)
-            assert (sxt / (stt * dt), syt / (stt * dt)) == _regression_velocity(list(range(t0, t0 + n)), xs, ys, dt)
+        for dt, latency in ((0.02, 3), (0.01, 1), (0.01, 7)):
+            lead = latency * dt
+            ahead = _unrolled_ahead(n, stt * dt, lead)
+            for _ in range(50):
+                t0 = rng.randrange(0, 100000)
+                x0, y0, vx, vy = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-3, 3), rng.uniform(-3, 3)
+                xs = [x0 + vx * dt * i + rng.gauss(0, 0.03) for i in range(n)]
+                ys = [y0 + vy * dt * i + rng.gauss(0, 0.03) for i in range(n)]
+                rvx, rvy = _regression_velocity(list(range(t0, t0 + n)), xs, ys, dt)
+                assert ahead(xs, ys) == (xs[-1] + rvx * lead, ys[-1] + rvy * lead)
 
 
 def test_segment_room_is_the_least_segment_distance_bit_for_bit():
@@ -267,3 +268,68 @@ def test_drive_narrows_the_push_guard_to_the_opponents_it_may_cap():
             cmds = [robot.drive(5, target, a, vmax, avoid=False, gain=gain, dribbler=has_ball) for robot in robots]
             assert msgspec.msgpack.encode(cmds[0]) == msgspec.msgpack.encode(cmds[1])
     assert len(asked[0]) == len(asked[1]) and sum(asked[0]) < 0.9 * sum(asked[1])
+
+
+def _tracked_reference(old: list, seen: list, tick: int, merge2: float, window: int) -> list:
+    """`RobotView._track` as plain formulas: each detection continues the nearest track within merge_radius."""
+    old, out = [(list(ts), list(xs), list(ys)) for _, _, ts, xs, ys in old], []
+    for x, y in seen:
+        best, best_d2 = None, merge2
+        for t in old:
+            d2 = (t[1][-1] - x) ** 2 + (t[2][-1] - y) ** 2
+            if d2 < best_d2:
+                best, best_d2 = t, d2
+        if best is None:
+            out.append((x, y, [tick], [x], [y]))
+            continue
+        old.remove(best)
+        for col, v in zip(best, (tick, x, y)):
+            if len(col) >= window:
+                del col[0]
+            col.append(v)
+        out.append((x, y, *best))
+    return out
+
+
+def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
+    """`_track` leaves out the distance of a pair farther apart along x than merge_radius; it continues the same
+    tracks as the plain nearest-within-merge_radius rule, pairs at the radius's edge included."""
+    cfg = MatchConfig()
+    rng = random.Random(9)
+    for radius in (0.5, 0.3, 1e-3):
+        view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams(merge_radius=radius), latency=3)
+        for tick in range(1, 400):
+            last = view._seen
+            seen = []
+            for _ in range(rng.randrange(0, 4)):
+                if last and rng.random() < 0.7:  # near a track's last detection, often at the radius along x
+                    a, b = rng.choice(last)
+                    dx = rng.choice((radius, -radius, math.nextafter(radius, 0), rng.uniform(-radius, radius)))
+                    seen.append((a + dx, b + rng.choice((0.0, rng.uniform(-0.01, 0.01)))))
+                else:
+                    seen.append((rng.uniform(-6, 6), rng.uniform(-4, 4)))
+            expected = _tracked_reference(view._tracks, seen, tick, view._merge2, view._window)
+            view._track(tick, seen)
+            view._seen = seen
+            assert view._tracks == expected
+
+
+def test_the_base_stations_ball_is_the_first_cluster_of_its_detections_bit_for_bit():
+    """`TeamModel.update`'s inlined ball fusion gives `cluster(detections, inf)[0]`, weights as `detection_sigma`'s."""
+    from arena.config import SensorParams
+    from arena.schemas.messages import Report
+    from arena.strategies.world import TeamModel, cluster, detection_sigma
+
+    rng = random.Random(13)
+    sensor = SensorParams()
+    for _ in range(500):
+        m = TeamModel("a", 3, sensor, 0.02)
+        reports, balls = {}, []
+        for n in range(rng.randrange(1, 4)):
+            px, py, bx, by = rng.uniform(-6, 6), rng.uniform(-4, 4), rng.uniform(-6, 6), rng.uniform(-4, 4)
+            pose = Pose(x=px, y=py, theta=0.0)
+            reports[n] = Report(tick=10, robot=n, pose=pose, ball=BallSeen(visible=True, x=bx, y=by))
+            s = detection_sigma(sensor, math.hypot(bx - px, by - py))
+            balls.append((bx, by, 1.0 / (s * s)))
+        m.update(10, reports)
+        assert m.ball_xy(10) == cluster(balls, math.inf)[0][:2]
