@@ -72,7 +72,8 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     match = _in(
         laptop,
         *py,
-        *("match", "--home", "BS", "--away", "BS", "--half-time", "10", "--seed", "3"),
+        # 2 x 60 s: long enough that the match still runs when the twin below comes (2 x 10 s could end first)
+        *("match", "--home", "BS", "--away", "BS", "--half-time", "60", "--seed", "3"),
         *("--external", "a/1", "--match", "lan", "--listen", "tcp/0.0.0.0:7447", "--json"),
     )
     reap.append(match)
@@ -98,7 +99,7 @@ def test_a_robot_on_another_host_joins_with_the_printed_command(two_hosts, reap)
     r_out, r_err = robot.communicate(timeout=30)
     assert robot.returncode == 0, r_err
     assert f"connected to {printed.split('--connect ')[1].split()[0]} (zenoh client)" in r_err, r_err
-    assert "match over at tick 1000 (END_GAME)" in r_err, r_err
+    assert "match over at tick 6000 (END_GAME)" in r_err, r_err
     result = json.loads(out)
     a1 = next(p for p in result["processes"] if (p["kind"], p["team"], p["robot"]) == ("robot", "a", 1))
     assert a1["external"] and result["distance_m"]["a/1"] > 0.5, "the robot across the network moved"
