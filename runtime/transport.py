@@ -205,12 +205,20 @@ class ZenohTransport:
             raw_put = _signed(pub.put, sign)
         if not when_matched:
             return raw_put
-        matched = [pub.matching_status]
+        matched = [True]
 
         def on_change(status: zenoh.MatchingStatus) -> None:
             matched[0] = status.matching
 
         self._keep.append(pub.declare_matching_listener(on_change))
+        # The status's `matching` (the status object itself is always true: every `world` frame was
+        # signed and put with nobody subscribed), read once the listener is there. Read again after
+        # it is set false: a subscriber that came between the first read and that store was heard
+        # by the listener before the store, and is seen by the second read. A stale true costs puts only.
+        if not pub.matching_status.matching:
+            matched[0] = False
+            if pub.matching_status.matching:
+                matched[0] = True
 
         def put(payload: bytes) -> None:
             if matched[0]:
