@@ -14,6 +14,7 @@ from __future__ import annotations
 import _thread
 import ctypes
 import functools
+import hmac
 import queue
 import threading
 from collections import defaultdict
@@ -21,6 +22,8 @@ from collections.abc import Callable
 from typing import Protocol
 
 import zenoh
+
+from arena.runtime import mac
 
 # Threads that hold a Python thread state of their own for good (`keep_thread_state`).
 _KEPT: set[int] = set()
@@ -199,20 +202,23 @@ class ZenohTransport:
         self._pubs[key] = pub
         raw_put = pub.put
         if sign is not None:
-            pub_put = pub.put
-
-            def signed_put(payload: bytes) -> None:
-                pub_put(payload, attachment=sign(payload))
-
-            raw_put = signed_put
+            raw_put = _signed(pub.put, sign)
         if not when_matched:
             return raw_put
-        matched = [pub.matching_status]
+        matched = [True]
 
         def on_change(status: zenoh.MatchingStatus) -> None:
             matched[0] = status.matching
 
         self._keep.append(pub.declare_matching_listener(on_change))
+        # The status's `matching` (the status object itself is always true: every `world` frame was
+        # signed and put with nobody subscribed), read once the listener is there. Read again after
+        # it is set false: a subscriber that came between the first read and that store was heard
+        # by the listener before the store, and is seen by the second read. A stale true costs puts only.
+        if not pub.matching_status.matching:
+            matched[0] = False
+            if pub.matching_status.matching:
+                matched[0] = True
 
         def put(payload: bytes) -> None:
             if matched[0]:
@@ -241,22 +247,7 @@ class ZenohTransport:
         verify: Verify | None = None,
         on_forged: Callable[[], None] | None = None,
     ) -> None:
-        if verify is None:
-
-            def on_sample(sample: zenoh.Sample) -> None:
-                keep_thread_state()
-                callback(sample.payload.to_bytes())
-
-        else:
-
-            def on_sample(sample: zenoh.Sample) -> None:
-                keep_thread_state()
-                payload = sample.payload.to_bytes()
-                if payload == WAKE or verify(payload, _attachment(sample)):
-                    callback(payload)
-                elif on_forged is not None:
-                    on_forged()
-
+        on_sample = _on_sample(callback, verify, on_forged)
         # indirect=False: run on zenoh's receive thread itself. The default hands
         # every sample to a Python thread of its own, one more wake-up per frame.
         handler = zenoh.handlers.Callback(on_sample, indirect=False)
@@ -343,6 +334,58 @@ class ZenohTransport:
             _undeclare(entity)
         self._keep.clear()
         self._pubs.clear()
+
+
+# Every frame of a lockstep match goes through one of these two, in the zenoh thread: each is
+# one Python frame (the MAC of runtime/mac.py worked out inline, the thread state kept only the
+# first time a thread comes), not the three to five calls of a signer, a verifier and their helpers.
+def _signed(pub_put: Callable[..., None], sign: Sign) -> Callable[[bytes], None]:
+    """`pub_put(payload, attachment=sign(payload))` as one function."""
+    copy = mac.copy_of(sign)
+    if copy is None:
+        return lambda payload: pub_put(payload, attachment=sign(payload))
+
+    def signed_put(payload: bytes) -> None:
+        h = copy()
+        h.update(payload)
+        pub_put(payload, attachment=h.digest())
+
+    return signed_put
+
+
+def _on_sample(
+    callback: Callable[[bytes], None], verify: Verify | None, on_forged: Callable[[], None] | None
+) -> Callable[[zenoh.Sample], None]:
+    """A zenoh callback: `callback(payload)` for a frame `verify` passes (or a WAKE), else `on_forged()`."""
+    kept, ident = _KEPT, _thread.get_ident
+    if verify is None:
+
+        def on_sample(sample: zenoh.Sample) -> None:
+            if ident() not in kept:
+                keep_thread_state()
+            callback(sample.payload.to_bytes())
+
+        return on_sample
+    copy, equal = mac.copy_of(verify), hmac.compare_digest
+
+    def on_verified(sample: zenoh.Sample) -> None:
+        if ident() not in kept:
+            keep_thread_state()
+        payload = sample.payload.to_bytes()
+        if copy is None:
+            good = verify(payload, _attachment(sample))
+        elif (a := sample.attachment) is None:
+            good = False
+        else:
+            h = copy()
+            h.update(payload)
+            good = equal(a.to_bytes(), h.digest())
+        if good or payload == WAKE:
+            callback(payload)
+        elif on_forged is not None:
+            on_forged()
+
+    return on_verified
 
 
 def _every_answer(verify: Verify | None) -> zenoh.ConsolidationMode | None:

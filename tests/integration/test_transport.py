@@ -172,3 +172,37 @@ def test_a_process_with_the_engines_key_never_takes_a_strangers_configuration(tm
         assert forged[0] >= 1
         for t in (liar, rx):
             t.close()
+
+
+def test_a_viewers_only_key_is_put_only_while_someone_subscribes(tmp_path):
+    """`publisher(when_matched=True)` (the engine's `world`): nothing is signed or put while nobody
+    subscribes; once a subscriber comes, its frames arrive. zenoh's MatchingStatus object is always
+    true: taken for the flag itself, every frame was signed and put to nobody."""
+    signed: list[bytes] = []
+    got: list[bytes] = []
+
+    def sign(payload: bytes) -> bytes:
+        signed.append(payload)
+        return b"mac"
+
+    endpoint = f"unixsock-stream/{tmp_path}/s.sock"
+    with (
+        open_session(NetConfig(mode="peer", listen=(endpoint,))) as sender,
+        open_session(NetConfig(mode="peer", connect=(endpoint,))) as viewer,
+    ):
+        tx, rx = ZenohTransport(sender), ZenohTransport(viewer)
+        put = tx.publisher("arena/w/world", when_matched=True, sign=sign)
+        time.sleep(0.3)  # the sessions are linked: a subscriber now would be known
+        for i in range(20):
+            put(bytes([i]))
+        assert signed == [], "nobody subscribes: nothing signed, nothing put"
+        rx.subscribe_callback("arena/w/world", got.append)
+
+        def arrived() -> bool:
+            put(b"x")
+            return bool(got)
+
+        wait_for(arrived, 10, "a frame for the subscriber")
+        assert signed and got[0] == b"x"
+        tx.close()
+        rx.close()

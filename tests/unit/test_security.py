@@ -129,6 +129,51 @@ def test_a_signer_and_a_verifier_reused_frame_after_frame_give_exactly_tag():
         assert ok(payload, sign(payload)) and not ok(payload, other(payload)) and not ok(payload + b"x", sign(payload))
 
 
+class _Bytes:
+    def __init__(self, raw: bytes):
+        self.raw = raw
+
+    def to_bytes(self) -> bytes:
+        return self.raw
+
+
+class _Sample:  # what a zenoh callback reads of a sample: payload and attachment
+    def __init__(self, payload: bytes, attachment: bytes | None):
+        self.payload = _Bytes(payload)
+        self.attachment = None if attachment is None else _Bytes(attachment)
+
+
+def test_the_transports_signed_put_and_verified_callback_work_out_exactly_tag():
+    """runtime/transport.py tags and checks inline (the keyed prefix copied in its own frame): every
+    frame carries exactly `tag`; a missing or wrong MAC is forged, a local WAKE passes."""
+    from arena.runtime.transport import WAKE, _on_sample, _signed
+
+    key, expr = bytes(range(32)), "arena/m/robot/a/0/cmd"
+    ring = Keyring("engine", {"robot/a/0": key})
+    sent: list[tuple[bytes, bytes]] = []
+    put = _signed(
+        lambda p, attachment: sent.append((p, attachment)), Keyring("robot/a/0", {"robot/a/0": key}).signer(expr)
+    )
+    got: list[bytes] = []
+    forged: list[int] = []
+    on_sample = _on_sample(got.append, ring.verifier("robot/a/0", expr), lambda: forged.append(1))
+    for payload in (b"\x82" * 300, b"", b"\x81\xa1a\x01"):
+        put(payload)
+        assert sent[-1] == (payload, tag(key, expr, payload))
+        on_sample(_Sample(*sent[-1]))
+        assert got[-1] == payload and not forged
+    for attachment in (None, tag(key, "arena/m/robot/a/1/cmd", b"\x82"), tag(bytes(32), expr, b"\x82")):
+        on_sample(_Sample(b"\x82", attachment))
+    assert len(forged) == 3 and len(got) == 3
+    on_sample(_Sample(WAKE, None))
+    assert got[-1] == WAKE and len(forged) == 3
+    # A verifier that is not runtime/mac.py's is asked as it is.
+    plain = _on_sample(got.append, lambda p, a: a == b"ok", lambda: forged.append(1))
+    plain(_Sample(b"x", b"ok"))
+    plain(_Sample(b"y", b"no"))
+    assert got[-1] == b"x" and len(forged) == 4
+
+
 def test_only_the_operator_puts_operator_frames_and_only_the_engine_and_referee_read_them():
     key = f"{P}operator"
     puts = {p for p in principals(NAMES) if key in permissions(p, P, 3).get("put/ingress", [])}
