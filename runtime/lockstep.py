@@ -229,9 +229,12 @@ class Outbound(Generic[M]):
     `sense`): with n <= L, nothing held on one half is due on the other
     (config/__init__.py `frames_per_message`), and flushing there too cost
     ~5 % of a batched distributed match.
+
+    `unbatched()`: one frame per message whatever `batch` asks (a cooperative
+    match's node, where nothing goes on a wire: `Node.out`).
     """
 
-    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last", "_heads")
+    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last", "_heads", "_single")
 
     def __init__(self, key: str, rel: str, put: Callable[[bytes], None], digest: hashlib.blake2b):
         self.key = key
@@ -244,9 +247,17 @@ class Outbound(Generic[M]):
         self._size = 1
         self._last = 0
         self._heads: dict[int, bytes] = {}  # payload length -> rel + that length, as the digest takes them
+        self._single = False  # `unbatched`
+
+    def unbatched(self) -> None:
+        """One frame per message from now on, whatever `batch` asks: the same frames, digest and order."""
+        self._single = True
+        self.batch(1, self._last)
 
     def batch(self, size: int, last: int) -> None:
         """Send `size` frames per message (ticks aligned to multiples of `size`); 1: one per message."""
+        if self._single:
+            size = 1
         self._buf = [] if size > 1 else None
         self._size = size
         self._last = last
