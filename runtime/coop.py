@@ -28,8 +28,9 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
 from arena.runtime.drivers import Wait, advance, subscribe
-from arena.runtime.lockstep import Inbound, Waits
+from arena.runtime.lockstep import BATCH_HEADS, Inbound, Waits
 from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
+from arena.schemas.keys import MAX_FRAME_BYTES
 from arena.schemas.messages import Summary
 
 if TYPE_CHECKING:
@@ -76,11 +77,12 @@ class CoopLink:
     frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
     queue at each wait, without the queue (a deque, its drain and two `try_recv` per frame)."""
 
-    __slots__ = ("_ib", "_accept", "waiter", "_wake")
+    __slots__ = ("_ib", "_accept", "_one", "waiter", "_wake")
 
     def __init__(self, ib: Inbound[Any], wake: Callable[[Task], None]):
         self._ib = ib
         self._accept = ib._accept_frame
+        self._one = ib._accept_one
         self.waiter: Task | None = None
         self._wake = wake
 
@@ -88,6 +90,8 @@ class CoopLink:
         ib = self._ib
         if payload == WAKE:  # `Inbound.feed`, inlined
             ib.woken = True
+        elif payload and payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
+            self._one(payload, None)  # what `_accept_frame` does with one frame: one call less a frame
         else:
             self._accept(payload, None)
         w = self.waiter
