@@ -51,7 +51,7 @@ from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.keys import MAX_BATCH, MAX_FRAME_BYTES
 from arena.schemas.messages import Base
-from arena.schemas.validate import nonfinite, safe_default, suspect
+from arena.schemas.validate import SUSPECT_CLASSES, nonfinite, safe_default, suspect
 
 M = TypeVar("M", bound=Base)
 _heappush, _heappop = heapq.heappush, heapq.heappop
@@ -447,7 +447,8 @@ class Inbound(Generic[M]):
         # In sequence: the link advances whatever the content. A frame that fails
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
-        problem = None if clean or not suspect(raw) else nonfinite(raw, msg)
+        # `suspect(raw)` inlined (one call less a frame; b"\x01\x02" is its SUSPECT_PAIR, a constant here)
+        problem = None if clean or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0 else nonfinite(raw, msg)
         if problem is None and self._check is not None:
             problem = self._check(msg)
         if problem:

@@ -28,10 +28,11 @@ from arena.schemas.messages import Base, Cmd, EngineEvents, Referee
 
 # msgpack float 64 (0xcb) and float 32 (0xca), big-endian: a non-finite value has
 # its exponent bits all set, so its first byte is 0x7f or 0xff. Translated through
-# _CLASSES (a header to 1, such a first byte to 2, any other byte to 0), a payload
-# holds b"\x01\x02" where it holds any of the four pairs: one scan instead of four,
+# SUSPECT_CLASSES (a header to 1, such a first byte to 2, any other byte to 0), a payload
+# holds SUSPECT_PAIR where it holds any of the four pairs: one scan instead of four,
 # which were ~6 % of a match's CPU in one process.
-_CLASSES = bytes(1 if b in (0xCA, 0xCB) else 2 if b in (0x7F, 0xFF) else 0 for b in range(256))
+SUSPECT_CLASSES = bytes(1 if b in (0xCA, 0xCB) else 2 if b in (0x7F, 0xFF) else 0 for b in range(256))
+SUSPECT_PAIR = b"\x01\x02"
 
 
 def first_problem(value: object, leaf: Callable[[object, str], str | None], path: str = "") -> str | None:
@@ -70,7 +71,7 @@ def suspect(raw: bytes) -> bool:
     """Whether `raw` holds a msgpack float header followed by the first byte of a non-finite value."""
     # `find`, not `in`: bytes' `in` first tries its operand as an integer, and builds and drops a
     # TypeError's message for every other operand (~1,800 instructions a call, more than the scan).
-    return raw.translate(_CLASSES).find(b"\x01\x02") >= 0
+    return raw.translate(SUSPECT_CLASSES).find(SUSPECT_PAIR) >= 0
 
 
 def safe_default(msg: Base, previous: Base | None) -> Base | None:
