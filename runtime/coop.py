@@ -105,7 +105,8 @@ class CoopLink:
         the first byte of a non-finite value can make it suspect (schemas/validate.py `suspect`, which
         also looks for float32 headers): two `find`s, about half the full scan, which a hit still gets."""
         if payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
-            self._one(payload, None, payload.find(b"\xcb\x7f") < 0 and payload.find(b"\xcb\xff") < 0)
+            clean = payload.find(b"\xcb\x7f") < 0 and payload.find(b"\xcb\xff") < 0 or _finite64(payload)
+            self._one(payload, None, clean)
         else:
             self._accept(payload, None)
         w = self.waiter
@@ -118,6 +119,20 @@ class CoopLink:
 
     def recv(self) -> bytes:
         raise WouldBlock("recv on a cooperative link (lockstep only; no --realtime)")
+
+
+def _finite64(raw: bytes) -> bool:
+    """No 0xcb header in `raw` starts a non-finite float64 (exponent bits all set: 0x7f or 0xff, then
+    0xf0 or more). A pair found in a float's other bytes (about 1 frame in 600; 46 of 50 in a 2 x 20 s
+    match) is then not walked field by field for nothing (`validate.first_problem`)."""
+    n = len(raw) - 2
+    for pair in (b"\xcb\x7f", b"\xcb\xff"):
+        i = raw.find(pair)
+        while i >= 0:
+            if i >= n or raw[i + 2] >= 0xF0:
+                return False
+            i = raw.find(pair, i + 1)
+    return True
 
 
 def _own_put(ch: CoopChannel | CoopLink) -> Callable[[bytes], None]:
