@@ -196,13 +196,3 @@ def test_a_cooperative_link_replaces_a_non_finite_frame_whether_its_own_process_
     assert h.rej.by_reason == {"invalid": 4}
     assert [c.vx for c in h.inbound.take(7)] == [1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 3.0]
 
-
-def test_a_pair_in_a_floats_other_bytes_is_no_non_finite_float64():
-    import struct
-
-    from arena.runtime.coop import _finite64
-
-    assert _finite64(struct.pack(">Bd", 0xCB, 1.0) + b"\xcb\x7f\x00")  # 0xcb 0x7f 0x00: a mantissa's bytes
-    for bad in (float("nan"), float("inf"), -float("inf"), -float("nan")):
-        assert not _finite64(b"\x81\xa1x" + struct.pack(">Bd", 0xCB, bad)), bad
-    assert not _finite64(b"\xcb\xff"), "cut short: not known to be clean"
