@@ -329,7 +329,7 @@ class Inbound(Generic[M]):
     __slots__ = (
         "key msg_type _decode channel schedule _period lag link_class sender emulator _dt_ms _rej _watchdog "
         "_is_dead _on_dead _check strict paired last_seen dead _next _hold ready_below woken _pending latest "
-        "_mask _recent _prev _stand_in _dropped_ticks waited _last_at __dict__"
+        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at __dict__"
     ).split()
 
     def __init__(
@@ -387,7 +387,7 @@ class Inbound(Generic[M]):
         self._mask = (1 << (RECENT * schedule.period - 1).bit_length()) - 1
         self._recent: list[bytes | None] = [None] * (self._mask + 1)
         self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
-        self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
+        self._stood_in = -1  # the last tick whose accepted frame was invalid, stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
         self.waited = -1  # the last k its lockstep loop yielded it with (set by the drivers' `advance`)
 
@@ -443,7 +443,6 @@ class Inbound(Generic[M]):
         # A ring by tick: one store a frame (a dict of ticks and a deque of their order took ~1 % of
         # an in-process match).
         self._recent[tick & self._mask] = raw
-        self._stand_in = False
         # In sequence: the link advances whatever the content. A frame that fails
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
@@ -452,10 +451,8 @@ class Inbound(Generic[M]):
         if problem is None and self._check is not None:
             problem = self._check(msg)
         if problem:
-            self._rej.reject(self.key, "invalid", problem)
-            msg = safe_default(msg, self._prev)  # type: ignore[assignment]
-            self._stand_in = True
-        if msg is not None:
+            msg = self._stand_in(msg, problem)
+        else:
             self._prev = msg
         self.last_seen = tick
         em = self.emulator
@@ -483,6 +480,15 @@ class Inbound(Generic[M]):
             self._last_at = at
         _heappush(self._pending, (at, tick, msg))
         return True
+
+    def _stand_in(self, msg: M, problem: str) -> M | None:
+        """An invalid frame in sequence, counted: what stands in for it (schemas/validate.py `safe_default`)."""
+        self._rej.reject(self.key, "invalid", problem)
+        self._stood_in = msg.tick
+        stand_in = safe_default(msg, self._prev)
+        if stand_in is not None:
+            self._prev = stand_in
+        return stand_in  # type: ignore[return-value]
 
     def _refuse(self, raw: bytes, msg: M, why: str) -> bool:
         """A frame out of sequence: a conflict if a different frame was accepted for its tick, else counted."""
@@ -527,7 +533,7 @@ class Inbound(Generic[M]):
         self._rej.conflict(self.key, msg.tick)  # type: ignore[attr-defined]
         if (
             msg.tick != self.last_seen
-            or not self._stand_in
+            or self._stood_in != msg.tick
             or nonfinite(raw, msg)
             or (self._check is not None and self._check(msg))
         ):
@@ -536,7 +542,7 @@ class Inbound(Generic[M]):
             if tick == msg.tick:  # type: ignore[attr-defined]
                 self._pending[i] = (at, tick, msg)  # same order keys: still a heap
                 self._prev = msg
-                self._stand_in = False
+                self._stood_in = -1
                 return
 
     # ------------------------------------------------- what drivers ask of a link

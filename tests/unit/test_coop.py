@@ -195,4 +195,3 @@ def test_a_cooperative_link_replaces_a_non_finite_frame_whether_its_own_process_
     h.close()
     assert h.rej.by_reason == {"invalid": 4}
     assert [c.vx for c in h.inbound.take(7)] == [1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 3.0]
-
