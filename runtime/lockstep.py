@@ -293,8 +293,9 @@ class Outbound(Generic[M]):
         # The digest takes rel, the payload's length (4 bytes, little-endian), the payload: the
         # first two as one prebuilt header per length (the same bytes, one update less).
         n = len(payload)
-        head = self._heads.get(n)
-        if head is None:
+        try:
+            head = self._heads[n]  # a subscript, not `get`: no method call
+        except KeyError:
             head = self._heads[n] = self.rel + n.to_bytes(4, "little")
         d = self._digest
         d.update(head)
@@ -329,7 +330,7 @@ class Inbound(Generic[M]):
     __slots__ = (
         "key msg_type _decode channel schedule _period lag link_class sender emulator _dt_ms _rej _watchdog "
         "_is_dead _on_dead _check strict paired last_seen dead _next _hold ready_below woken _pending latest "
-        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at __dict__"
+        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time __dict__"
     ).split()
 
     def __init__(
@@ -360,6 +361,7 @@ class Inbound(Generic[M]):
         self.link_class = link_class
         self.sender = sender
         self.emulator = emulator
+        self._on_time = emulator.on_time  # `emulator.on_time`, kept here (one attribute read less a frame)
         self._dt_ms = dt * 1000.0
         self._rej = rejections
         self._watchdog = watchdog
@@ -455,9 +457,8 @@ class Inbound(Generic[M]):
         else:
             self._prev = msg
         self.last_seen = tick
-        em = self.emulator
-        if em.on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
-            em.frames += 1
+        if self._on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
+            self.emulator.frames += 1
             if msg is not None:
                 at = (tick if now_tick is None else now_tick) + self.lag
                 if at >= self._last_at:  # every frame of an ideal link: no push's compare (~300 instructions)
@@ -466,7 +467,9 @@ class Inbound(Generic[M]):
                 else:
                     _heappush(self._pending, (at, tick, msg))
             return True
+        em = self.emulator
         delay = em.decide(tick)
+        self._on_time = em.on_time  # (a scenario's last link change made it ideal for good)
         if delay is None:
             self._dropped_ticks.append(tick)
             return True
