@@ -51,7 +51,7 @@ from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.keys import MAX_BATCH, MAX_FRAME_BYTES
 from arena.schemas.messages import Base
-from arena.schemas.validate import nonfinite, safe_default, suspect
+from arena.schemas.validate import SUSPECT_CLASSES, nonfinite, safe_default, suspect
 
 M = TypeVar("M", bound=Base)
 _heappush, _heappop = heapq.heappush, heapq.heappop
@@ -229,9 +229,12 @@ class Outbound(Generic[M]):
     `sense`): with n <= L, nothing held on one half is due on the other
     (config/__init__.py `frames_per_message`), and flushing there too cost
     ~5 % of a batched distributed match.
+
+    `unbatched()`: one frame per message whatever `batch` asks (a cooperative
+    match's node, where nothing goes on a wire: `Node.out`).
     """
 
-    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last", "_heads")
+    __slots__ = ("key", "rel", "_put", "_digest", "_encode", "sent", "_buf", "_size", "_last", "_heads", "_single")
 
     def __init__(self, key: str, rel: str, put: Callable[[bytes], None], digest: hashlib.blake2b):
         self.key = key
@@ -244,9 +247,17 @@ class Outbound(Generic[M]):
         self._size = 1
         self._last = 0
         self._heads: dict[int, bytes] = {}  # payload length -> rel + that length, as the digest takes them
+        self._single = False  # `unbatched`
+
+    def unbatched(self) -> None:
+        """One frame per message from now on, whatever `batch` asks: the same frames, digest and order."""
+        self._single = True
+        self.batch(1, self._last)
 
     def batch(self, size: int, last: int) -> None:
         """Send `size` frames per message (ticks aligned to multiples of `size`); 1: one per message."""
+        if self._single:
+            size = 1
         self._buf = [] if size > 1 else None
         self._size = size
         self._last = last
@@ -282,8 +293,9 @@ class Outbound(Generic[M]):
         # The digest takes rel, the payload's length (4 bytes, little-endian), the payload: the
         # first two as one prebuilt header per length (the same bytes, one update less).
         n = len(payload)
-        head = self._heads.get(n)
-        if head is None:
+        try:
+            head = self._heads[n]  # a subscript, not `get`: no method call
+        except KeyError:
             head = self._heads[n] = self.rel + n.to_bytes(4, "little")
         d = self._digest
         d.update(head)
@@ -318,7 +330,7 @@ class Inbound(Generic[M]):
     __slots__ = (
         "key msg_type _decode channel schedule _period lag link_class sender emulator _dt_ms _rej _watchdog "
         "_is_dead _on_dead _check strict paired last_seen dead _next _hold ready_below woken _pending latest "
-        "_mask _recent _prev _stand_in _dropped_ticks waited _last_at __dict__"
+        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time __dict__"
     ).split()
 
     def __init__(
@@ -349,6 +361,7 @@ class Inbound(Generic[M]):
         self.link_class = link_class
         self.sender = sender
         self.emulator = emulator
+        self._on_time = emulator.on_time  # `emulator.on_time`, kept here (one attribute read less a frame)
         self._dt_ms = dt * 1000.0
         self._rej = rejections
         self._watchdog = watchdog
@@ -376,7 +389,7 @@ class Inbound(Generic[M]):
         self._mask = (1 << (RECENT * schedule.period - 1).bit_length()) - 1
         self._recent: list[bytes | None] = [None] * (self._mask + 1)
         self._prev: M | None = None  # the last accepted message (an invalid frame's stand-in)
-        self._stand_in = False  # the last accepted frame was invalid and stood in for by a safe default
+        self._stood_in = -1  # the last tick whose accepted frame was invalid, stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
         self.waited = -1  # the last k its lockstep loop yielded it with (set by the drivers' `advance`)
 
@@ -432,23 +445,20 @@ class Inbound(Generic[M]):
         # A ring by tick: one store a frame (a dict of ticks and a deque of their order took ~1 % of
         # an in-process match).
         self._recent[tick & self._mask] = raw
-        self._stand_in = False
         # In sequence: the link advances whatever the content. A frame that fails
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
-        problem = None if clean or not suspect(raw) else nonfinite(raw, msg)
+        # `suspect(raw)` inlined (one call less a frame; b"\x01\x02" is its SUSPECT_PAIR, a constant here)
+        problem = None if clean or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0 else nonfinite(raw, msg)
         if problem is None and self._check is not None:
             problem = self._check(msg)
         if problem:
-            self._rej.reject(self.key, "invalid", problem)
-            msg = safe_default(msg, self._prev)  # type: ignore[assignment]
-            self._stand_in = True
-        if msg is not None:
+            msg = self._stand_in(msg, problem)
+        else:
             self._prev = msg
         self.last_seen = tick
-        em = self.emulator
-        if em.on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
-            em.frames += 1
+        if self._on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
+            self.emulator.frames += 1
             if msg is not None:
                 at = (tick if now_tick is None else now_tick) + self.lag
                 if at >= self._last_at:  # every frame of an ideal link: no push's compare (~300 instructions)
@@ -457,7 +467,9 @@ class Inbound(Generic[M]):
                 else:
                     _heappush(self._pending, (at, tick, msg))
             return True
+        em = self.emulator
         delay = em.decide(tick)
+        self._on_time = em.on_time  # (a scenario's last link change made it ideal for good)
         if delay is None:
             self._dropped_ticks.append(tick)
             return True
@@ -471,6 +483,15 @@ class Inbound(Generic[M]):
             self._last_at = at
         _heappush(self._pending, (at, tick, msg))
         return True
+
+    def _stand_in(self, msg: M, problem: str) -> M | None:
+        """An invalid frame in sequence, counted: what stands in for it (schemas/validate.py `safe_default`)."""
+        self._rej.reject(self.key, "invalid", problem)
+        self._stood_in = msg.tick
+        stand_in = safe_default(msg, self._prev)
+        if stand_in is not None:
+            self._prev = stand_in
+        return stand_in  # type: ignore[return-value]
 
     def _refuse(self, raw: bytes, msg: M, why: str) -> bool:
         """A frame out of sequence: a conflict if a different frame was accepted for its tick, else counted."""
@@ -515,7 +536,7 @@ class Inbound(Generic[M]):
         self._rej.conflict(self.key, msg.tick)  # type: ignore[attr-defined]
         if (
             msg.tick != self.last_seen
-            or not self._stand_in
+            or self._stood_in != msg.tick
             or nonfinite(raw, msg)
             or (self._check is not None and self._check(msg))
         ):
@@ -524,7 +545,7 @@ class Inbound(Generic[M]):
             if tick == msg.tick:  # type: ignore[attr-defined]
                 self._pending[i] = (at, tick, msg)  # same order keys: still a heap
                 self._prev = msg
-                self._stand_in = False
+                self._stood_in = -1
                 return
 
     # ------------------------------------------------- what drivers ask of a link

@@ -400,6 +400,10 @@ class Node(Peer):
             ob: Outbound[Any] = Outbound(key, self.keys.rel(key), put, self.digest)
         else:
             ob = TappedOutbound(key, self.keys.rel(key), put, self.digest, self.tap)
+        if self.cooperative and not self.cfg.timing.batch:
+            # No wire in a cooperative match: a batch's encode, decode and scan buy nothing there, and a
+            # batch is a transport detail (the same digests). An explicit `timing.batch` still batches.
+            ob.unbatched()
         if name in SERVED:
             latest = Latest()
             ob.put_through(latest.wrap)

@@ -274,7 +274,8 @@ k+N-1 needs the commands up to k+N-2, and a robot has those only if N <= L).
 A sender puts a batch early, shorter than N, whenever it is about to wait for
 an input itself, so a receiver must take batches of any length from 1 to
 {MAX_BATCH} (a frame held back could be what the sender waits for, through
-other links). With `--realtime` every frame is its own message. The batch size is a
+other links). With `--realtime` every frame is its own message, and in one process (no
+wire) too unless `timing.batch` is set. The batch size is a
 transport detail: the digest covers the frames, one by one, not the messages.
 
 **QoS of a put.** Every data key, `{SUMMARY}`, `{TAP}` and `{ACK}`: reliability

@@ -86,8 +86,8 @@ def add_match_flags(
         type=int,
         default=None,
         metavar="N",
-        help="sense/cmd frames per message, 1..perception latency; 0 = as many as it allows (a transport "
-        "detail: digests are the same for every N), e.g. --batch 1 for one frame per message (0)",
+        help="sense/cmd frames per message, 1..perception latency; 0 = as many as it allows, one in process (a "
+        "transport detail: digests are the same for every N), e.g. --batch 1 for one frame per message (0)",
     )
 
 

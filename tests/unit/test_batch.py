@@ -114,11 +114,25 @@ def test_the_batch_size_is_a_transport_detail_and_the_latency_is_the_model(laten
 @pytest.mark.parametrize("latency", [6, 7, 12, 25])
 @pytest.mark.parametrize(("comm", "referee"), [(5, 5), (1, 1), (10, 3)])
 def test_no_latency_batch_or_period_deadlocks(latency, comm, referee):
-    """The old aligned batches deadlocked from L = 6 on (196 of 376 such settings)."""
+    """The old aligned batches deadlocked from L = 6 on (196 of 376 such settings). Batches of L, as a
+    distributed match puts them (in process they are only put when `timing.batch` asks)."""
     timing = dataclasses.replace(
-        MatchConfig().timing, perception_latency=latency, comm_period=comm, referee_period=referee
+        MatchConfig().timing, perception_latency=latency, comm_period=comm, referee_period=referee, batch=latency
     )
     cfg = MatchConfig(home="AD", away="BS", half_time=1.0, seed=latency, timing=timing)
     summaries, _ = play_in_process(cfg, watch=())
     assert summaries["engine"].tick == cfg.total_ticks
     assert not any(s.dead for s in summaries.values())
+
+
+def test_in_process_frames_go_one_per_message_unless_a_batch_size_is_asked():
+    """No wire in a cooperative match: `timing.batch` 0 (L) puts one frame per message there."""
+    from arena.match.inprocess import Stepped
+
+    def batching(batch: int) -> set[bool]:
+        timing = dataclasses.replace(MatchConfig().timing, perception_latency=3, batch=batch)
+        nodes = Stepped(MatchConfig(home="AD", away="BS", timing=timing)).nodes.values()
+        return {n.cmd_out.batching for n in nodes if n.name.startswith("robot/")}
+
+    assert batching(0) == {False}
+    assert batching(3) == {True}

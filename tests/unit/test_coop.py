@@ -166,3 +166,32 @@ def test_a_straightened_publisher_puts_into_its_one_target_and_a_later_subscribe
     assert got[:2] == [encode(Cmd(tick=0))] * 2 and got[2:4] == [encode(Cmd(tick=1))] * 2 and got[4:] == [None] * 2
     assert [later.try_recv() for _ in range(3)] == [encode(Cmd(tick=1))] * 2 + [None], "the later subscriber too"
     assert latest.get() == encode(Cmd(tick=1))
+
+
+def test_a_cooperative_link_replaces_a_non_finite_frame_whether_its_own_process_or_another_put_it():
+    """`CoopLink.put_own` (a publisher of this process, msgspec: float64 only) scans for two pairs,
+    `put` (anything else, e.g. a replay's recorded frames) for all four (`validate.suspect`)."""
+    import hashlib
+    import math
+    import struct
+
+    from arena.runtime import coop
+    from arena.runtime.lockstep import Outbound
+    from arena.schemas.messages import Cmd, encode
+    from tests.unit.test_lockstep import KEY, Harness
+
+    h = Harness()
+    bus = coop.CoopBus()
+    coop.connect(h.inbound, coop.MemoryTransport(bus), None, None)
+    ob = Outbound(KEY, "robot/a/1/cmd", coop.MemoryTransport(bus).publisher(KEY), hashlib.blake2b())
+    bus.straighten([ob])
+    assert ob._put == h.inbound.channel.put_own
+    for vx in (1.0, math.nan, -math.inf, math.inf, 2.0):
+        ob.send(Cmd(tick=h.inbound.last_seen + 1, vx=vx))
+    float32_nan = encode(Cmd(tick=5, vx=1.5)).replace(struct.pack(">Bd", 0xCB, 1.5), b"\xca\x7f\xc0\x00\x00")
+    assert h.inbound._decode(float32_nan).vx != h.inbound._decode(float32_nan).vx  # NaN, as a float32
+    bus.deliver(KEY, float32_nan)
+    bus.deliver(KEY, encode(Cmd(tick=6, vx=3.0)))
+    h.close()
+    assert h.rej.by_reason == {"invalid": 4}
+    assert [c.vx for c in h.inbound.take(7)] == [1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 3.0]

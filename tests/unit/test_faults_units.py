@@ -10,7 +10,7 @@ import pytest
 from arena.config import MatchConfig
 from arena.match.faults import Fault, blame, lapses, outcome
 from arena.schemas.messages import Cmd, EngineEvents, Order, RefCommand, Referee, Summary, TeamPose, encode
-from arena.schemas.validate import nonfinite, safe_default, suspect
+from arena.schemas.validate import nonfinite, safe_default, starts_nonfinite, suspect
 from arena.sim.physics import Physics
 from tests.unit.test_lockstep import Harness
 
@@ -156,6 +156,27 @@ def test_the_one_scan_finds_exactly_the_four_suspect_pairs():
             raw = bytes([0x93, a, b, 0x01])
             assert suspect(raw) == any(p in raw for p in pairs), raw
     assert not suspect(b"") and suspect(msgspec.msgpack.encode([1.0, float("-inf")]))
+
+
+def test_a_suspect_pair_starts_a_non_finite_value_only_if_the_exponents_next_bits_are_set_too():
+    """starts_nonfinite: a float64's exponent is 11 bits (0xf0 and over next), a float32's 8 (0x80 and over)."""
+    import struct
+
+    for head, least in ((0xCB, 0xF0), (0xCA, 0x80)):
+        for first in (0x7F, 0xFF):
+            for b in range(256):
+                raw = bytes([0x81, 0xA1, 0x78, head, first, b, 0, 0, 0, 0, 0, 0, 0])
+                assert starts_nonfinite(raw) == (b >= least), raw
+    for x in (math.nan, math.inf, -math.inf, -math.nan):
+        assert starts_nonfinite(struct.pack(">Bd", 0xCB, x)) and starts_nonfinite(struct.pack(">Bf", 0xCA, x))
+    # A float's other bytes hold a pair: not walked, no problem; a pair cut short: walked.
+    clean = encode(Cmd(tick=1, vx=1.0)).replace(struct.pack(">d", 1.0), b"\x3f\xf0\xcb\x7f\x00\x00\x00\x00")
+    assert (
+        suspect(clean)
+        and not starts_nonfinite(clean)
+        and nonfinite(clean, msgspec.msgpack.decode(clean, type=Cmd)) is None
+    )
+    assert starts_nonfinite(b"\x92\x01\xcb\xff")
 
 
 def test_a_token_that_lapsed_under_load_is_no_fault_unless_a_peer_gave_up_on_it():
