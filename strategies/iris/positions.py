@@ -27,27 +27,37 @@ class PositionsMixin:
         defending mode between the ball and our goal, at most 3.2 m out.
         S2 (losing) pushes everyone 1 m up, S3 (winning) 1 m back.
         """
+        # S.clamp, S.dist and S.angle_to written out (the same operations): an off-ball robot asks every tick
         lo, hi = self.plan.area  # type: ignore[union-attr]
         d = order.attack_dir
-        bu = d * ball[0]
-        shift = 1.0 if order.strategy == R.S_OFFENSIVE else -1.0 if order.strategy == R.S_DEFENSIVE else 0.0
+        bx, by = ball
+        bu = d * bx
+        strategy = order.strategy
+        shift = 1.0 if strategy == R.S_OFFENSIVE else -1.0 if strategy == R.S_DEFENSIVE else 0.0
         attacking = self.plan.attacking  # type: ignore[union-attr]
         if self.role == "attacker":
             if attacking:
-                u = S.clamp(bu + 2.5 + shift, max(lo + 1.5, 1.0), hi - 2.0)
-                yy = -1.5 if ball[1] > 0.5 else 1.5 if ball[1] < -0.5 else (1.5 if self.n % 2 else -1.5)
+                ulo = lo + 1.5
+                u, ulo, uhi = bu + 2.5 + shift, 1.0 if 1.0 > ulo else ulo, hi - 2.0  # max(lo + 1.5, 1.0)
+                u = ulo if u < ulo else uhi if u > uhi else u
+                yy = -1.5 if by > 0.5 else 1.5 if by < -0.5 else (1.5 if self.n % 2 else -1.5)
                 return d * u, yy
-            u = S.clamp(bu + 1.5 + shift, lo + 0.5, hi - 1.5)
-            yy = S.clamp(-0.5 * ball[1] + (1.0 if ball[1] <= 0 else -1.0), -2.5, 2.5)
+            u, ulo, uhi = bu + 1.5 + shift, lo + 0.5, hi - 1.5
+            u = ulo if u < ulo else uhi if u > uhi else u
+            yy = -0.5 * by + (1.0 if by <= 0 else -1.0)
+            yy = -2.5 if yy < -2.5 else 2.5 if yy > 2.5 else yy
             return d * u, yy
         if attacking:  # cover behind the play, little moved by the ball: the defender's area is its own half
-            u = S.clamp(self.p.cover_depth + shift, lo + 1.5, hi - 0.3)
-            return d * u, 0.25 * ball[1]
-        own = self.plan.own  # type: ignore[union-attr]
-        r = min(3.2 + max(shift, 0.0), 0.5 * S.dist(own, ball) + 1.0)
-        a = S.angle_to(own, ball)
-        hx, hy = own[0] + r * math.cos(a), own[1] + r * math.sin(a)
-        u = S.clamp(d * hx, lo + 1.0, hi - 0.3)
+            u, ulo, uhi = self.p.cover_depth + shift, lo + 1.5, hi - 0.3
+            u = ulo if u < ulo else uhi if u > uhi else u
+            return d * u, 0.25 * by
+        ox, oy = self.plan.own  # type: ignore[union-attr]
+        r, far = 3.2 + (0.0 if 0.0 > shift else shift), 0.5 * math.hypot(ox - bx, oy - by) + 1.0
+        r = far if far < r else r  # min(3.2 + max(shift, 0.0), 0.5 * S.dist(own, ball) + 1.0)
+        a = math.atan2(by - oy, bx - ox)
+        hx, hy = ox + r * math.cos(a), oy + r * math.sin(a)
+        u, ulo, uhi = d * hx, lo + 1.0, hi - 0.3
+        u = ulo if u < ulo else uhi if u > uhi else u
         return d * u, hy
 
     def support_point(self, order: Order, ball: Vec) -> Vec:
