@@ -98,16 +98,19 @@ class DefenseMixin:
             if self.is_blocker(order, block, d_carrier - 0.2, own):
                 # Within take_distance of the ball, take it, but only from the kick line: straight at the
                 # ball from goal-side; going round the ball to get behind it would open the line to our goal.
-                on_line = abs(wrap_angle(S.angle_to(ball, pos) - S.angle_to(ball, own))) < self.p.take_angle
-                if S.dist(pos, ball) < sp.take_distance and on_line:
+                # S.dist and S.angle_to written out (the same operations): the blocker asks every tick
+                bx, by = ball
+                px, py = pos
+                on_line = abs(wrap_angle(atan2(py - by, px - bx) - atan2(oy - by, ox - bx))) < self.p.take_angle
+                if hypot(px - bx, py - by) < sp.take_distance and on_line:
                     return self.drive(
-                        tick, ball, S.angle_to(pos, ball), self.p.approach_speed, dribbler=True, avoid=False
+                        tick, ball, atan2(by - py, bx - px), self.p.approach_speed, dribbler=True, avoid=False
                     )
-                goal_side = S.dist(pos, own) < d_carrier - 0.2
+                goal_side = hypot(px - ox, py - oy) < d_carrier - 0.2
                 return self.drive(
                     tick,
                     block,
-                    S.angle_to(block, ball),
+                    atan2(by - block[1], bx - block[0]),  # S.angle_to(block, ball)
                     self.p.cruise,
                     dribbler=True,
                     avoid=not goal_side,
@@ -124,7 +127,8 @@ class DefenseMixin:
         if target is None:
             return None
         mark = S.mark_point(target, own, sp.mark_distance)
-        if not self.in_area(order, mark):  # static roles: a mark outside its Fig. 5 area is not its job
+        # static roles: a mark outside its Fig. 5 area is not its job (`in_area` holds for all under dynamic roles)
+        if not self.p.dynamic and not self.in_area(order, mark):
             return None
         return self.drive(tick, mark, atan2(by - mark[1], bx - mark[0]), self.p.cruise)  # S.angle_to(mark, ball)
 
@@ -135,7 +139,7 @@ class DefenseMixin:
         go round it) and `chase_hysteresis` less for the current blocker. Static roles: only robots whose
         Fig. 5 area holds the block point."""
         mem = self.mem
-        if not self.in_area(order, block):
+        if not self.p.dynamic and not self.in_area(order, block):  # dynamic roles: `in_area` holds for all
             mem.blocking = False
             return False
         penalty = self.p.behind_penalty
