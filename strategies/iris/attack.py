@@ -37,18 +37,20 @@ class AttackMixin:
     def basic_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
         """Paper 2, basic strategy: dribble towards the goal, kick from a set distance."""
         aim = (goal[0], self.open_side(goal[0]))
-        if S.dist(pos, goal) < self.p.basic_shoot_distance:
+        px, py = pos  # S.dist and S.angle_to written out below: a holder asks every tick
+        gx, gy = goal
+        if hypot(px - gx, py - gy) < self.p.basic_shoot_distance:
             return self.turn_and_kick(tick, aim, self.p.kick_speed)
-        _, hi = self.my_area(order)
-        if not self.p.dynamic and self.u(order, pos[0]) > hi - 0.3:
-            # A static robot may not leave its area: kick the ball on to the attacker, else at the goal.
+        if not self.p.dynamic and order.attack_dir * px > self.plan.area[1] - 0.3:  # type: ignore[union-attr]
+            # A static robot may not leave its area (self.u > my_area's hi - 0.3): kick the ball on to the
+            # attacker, else at the goal.
             target = self.feed_target(order)
             if target is not None:
                 return self.pass_to(tick, target)
             return self.turn_and_kick(tick, aim, self.p.kick_speed)
         if at_limit:
             return self.turn_and_kick(tick, self.nudge_point(pos, goal, []), self.p.nudge_speed)
-        return self.drive(tick, goal, S.angle_to(pos, goal), self.p.dribble_speed, dribbler=True, avoid=False)
+        return self.drive(tick, goal, atan2(gy - py, gx - px), self.p.dribble_speed, dribbler=True, avoid=False)
 
     def advance_attack(self, tick: int, order: Order, ball: Vec, pos: Vec, goal: Vec, at_limit: bool) -> Cmd:
         """Paper 2, Fig. 7a: feed the attacker, sidestep blockers with the back to them, shoot when clear."""

@@ -135,9 +135,11 @@ class HandlingMixin:
         x, y, _ = self.view.pose  # type: ignore[misc]
         pos = (x, y)
         goal = self.plan.goal  # type: ignore[union-attr]
-        carried = S.dist(pos, self.mem.carry_from) if self.mem.carry_from is not None else 0.0
+        mem = self.mem
+        carry_from = mem.carry_from  # S.dist(pos, carry_from) written out: a holder asks every tick
+        carried = hypot(x - carry_from[0], y - carry_from[1]) if carry_from is not None else 0.0
         at_limit = carried > self.p.carry_limit
-        if (tick - self.mem.hold_since) * self.cfg.timing.dt > self.p.stall_hold:
+        if (tick - mem.hold_since) * self._dt > self.p.stall_hold:  # _dt: cfg.timing.dt
             return self.unstall(tick, order)
         if self.p.advance:
             return self.advance_attack(tick, order, ball, pos, goal, at_limit)

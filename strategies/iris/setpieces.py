@@ -142,4 +142,4 @@ class SetPieceMixin:
         if order.command_team in (self.team, "") or self.role == "goalkeeper":
             return False
         fresh = tick - self.mem.command_since < self._ticks_2s
-        return fresh and S.dist(ball, (order.spot_x, order.spot_y)) < 0.3
+        return fresh and hypot(ball[0] - order.spot_x, ball[1] - order.spot_y) < 0.3  # S.dist(ball, spot)
