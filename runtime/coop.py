@@ -32,7 +32,6 @@ from arena.runtime.lockstep import BATCH_HEADS, Inbound, Waits
 from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.keys import MAX_FRAME_BYTES
 from arena.schemas.messages import Summary
-from arena.schemas.validate import starts_nonfinite
 
 if TYPE_CHECKING:
     from arena.runtime.node import Node
@@ -72,7 +71,7 @@ class CoopChannel:
 class CoopLink:
     """A lockstep link's subscription (`Task.connect`): a frame put is taken in by its `Inbound` at
     once, in the sender's turn, as a `Reactor` takes it in from a receive callback; its parked task
-    (if any) is woken only once the link is ready for the tick it waits on.
+    (if any) is woken only once the link is ready for the tick it waits on (by the `Inbound`, `_link`).
 
     Taking a frame in early is what a distributed receiver does whenever the network is quick: a
     frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
@@ -88,33 +87,20 @@ class CoopLink:
         self._wake = wake
 
     def put(self, payload: bytes) -> None:
-        ib = self._ib
+        """What else is put on the key (`CoopBus.deliver`: a replay's recorded frames, a WAKE): scanned
+        for every float header. A frame taken in wakes the parked task itself (`Inbound._accept_one`)."""
         if payload == WAKE:  # `Inbound.feed`, inlined
-            ib.woken = True
+            self._ib.woken = True
         elif payload and payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
-            self._one(payload, None)  # what `_accept_frame` does with one frame: one call less a frame
+            self._one(payload, None, False)  # what `_accept_frame` does with one frame: one call less a frame
         else:
             self._accept(payload, None)
-        w = self.waiter
-        if w is not None and w.waiting[1] < ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
-            self.waiter = None
-            self._wake(w)
 
-    def put_own(self, payload: bytes) -> None:
-        """`put` for what a publisher of this process put (`CoopBus.putter`): an `Outbound`'s frame,
-        never a WAKE. msgspec writes every float as a float64 (0xcb), so only a 0xcb header before
-        the first byte of a non-finite value can make it suspect (schemas/validate.py `suspect`, which
-        also looks for float32 headers): two `find`s, about half the full scan. A frame they find a
-        pair in is known clean if no pair starts a non-finite value (`starts_nonfinite`)."""
-        if payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
-            clean = payload.find(b"\xcb\x7f") < 0 and payload.find(b"\xcb\xff") < 0 or not starts_nonfinite(payload)
-            self._one(payload, None, clean)
-        else:
-            self._accept(payload, None)
-        w = self.waiter
-        if w is not None and w.waiting[1] < self._ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
-            self.waiter = None
-            self._wake(w)
+    def own(self) -> Callable[[bytes], None]:
+        """What a publisher of this process puts with (`CoopBus.putter`): `Inbound._accept_one(raw)`,
+        for an `Outbound`'s frame (float64s only: a cheaper scan), never a WAKE; it wakes the parked
+        task itself. Straight there: one Python call a frame from `Outbound.send`, not two."""
+        return self._ib._accept_one
 
     def try_recv(self) -> bytes | None:
         return None  # every frame was taken in as it was put
@@ -124,8 +110,8 @@ class CoopLink:
 
 
 def _own_put(ch: CoopChannel | CoopLink) -> Callable[[bytes], None]:
-    """What a publisher of this process puts into `ch` with (`CoopLink.put_own`)."""
-    return ch.put_own if type(ch) is CoopLink else ch.put
+    """What a publisher of this process puts into `ch` with (`CoopLink.own`)."""
+    return ch.own() if type(ch) is CoopLink else ch.put
 
 
 class CoopBus(MemoryBus):
@@ -200,6 +186,7 @@ class CoopBus(MemoryBus):
     def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
         """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
         ch = CoopLink(ib, self.runnable.append)
+        ib._link = ch  # its frames wake the task parked on `ch` (`Inbound._accept_one`)
         self._subscribed(owner, ib.key, ch)
         return ch
 
