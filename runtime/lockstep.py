@@ -451,6 +451,9 @@ class Inbound(Generic[M]):
             return self._refuse(raw, msg, f"tick {tick} after {self.last_seen}")
         else:
             self._next = nxt = self.schedule.first_after(tick)
+            # An ideal link's frame counted here (`decide` counts the others): only real time reads the
+            # count (`counted`), so a lockstep frame pays nothing for it.
+            self.emulator.frames += self._on_time
         self.ready_below = nxt + self._hold
         # A ring by tick: one store a frame (a dict of ticks and a deque of their order took ~1 % of
         # an in-process match).
@@ -467,8 +470,7 @@ class Inbound(Generic[M]):
         else:
             self._prev = msg
         self.last_seen = tick
-        if self._on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
-            self.emulator.frames += 1
+        if self._on_time:  # `decide` inlined for an ideal link: held for `lag` (counted above in real time)
             if msg is not None:
                 at = (tick if now_tick is None else now_tick) + self.lag
                 if at >= self._last_at:  # every frame of an ideal link: no push's compare (~300 instructions)
