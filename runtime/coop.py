@@ -207,7 +207,7 @@ class Task:
     `drive` sees it. A `Driver` (runtime/drivers.py) whose `drive` hands the loop's waits to
     the scheduler; the start barrier is skipped: every node is there by construction."""
 
-    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "summary")
+    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "summary", "node")
 
     cooperative = True
     watchdog = None  # nothing blocks: a deadlock is detected by `drive`, not waited out
@@ -223,6 +223,7 @@ class Task:
         # receivers did to take in its frames (`CoopLink`).
         self.busy_s = 0.0
         self.summary: Summary | None = None  # what `play` played to its end returned
+        self.node: Node | None = None  # the node it plays (`play`)
 
     def drive(self, steps: Waits, before_wait: Callable[[], None] | None) -> Waits:
         # The loop itself, not a generator round it: one level less for each of its resumes.
@@ -240,8 +241,18 @@ class Task:
     def close(self) -> None:
         pass
 
-    def playing(self, node: Node) -> Waits:
-        self.summary = yield from node.playing()
+    def play(self, node: Node) -> None:
+        """Play `node`'s match (`Node.playing`): `steps` is its generator itself, not one delegating to
+        it (each level of `yield from` costs every resume a frame entry), and `summary` is what the
+        node `concluded` once its loop has ended (`end`)."""
+        self.node = node
+        self.steps = node.playing()
+
+    def end(self) -> None:
+        """The loop has ended: the task is done, with its node's summary (if it plays one)."""
+        self.done = True
+        if self.node is not None:
+            self.summary = self.node.concluded
 
 
 class NodeFailed(RuntimeError):
@@ -265,7 +276,7 @@ def _advance(task: Task) -> None:
     """Run `task` until it waits on a link that is not ready (parked on its channel), or ends."""
     task.waiting = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
     if task.waiting is None:
-        task.done = True
+        task.end()
     else:
         task.waiting[0].channel.waiter = task  # type: ignore[union-attr]
 
@@ -283,7 +294,7 @@ def play(
     for node in nodes:
         task = node.driver
         assert isinstance(task, Task), f"{node.name}: a cooperative match's nodes are driven by a coop.Task"
-        task.steps = task.playing(node)
+        task.play(node)
         tasks.append(task)
     deadlocks = drive(bus, tasks, on_idle=on_idle, quit_early=quit_early, meant_to_end=meant_to_end)
     return {t.name: t.summary for t in tasks if t.summary is not None}, deadlocks
@@ -321,7 +332,7 @@ def drive(
             try:  # `_advance(task)`, inlined: one call less a resume
                 task.waiting = w = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
                 if w is None:
-                    task.done = True
+                    task.end()
                 else:
                     w[0].channel.waiter = task  # type: ignore[union-attr]
             except Exception as exc:
