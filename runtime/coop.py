@@ -71,7 +71,7 @@ class CoopChannel:
 class CoopLink:
     """A lockstep link's subscription (`Task.connect`): a frame put is taken in by its `Inbound` at
     once, in the sender's turn, as a `Reactor` takes it in from a receive callback; its parked task
-    (if any) is woken only once the link is ready for the tick it waits on (by the `Inbound`, `_link`).
+    (if any) is woken only once the link is ready for the tick it waits on (by the `Inbound`, `link`).
 
     Taking a frame in early is what a distributed receiver does whenever the network is quick: a
     frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
@@ -186,7 +186,7 @@ class CoopBus(MemoryBus):
     def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
         """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
         ch = CoopLink(ib, self.runnable.append)
-        ib._link = ch  # its frames wake the task parked on `ch` (`Inbound._accept_one`)
+        ib.link = ch  # its frames wake the task parked on `ch` (`Inbound._accept_one`)
         self._subscribed(owner, ib.key, ch)
         return ch
 

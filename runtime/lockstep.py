@@ -330,7 +330,7 @@ class Inbound(Generic[M]):
     __slots__ = (
         "key msg_type _decode channel schedule _period lag link_class sender emulator _dt_ms _rej _watchdog "
         "_is_dead _on_dead _check strict paired last_seen dead _next _hold ready_below woken _pending latest "
-        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time _link __dict__"
+        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time link __dict__"
     ).split()
 
     def __init__(
@@ -392,7 +392,9 @@ class Inbound(Generic[M]):
         self._stood_in = -1  # the last tick whose accepted frame was invalid, stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
         self.waited = -1  # the last k its lockstep loop yielded it with (set by the drivers' `advance`)
-        self._link: Any = None  # its cooperative link (runtime/coop.py `CoopLink`): a frame taken in may wake its task
+        # Its cooperative link (runtime/coop.py `CoopLink`), which takes every frame in as it is put: a frame
+        # taken in may wake its parked task, and a wait has nothing to settle (runtime/drivers.py `advance`).
+        self.link: Any = None
 
     # ------------------------------------------------------------------ intake
     def _accept(self, raw: bytes, now_tick: int | None) -> bool:
@@ -426,7 +428,7 @@ class Inbound(Generic[M]):
 
     def _accept_one(self, raw: bytes, now_tick: int | None = None, clean: bool | None = None) -> bool:
         """One frame's bytes: decode, check the sequence, emulate the link, wake the task parked on
-        its cooperative link (`_link`) once it is ready. `clean`: True, known to hold no non-finite
+        its cooperative link (`link`) once it is ready. `clean`: True, known to hold no non-finite
         float (its batch was scanned); False, scanned for every float header (`validate.suspect`);
         None (`_accept_one(raw)` alone, what a cooperative link's own publishers put, runtime/coop.py
         `CoopLink.own`): an `Outbound`'s frame, where msgspec writes every float as a float64 (0xcb),
@@ -479,7 +481,7 @@ class Inbound(Generic[M]):
                 else:
                     _heappush(self._pending, (at, tick, msg))
             # `_wake`, inlined (a cooperative link's every frame)
-            if (link := self._link) is not None and (w := link.waiter) is not None and w.waiting[1] < self.ready_below:
+            if (link := self.link) is not None and (w := link.waiter) is not None and w.waiting[1] < self.ready_below:
                 link.waiter = None
                 link._wake(w)
             return True
@@ -505,7 +507,7 @@ class Inbound(Generic[M]):
 
     def _wake(self) -> None:
         """Wake the task parked on this link's cooperative channel if it is now ready (`CoopLink`)."""
-        link = self._link
+        link = self.link
         if link is not None:
             w = link.waiter
             if w is not None and w.waiting[1] < self.ready_below:
