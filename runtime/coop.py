@@ -330,7 +330,10 @@ def drive(
             if task.done:
                 continue
             try:  # `_advance(task)`, inlined: one call less a resume
-                task.waiting = w = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
+                # Once its loop has started (a wait given back), what `before_wait` calls is known: the
+                # node's flusher, None (most in process: nothing batched) saving a call every park.
+                w = task.waiting
+                task.waiting = w = advance(task.steps, w, _drained, task.before_wait if w is None else task.flush)  # type: ignore[arg-type]
                 if w is None:
                     task.end()
                 else:
