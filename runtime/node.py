@@ -465,16 +465,18 @@ class Node(Peer):
 
     # ------------------------------------------------------------------- loop
     def loop(self) -> Waits:
-        """The whole match: the lockstep loop under the driver, or the real-time one with `--realtime`."""
+        """The whole match: the lockstep loop under the driver, or the real-time one with `--realtime`.
+        Not a generator itself: it returns the driver's (a cooperative driver's is the lockstep loop
+        itself), so that `playing` resumes it with one level of `yield from` less."""
         if self.cfg.realtime and not self.cooperative:
             self.loop_realtime()
-            return
+            return iter(())
         stop = killed_at(self.cfg, self.name)
         self.skip_below = stop if stop >= 0 else 1 << 62  # see `Node.skip_below`
         steps = self.lockstep()
         if stop >= 0:  # a scenario's `kill` step: the loop ends before acting at that tick
             steps = until(steps, stop)
-        yield from self.driver.drive(steps, self.batch_flusher())
+        return self.driver.drive(steps, self.batch_flusher())
 
     def lockstep(self) -> Waits:
         """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""
