@@ -32,7 +32,6 @@ from arena.runtime.lockstep import BATCH_HEADS, Inbound, Waits
 from arena.runtime.transport import WAKE, MemoryBus, MemoryTransport
 from arena.schemas.keys import MAX_FRAME_BYTES
 from arena.schemas.messages import Summary
-from arena.schemas.validate import starts_nonfinite
 
 if TYPE_CHECKING:
     from arena.runtime.node import Node
@@ -72,7 +71,7 @@ class CoopChannel:
 class CoopLink:
     """A lockstep link's subscription (`Task.connect`): a frame put is taken in by its `Inbound` at
     once, in the sender's turn, as a `Reactor` takes it in from a receive callback; its parked task
-    (if any) is woken only once the link is ready for the tick it waits on.
+    (if any) is woken only once the link is ready for the tick it waits on (by the `Inbound`, `link`).
 
     Taking a frame in early is what a distributed receiver does whenever the network is quick: a
     frame not yet due is held by the link (`Inbound.take`), so the digests are those of draining a
@@ -88,33 +87,20 @@ class CoopLink:
         self._wake = wake
 
     def put(self, payload: bytes) -> None:
-        ib = self._ib
+        """What else is put on the key (`CoopBus.deliver`: a replay's recorded frames, a WAKE): scanned
+        for every float header. A frame taken in wakes the parked task itself (`Inbound._accept_one`)."""
         if payload == WAKE:  # `Inbound.feed`, inlined
-            ib.woken = True
+            self._ib.woken = True
         elif payload and payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
-            self._one(payload, None)  # what `_accept_frame` does with one frame: one call less a frame
+            self._one(payload, None, False)  # what `_accept_frame` does with one frame: one call less a frame
         else:
             self._accept(payload, None)
-        w = self.waiter
-        if w is not None and w.waiting[1] < ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
-            self.waiter = None
-            self._wake(w)
 
-    def put_own(self, payload: bytes) -> None:
-        """`put` for what a publisher of this process put (`CoopBus.putter`): an `Outbound`'s frame,
-        never a WAKE. msgspec writes every float as a float64 (0xcb), so only a 0xcb header before
-        the first byte of a non-finite value can make it suspect (schemas/validate.py `suspect`, which
-        also looks for float32 headers): two `find`s, about half the full scan. A frame they find a
-        pair in is known clean if no pair starts a non-finite value (`starts_nonfinite`)."""
-        if payload[0] not in BATCH_HEADS and len(payload) <= MAX_FRAME_BYTES:
-            clean = payload.find(b"\xcb\x7f") < 0 and payload.find(b"\xcb\xff") < 0 or not starts_nonfinite(payload)
-            self._one(payload, None, clean)
-        else:
-            self._accept(payload, None)
-        w = self.waiter
-        if w is not None and w.waiting[1] < self._ib.ready_below:  # type: ignore[index]  # `ib.ready(k)`
-            self.waiter = None
-            self._wake(w)
+    def own(self) -> Callable[[bytes], None]:
+        """What a publisher of this process puts with (`CoopBus.putter`): `Inbound._accept_one(raw)`,
+        for an `Outbound`'s frame (float64s only: a cheaper scan), never a WAKE; it wakes the parked
+        task itself. Straight there: one Python call a frame from `Outbound.send`, not two."""
+        return self._ib._accept_one
 
     def try_recv(self) -> bytes | None:
         return None  # every frame was taken in as it was put
@@ -124,8 +110,8 @@ class CoopLink:
 
 
 def _own_put(ch: CoopChannel | CoopLink) -> Callable[[bytes], None]:
-    """What a publisher of this process puts into `ch` with (`CoopLink.put_own`)."""
-    return ch.put_own if type(ch) is CoopLink else ch.put
+    """What a publisher of this process puts into `ch` with (`CoopLink.own`)."""
+    return ch.own() if type(ch) is CoopLink else ch.put
 
 
 class CoopBus(MemoryBus):
@@ -200,6 +186,7 @@ class CoopBus(MemoryBus):
     def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
         """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
         ch = CoopLink(ib, self.runnable.append)
+        ib.link = ch  # its frames wake the task parked on `ch` (`Inbound._accept_one`)
         self._subscribed(owner, ib.key, ch)
         return ch
 
@@ -220,7 +207,7 @@ class Task:
     `drive` sees it. A `Driver` (runtime/drivers.py) whose `drive` hands the loop's waits to
     the scheduler; the start barrier is skipped: every node is there by construction."""
 
-    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "summary")
+    __slots__ = ("name", "steps", "flush", "waiting", "done", "busy_s", "summary", "node")
 
     cooperative = True
     watchdog = None  # nothing blocks: a deadlock is detected by `drive`, not waited out
@@ -236,6 +223,7 @@ class Task:
         # receivers did to take in its frames (`CoopLink`).
         self.busy_s = 0.0
         self.summary: Summary | None = None  # what `play` played to its end returned
+        self.node: Node | None = None  # the node it plays (`play`)
 
     def drive(self, steps: Waits, before_wait: Callable[[], None] | None) -> Waits:
         # The loop itself, not a generator round it: one level less for each of its resumes.
@@ -253,8 +241,18 @@ class Task:
     def close(self) -> None:
         pass
 
-    def playing(self, node: Node) -> Waits:
-        self.summary = yield from node.playing()
+    def play(self, node: Node) -> None:
+        """Play `node`'s match (`Node.playing`): `steps` is its generator itself, not one delegating to
+        it (each level of `yield from` costs every resume a frame entry), and `summary` is what the
+        node `concluded` once its loop has ended (`end`)."""
+        self.node = node
+        self.steps = node.playing()
+
+    def end(self) -> None:
+        """The loop has ended: the task is done, with its node's summary (if it plays one)."""
+        self.done = True
+        if self.node is not None:
+            self.summary = self.node.concluded
 
 
 class NodeFailed(RuntimeError):
@@ -278,7 +276,7 @@ def _advance(task: Task) -> None:
     """Run `task` until it waits on a link that is not ready (parked on its channel), or ends."""
     task.waiting = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
     if task.waiting is None:
-        task.done = True
+        task.end()
     else:
         task.waiting[0].channel.waiter = task  # type: ignore[union-attr]
 
@@ -296,7 +294,7 @@ def play(
     for node in nodes:
         task = node.driver
         assert isinstance(task, Task), f"{node.name}: a cooperative match's nodes are driven by a coop.Task"
-        task.steps = task.playing(node)
+        task.play(node)
         tasks.append(task)
     deadlocks = drive(bus, tasks, on_idle=on_idle, quit_early=quit_early, meant_to_end=meant_to_end)
     return {t.name: t.summary for t in tasks if t.summary is not None}, deadlocks
@@ -332,9 +330,12 @@ def drive(
             if task.done:
                 continue
             try:  # `_advance(task)`, inlined: one call less a resume
-                task.waiting = w = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
+                # Once its loop has started (a wait given back), what `before_wait` calls is known: the
+                # node's flusher, None (most in process: nothing batched) saving a call every park.
+                w = task.waiting
+                task.waiting = w = advance(task.steps, w, _drained, task.before_wait if w is None else task.flush)  # type: ignore[arg-type]
                 if w is None:
-                    task.done = True
+                    task.end()
                 else:
                     w[0].channel.waiter = task  # type: ignore[union-attr]
             except Exception as exc:

@@ -86,8 +86,13 @@ def advance(
             ib, k = waiting
             # `ib.ready(k)` of a link is `k < ib.ready_below`: a comparison, not a call. What duck-types
             # a link without keeping that bound (ready_below -1: the engine's pacer, a learner's gate) is asked.
+            # A link on a cooperative `link` took every frame in as it was put: no `settle` call to ask.
             below = ib.ready_below
-            if k >= below and (below >= 0 or not ib.ready(k)) and not settle(ib, k):
+            if (
+                k >= below
+                and (below >= 0 or not ib.ready(k))
+                and (below >= 0 and ib.link is not None or not settle(ib, k))
+            ):
                 if before_wait is not None and not ib.paired:
                     before_wait()
                 return waiting

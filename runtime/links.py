@@ -140,10 +140,11 @@ class LinkEmulator:
         self._rng = rng
         self._bad = False
         self._ideal = model.is_ideal()
-        # Ideal now and for good: `decide` only counts the frame and says 0.0 (its receiver
-        # does that itself, without the call: runtime/lockstep.py `Inbound._accept_one`).
+        # Ideal now and for good: `decide` only counts the frame and says 0.0 (its receiver does
+        # that itself, without the call, and counts it only in real time, where the count is read:
+        # runtime/lockstep.py `Inbound._accept_one`, `counted`).
         self.on_time = self._ideal and not self._changes
-        self.frames = 0
+        self.frames = 0  # frames decided, and a real-time receiver's on an ideal link (`Inbound._accept_one`)
         self.dropped = 0
         self.delays_ms: list[float] = []  # drawn delays of delivered frames (non-ideal links)
 

@@ -51,7 +51,7 @@ from arena.runtime.links import LinkEmulator
 from arena.runtime.transport import WAKE, Channel, Transport
 from arena.schemas.keys import MAX_BATCH, MAX_FRAME_BYTES
 from arena.schemas.messages import Base
-from arena.schemas.validate import SUSPECT_CLASSES, nonfinite, safe_default, suspect
+from arena.schemas.validate import SUSPECT_CLASSES, nonfinite, safe_default, starts_nonfinite, suspect
 
 M = TypeVar("M", bound=Base)
 _heappush, _heappop = heapq.heappush, heapq.heappop
@@ -330,7 +330,7 @@ class Inbound(Generic[M]):
     __slots__ = (
         "key msg_type _decode channel schedule _period lag link_class sender emulator _dt_ms _rej _watchdog "
         "_is_dead _on_dead _check strict paired last_seen dead _next _hold ready_below woken _pending latest "
-        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time __dict__"
+        "_mask _recent _prev _stood_in _dropped_ticks waited _last_at _on_time link __dict__"
     ).split()
 
     def __init__(
@@ -392,6 +392,9 @@ class Inbound(Generic[M]):
         self._stood_in = -1  # the last tick whose accepted frame was invalid, stood in for by a safe default
         self._dropped_ticks: list[int] = []  # send ticks of the frames the link emulation dropped (`counted`)
         self.waited = -1  # the last k its lockstep loop yielded it with (set by the drivers' `advance`)
+        # Its cooperative link (runtime/coop.py `CoopLink`), which takes every frame in as it is put: a frame
+        # taken in may wake its parked task, and a wait has nothing to settle (runtime/drivers.py `advance`).
+        self.link: Any = None
 
     # ------------------------------------------------------------------ intake
     def _accept(self, raw: bytes, now_tick: int | None) -> bool:
@@ -421,11 +424,20 @@ class Inbound(Generic[M]):
             for frame in frames:
                 got = self._accept_one(frame, now_tick, clean) or got
             return got
-        return self._accept_one(raw, now_tick)
+        return self._accept_one(raw, now_tick, False)
 
-    def _accept_one(self, raw: bytes, now_tick: int | None, clean: bool = False) -> bool:
-        """One frame's bytes: decode, check the sequence, emulate the link; `clean`: known to hold no
-        non-finite float (its batch was scanned)."""
+    def _accept_one(self, raw: bytes, now_tick: int | None = None, clean: bool | None = None) -> bool:
+        """One frame's bytes: decode, check the sequence, emulate the link, wake the task parked on
+        its cooperative link (`link`) once it is ready. `clean`: True, known to hold no non-finite
+        float (its batch was scanned); False, scanned for every float header (`validate.suspect`);
+        None (`_accept_one(raw)` alone, what a cooperative link's own publishers put, runtime/coop.py
+        `CoopLink.own`): an `Outbound`'s frame, where msgspec writes every float as a float64 (0xcb),
+        so only a 0xcb header before the first byte of a non-finite value can make it suspect: two
+        `find`s, about half the full scan. Every other caller says True or False."""
+        if clean is None:  # one Python call a frame from an `Outbound` to here, not two
+            if raw[0] in BATCH_HEADS or len(raw) > MAX_FRAME_BYTES:
+                return self._accept_frame(raw, now_tick)
+            clean = raw.find(b"\xcb\x7f") < 0 and raw.find(b"\xcb\xff") < 0 or not starts_nonfinite(raw)
         try:
             msg = self._decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
@@ -441,6 +453,9 @@ class Inbound(Generic[M]):
             return self._refuse(raw, msg, f"tick {tick} after {self.last_seen}")
         else:
             self._next = nxt = self.schedule.first_after(tick)
+            # An ideal link's frame counted here (`decide` counts the others): only real time reads the
+            # count (`counted`), so a lockstep frame pays nothing for it.
+            self.emulator.frames += self._on_time
         self.ready_below = nxt + self._hold
         # A ring by tick: one store a frame (a dict of ticks and a deque of their order took ~1 % of
         # an in-process match).
@@ -457,8 +472,7 @@ class Inbound(Generic[M]):
         else:
             self._prev = msg
         self.last_seen = tick
-        if self._on_time:  # `decide` inlined for an ideal link: counted, held for `lag`
-            self.emulator.frames += 1
+        if self._on_time:  # `decide` inlined for an ideal link: held for `lag` (counted above in real time)
             if msg is not None:
                 at = (tick if now_tick is None else now_tick) + self.lag
                 if at >= self._last_at:  # every frame of an ideal link: no push's compare (~300 instructions)
@@ -466,23 +480,39 @@ class Inbound(Generic[M]):
                     self._pending.append((at, tick, msg))
                 else:
                     _heappush(self._pending, (at, tick, msg))
+            # `_wake`, inlined (a cooperative link's every frame)
+            if (link := self.link) is not None and (w := link.waiter) is not None and w.waiting[1] < self.ready_below:
+                link.waiter = None
+                link._wake(w)
             return True
+        return self._emulate(msg, tick, now_tick)
+
+    def _emulate(self, msg: M | None, tick: int, now_tick: int | None) -> bool:
+        """`_accept_one`'s end on a link that is not ideal: the link emulation decides the frame's fate."""
         em = self.emulator
         delay = em.decide(tick)
         self._on_time = em.on_time  # (a scenario's last link change made it ideal for good)
         if delay is None:
             self._dropped_ticks.append(tick)
-            return True
-        if msg is None:
-            return True
-        base = tick if now_tick is None else now_tick
-        # A frame on time (every frame of an ideal link) is held for `lag`, which is what the formula gives for 0.
-        hold = self.lag if delay == 0.0 else max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
-        at = base + hold
-        if at > self._last_at:
-            self._last_at = at
-        _heappush(self._pending, (at, tick, msg))
+        elif msg is not None:
+            base = tick if now_tick is None else now_tick
+            # A frame on time (every frame of an ideal link) is held for `lag`, which is what the formula gives for 0.
+            hold = self.lag if delay == 0.0 else max(self.lag, math.ceil(delay / self._dt_ms - 1e-9))
+            at = base + hold
+            if at > self._last_at:
+                self._last_at = at
+            _heappush(self._pending, (at, tick, msg))
+        self._wake()
         return True
+
+    def _wake(self) -> None:
+        """Wake the task parked on this link's cooperative channel if it is now ready (`CoopLink`)."""
+        link = self.link
+        if link is not None:
+            w = link.waiter
+            if w is not None and w.waiting[1] < self.ready_below:
+                link.waiter = None
+                link._wake(w)
 
     def _stand_in(self, msg: M, problem: str) -> M | None:
         """An invalid frame in sequence, counted: what stands in for it (schemas/validate.py `safe_default`)."""

@@ -91,7 +91,7 @@ class Peer:
     __slots__ = (
         "pid clock name cfg transport keys log keyring digest rejections silent outbound inbound gone dead "
         "dead_at _alive _alive_cond _work_s last_tick _wall_s play_started _collector on_waiting tap "
-        "_tap_handoff _spoofing_tokens __dict__"
+        "_tap_handoff _spoofing_tokens concluded __dict__"
     ).split()
 
     cooperative = False  # True: played by a cooperative scheduler (runtime/drivers.py `Driver`)
@@ -121,6 +121,7 @@ class Peer:
         self.last_tick = 0
         self._wall_s = 0.0
         self.play_started = 0.0  # [s] Unix time of the start of the loop (start-up measurement only)
+        self.concluded: msgs.Summary | None = None  # what `playing` returned, once it has
         self._collector = False
         # Called with the peers still missing, once a wait at the start barrier
         # passes 1 s and whenever that list changes (`arena run` by hand prints it).
@@ -246,7 +247,8 @@ class Peer:
             self._wall_s = time.perf_counter() - t0
         finally:
             self.close()
-        return self.conclude()
+        self.concluded = summary = self.conclude()
+        return summary
 
     def play(self) -> msgs.Summary:
         """This process's whole match: the start barrier, the loop, the summary (published and returned)."""
@@ -463,16 +465,18 @@ class Node(Peer):
 
     # ------------------------------------------------------------------- loop
     def loop(self) -> Waits:
-        """The whole match: the lockstep loop under the driver, or the real-time one with `--realtime`."""
+        """The whole match: the lockstep loop under the driver, or the real-time one with `--realtime`.
+        Not a generator itself: it returns the driver's (a cooperative driver's is the lockstep loop
+        itself), so that `playing` resumes it with one level of `yield from` less."""
         if self.cfg.realtime and not self.cooperative:
             self.loop_realtime()
-            return
+            return iter(())
         stop = killed_at(self.cfg, self.name)
         self.skip_below = stop if stop >= 0 else 1 << 62  # see `Node.skip_below`
         steps = self.lockstep()
         if stop >= 0:  # a scenario's `kill` step: the loop ends before acting at that tick
             steps = until(steps, stop)
-        yield from self.driver.drive(steps, self.batch_flusher())
+        return self.driver.drive(steps, self.batch_flusher())
 
     def lockstep(self) -> Waits:
         """The lockstep loop: yields (inbound, k) wherever it needs that link's frames due at k."""

@@ -169,7 +169,7 @@ def test_a_straightened_publisher_puts_into_its_one_target_and_a_later_subscribe
 
 
 def test_a_cooperative_link_replaces_a_non_finite_frame_whether_its_own_process_or_another_put_it():
-    """`CoopLink.put_own` (a publisher of this process, msgspec: float64 only) scans for two pairs,
+    """`CoopLink.own` (a publisher of this process, msgspec: float64 only) scans for two pairs,
     `put` (anything else, e.g. a replay's recorded frames) for all four (`validate.suspect`)."""
     import hashlib
     import math
@@ -185,7 +185,7 @@ def test_a_cooperative_link_replaces_a_non_finite_frame_whether_its_own_process_
     coop.connect(h.inbound, coop.MemoryTransport(bus), None, None)
     ob = Outbound(KEY, "robot/a/1/cmd", coop.MemoryTransport(bus).publisher(KEY), hashlib.blake2b())
     bus.straighten([ob])
-    assert ob._put == h.inbound.channel.put_own
+    assert ob._put == h.inbound.channel.own()
     for vx in (1.0, math.nan, -math.inf, math.inf, 2.0):
         ob.send(Cmd(tick=h.inbound.last_seen + 1, vx=vx))
     float32_nan = encode(Cmd(tick=5, vx=1.5)).replace(struct.pack(">Bd", 0xCB, 1.5), b"\xca\x7f\xc0\x00\x00")

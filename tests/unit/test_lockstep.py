@@ -531,6 +531,16 @@ def test_the_counters_count_the_frames_waited_for_not_those_racing_the_end():
         harness.close()
 
 
+def test_in_real_time_an_ideal_link_counts_every_frame_it_takes_in(h):
+    """Real time reports the link emulation's own count (`counted`); an ideal link's frames are
+    counted by the receiver, not by `decide` (in lockstep nobody reads that count)."""
+    h.inbound.strict = False
+    for k in (0, 1, 3, 2, 4):  # tick 2 after 3: refused, not counted
+        h.put(encode(Cmd(tick=k)))
+    h.inbound.poll(5)
+    assert h.inbound.emulator.on_time and h.inbound.counted() == (4, 0, [])
+
+
 def test_a_genuine_frame_after_forged_ones_ahead_is_a_conflict_whatever_its_tick(h, caplog):
     """A stranger without keys (a process started by hand, no MACs to check) puts ticks 0..4
     ahead of the genuine sender: they take the slots, and each genuine frame that follows is
