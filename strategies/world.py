@@ -281,7 +281,7 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _slopes _window_ahead _ahead _seen sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _slopes _window_ahead _ahead _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
         "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
@@ -309,7 +309,7 @@ class RobotView:
         full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
         self._window_ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
-        self._seen: list[Vec] = []  # own opponent detections of this tick
+        self._unexplained: list[Vec] = []  # the order's opponents that no own detection of this tick explains
         self.sensor = sensor
         self.dt = dt
         self.own_ball = BallFilter(p, dt)
@@ -360,7 +360,6 @@ class RobotView:
             if lead > 0.0:
                 if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
                     self._track(sense.tick, seen)
-                self._seen = seen
                 self._now = None  # predicted when asked for (`opponents_now`, `opponents_near`)
         elif order is not None and self.pose is None:
             self._pose_from_order(order)
@@ -378,7 +377,7 @@ class RobotView:
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
             self._take_order(order)
         # The base station's entries that no own detection within merge_radius explains.
-        opponents = seen[:]
+        unexplained: list[Vec] = []
         if order is not None:
             memory = self._opponent_memory - (tick - order.tick)
             # none too old (the usual case): all of them
@@ -391,8 +390,9 @@ class RobotView:
                     if dx * dx + dy * dy < merge2:
                         break
                 else:
-                    opponents.append(xy)
-        self.opponents = opponents
+                    unexplained.append(xy)
+        self.opponents = seen + unexplained
+        self._unexplained = unexplained  # `opponents_near` adds them to its predictions
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
 
@@ -525,7 +525,7 @@ class RobotView:
                         syt += d * (v - my)
                     p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
-        out.extend(self.opponents[len(self._seen) :])
+        out += self._unexplained
         return out
 
     @property

@@ -298,8 +298,8 @@ def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
     rng = random.Random(9)
     for radius in (0.5, 0.3, 1e-3):
         view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams(merge_radius=radius), latency=3)
+        last: list = []  # the detections of the tick before
         for tick in range(1, 400):
-            last = view._seen
             seen = []
             for _ in range(rng.randrange(0, 4)):
                 if last and rng.random() < 0.7:  # near a track's last detection, often at the radius along x
@@ -310,7 +310,7 @@ def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
                     seen.append((rng.uniform(-6, 6), rng.uniform(-4, 4)))
             expected = _tracked_reference(view._tracks, seen, tick, view._merge2, view._window)
             view._track(tick, seen)
-            view._seen = seen
+            last = seen
             assert view._tracks == expected
 
 
