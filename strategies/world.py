@@ -281,7 +281,7 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _slopes _window_ahead _ahead _unexplained sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
         "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
         "_ball_memory __dict__"
@@ -305,9 +305,9 @@ class RobotView:
         for k, (ds, stt) in _CONSECUTIVE.items():
             if k < len(slopes):
                 slopes[k] = (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
-        self._slopes = slopes
         full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
-        self._window_ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
+        ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
+        self._predict = (slopes, self.lead, *ahead)  # what `opponents_near` reads, in one attribute
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._unexplained: list[Vec] = []  # the order's opponents that no own detection of this tick explains
         self.sensor = sensor
@@ -480,14 +480,14 @@ class RobotView:
 
         The same positions in the same order, only fewer: a caller that skips what lies outside that box
         gets the same result from either. A track is predicted only when it may be inside: the regression
-        is most of the view's work (the bound: `_slopes`, plus 1 um for rounding).
+        is most of the view's work (the bound: `_predict`'s slopes, plus 1 um for rounding).
         """
         if self.lead == 0.0:
             return self.opponents
         if self._now is not None:
             return self._now
-        ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
-        window, window_ahead = self._window_ahead
+        slopes, lead, window, window_ahead = self._predict
+        ahead, out = self._ahead, []
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
         for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
