@@ -260,21 +260,6 @@ def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: fl
     return sxt / (stt * dt), syt / (stt * dt)
 
 
-def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
-    """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
-    if not seen:  # nothing to explain them away: all of them
-        out.extend(entries)
-        return
-    for xy in entries:
-        x, y = xy
-        for a, b in seen:
-            dx, dy = x - a, y - b
-            if dx * dx + dy * dy < min2:
-                break
-        else:
-            out.append(xy)
-
-
 class RobotView:
     """One robot's picture of the world for this tick."""
 
@@ -383,7 +368,7 @@ class RobotView:
             # none too old (the usual case): all of them
             entries = self._order_opponent_xy if self._order_opponent_oldest <= memory else self._younger(memory)
             merge2 = self._merge2
-            for xy in entries:  # `_add_unexplained`, inlined: the view's hottest loop
+            for xy in entries:  # the view's hottest loop
                 ex, ey = xy
                 for ox, oy in seen:
                     dx, dy = ex - ox, ey - oy
@@ -535,7 +520,14 @@ class RobotView:
         if mates is None:
             near, merge2 = self._near, self._merge2
             mates = near[:]
-            _add_unexplained(mates, self._mate_xy, near, merge2)
+            for xy in self._mate_xy:  # each with no own detection within merge_radius
+                x, y = xy
+                for a, b in near:
+                    dx, dy = x - a, y - b
+                    if dx * dx + dy * dy < merge2:
+                        break
+                else:
+                    mates.append(xy)
             self._mate_obstacles = mates
         return mates
 
