@@ -268,7 +268,7 @@ class RobotView:
     __slots__ = (
         "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
+        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _tracking _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -318,7 +318,8 @@ class RobotView:
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
         # [m] two points this far apart along one axis are not within merge_radius: d ** 2 >= _merge2 (pow errs
         # by under an ulp, a sum of squares rounds up from either), so `_track` skips such a pair's distance
-        self._merge_far = abs(p.merge_radius) * (1 + 1e-9)
+        self._merge_far = far = abs(p.merge_radius) * (1 + 1e-9)
+        self._tracking = (self._merge2, window, far, -far)  # what `_track` reads, in one attribute
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
@@ -418,9 +419,8 @@ class RobotView:
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
-        old, merge2, window = self._tracks, self._merge2, self._window
-        far = self._merge_far
-        nfar = -far
+        old = self._tracks
+        merge2, window, far, nfar = self._tracking
         tracks: list[Tracked] = []
         for x, y in seen:
             best, best_d2 = None, merge2
