@@ -377,7 +377,7 @@ class RobotView:
                         break
                 else:
                     unexplained.append(xy)
-        self.opponents = seen + unexplained
+        self.opponents = seen + unexplained if unexplained else seen  # `seen` is this tick's own, kept nowhere else
         self._unexplained = unexplained  # `opponents_near` adds them to its predictions
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
