@@ -268,7 +268,7 @@ class RobotView:
     __slots__ = (
         "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _tracking _opponent_memory "
+        "_order_opponent_xy _order_opponents_until _mate_xy _merge2 _merge_far _tracking _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -313,7 +313,7 @@ class RobotView:
         self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
         self._order_opponent_xy: list[Vec] = []  # the positions of the order's P_B entries ...
-        self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
+        self._order_opponents_until = 0  # [tick] ... and the last tick at which none of them is too old
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
         # [m] two points this far apart along one axis are not within merge_radius: d ** 2 >= _merge2 (pow errs
@@ -365,9 +365,12 @@ class RobotView:
         # The base station's entries that no own detection within merge_radius explains.
         unexplained: list[Vec] = []
         if order is not None:
-            memory = self._opponent_memory - (tick - order.tick)
-            # none too old (the usual case): all of them
-            entries = self._order_opponent_xy if self._order_opponent_oldest <= memory else self._younger(memory)
+            # none too old (the usual case): all of them; else those young enough (rare)
+            entries = (
+                self._order_opponent_xy
+                if tick <= self._order_opponents_until
+                else self._younger(self._opponent_memory - (tick - order.tick))
+            )
             merge2 = self._merge2
             for xy in entries:  # the view's hottest loop
                 ex, ey = xy
@@ -415,7 +418,9 @@ class RobotView:
                 if tp.age > oldest:  # never below 0: the filter in `update` then runs, with the same result
                     oldest = tp.age
         self.mates, self._mate_xy = mates, mate_xy
-        self._order_opponent_xy, self._order_opponent_oldest = xys, oldest
+        self._order_opponent_xy = xys
+        # oldest + (tick - order.tick) <= opponent_memory, solved for tick (integers: exact)
+        self._order_opponents_until = order.tick + self._opponent_memory - oldest if order is not None else 0
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""

@@ -333,3 +333,23 @@ def test_the_base_stations_ball_is_the_first_cluster_of_its_detections_bit_for_b
             balls.append((bx, by, 1.0 / (s * s)))
         m.update(10, reports)
         assert m.ball_xy(10) == cluster(balls, math.inf)[0][:2]
+
+
+def test_an_orders_opponents_are_dropped_once_older_than_the_memory_tick_by_tick():
+    """`update` keeps the order's opponents while age + (tick - order.tick) <= opponent_memory, each on its own."""
+    cfg = MatchConfig()
+    p = FusionParams(opponent_memory=10)
+    view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, p, latency=3)
+    ages = (0, 4, 9, 2)
+    order = Order(
+        tick=5,
+        robot=1,
+        own=[TeamPose(robot=1, x=0.0, y=0.0)],
+        opponents=[TeamPose(robot=-1, x=float(i), y=1.0, age=a) for i, a in enumerate(ages)],
+    )
+    kept = []
+    for tick in range(5, 20):
+        view.update(tick, None, order)
+        assert view.opponents == [(float(i), 1.0) for i, a in enumerate(ages) if a + tick - 5 <= 10]
+        kept.append(len(view.opponents))
+    assert kept[0] == 4 and kept[-1] == 0 and len(set(kept)) == 5  # every age leaves at its own tick
