@@ -325,7 +325,8 @@ def keeper_target(ball: Vec, ball_vel: Vec, own_goal_x: float, goal_half: float,
         y = clamp(ball[1], -lim, lim)
     else:
         y = ball[1] * p.keeper_depth / abs(dx)
-    return (line_x, clamp(y, -lim, lim)), False
+    low = -lim  # `clamp(y, -lim, lim)` inline: the goalkeeper asks every tick
+    return (line_x, low if y < low else lim if y > lim else y), False
 
 
 def pass_speed(distance: float, arrive: float, decel: float, max_speed: float) -> float:

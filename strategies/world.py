@@ -260,30 +260,15 @@ def _regression_velocity(ts: list[int], xs: list[float], ys: list[float], dt: fl
     return sxt / (stt * dt), syt / (stt * dt)
 
 
-def _add_unexplained(out: list[Vec], entries: list[Vec], seen: list[Vec], min2: float) -> None:
-    """Append to `out` each of `entries` with no point of `seen` within sqrt(min2) [m]."""
-    if not seen:  # nothing to explain them away: all of them
-        out.extend(entries)
-        return
-    for xy in entries:
-        x, y = xy
-        for a, b in seen:
-            dx, dy = x - a, y - b
-            if dx * dx + dy * dy < min2:
-                break
-        else:
-            out.append(xy)
-
-
 class RobotView:
     """One robot's picture of the world for this tick."""
 
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _slopes _window_ahead _ahead _seen sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
-        "_order_opponent_xy _order_opponent_oldest _mate_xy _merge2 _merge_far _opponent_memory "
+        "_order_opponent_xy _order_opponents_until _mate_xy _merge2 _merge_far _tracking _opponent_memory "
         "_ball_memory __dict__"
     ).split()
 
@@ -305,11 +290,11 @@ class RobotView:
         for k, (ds, stt) in _CONSECUTIVE.items():
             if k < len(slopes):
                 slopes[k] = (ds, stt * dt, sum(map(abs, ds)) / (stt * dt) * self.lead * (1 + 1e-9))
-        self._slopes = slopes
         full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
-        self._window_ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
+        ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
+        self._predict = (slopes, self.lead, *ahead)  # what `opponents_near` reads, in one attribute
         self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
-        self._seen: list[Vec] = []  # own opponent detections of this tick
+        self._unexplained: list[Vec] = []  # the order's opponents that no own detection of this tick explains
         self.sensor = sensor
         self.dt = dt
         self.own_ball = BallFilter(p, dt)
@@ -328,12 +313,13 @@ class RobotView:
         self._mate_obstacles: list[Vec] | None = []  # see `mate_obstacles`
         self._order: Order | None = None
         self._order_opponent_xy: list[Vec] = []  # the positions of the order's P_B entries ...
-        self._order_opponent_oldest = 0  # [ticks] ... and the largest age among them
+        self._order_opponents_until = 0  # [tick] ... and the last tick at which none of them is too old
         self._mate_xy: list[Vec] = []  # the teammates' positions of the order
         self._merge2 = p.merge_radius * p.merge_radius  # [m^2]
         # [m] two points this far apart along one axis are not within merge_radius: d ** 2 >= _merge2 (pow errs
         # by under an ulp, a sum of squares rounds up from either), so `_track` skips such a pair's distance
-        self._merge_far = abs(p.merge_radius) * (1 + 1e-9)
+        self._merge_far = far = abs(p.merge_radius) * (1 + 1e-9)
+        self._tracking = (self._merge2, window, far, -far)  # what `_track` reads, in one attribute
         self._opponent_memory = p.opponent_memory
         self._ball_memory = p.ball_memory
 
@@ -360,7 +346,6 @@ class RobotView:
             if lead > 0.0:
                 if seen or self._tracks:  # nothing seen now or before (a quarter of the ticks): no tracks, as they were
                     self._track(sense.tick, seen)
-                self._seen = seen
                 self._now = None  # predicted when asked for (`opponents_now`, `opponents_near`)
         elif order is not None and self.pose is None:
             self._pose_from_order(order)
@@ -378,21 +363,25 @@ class RobotView:
         if order is not self._order:  # the teammates and the base station's opponents change with the order only
             self._take_order(order)
         # The base station's entries that no own detection within merge_radius explains.
-        opponents = seen[:]
+        unexplained: list[Vec] = []
         if order is not None:
-            memory = self._opponent_memory - (tick - order.tick)
-            # none too old (the usual case): all of them
-            entries = self._order_opponent_xy if self._order_opponent_oldest <= memory else self._younger(memory)
+            # none too old (the usual case): all of them; else those young enough (rare)
+            entries = (
+                self._order_opponent_xy
+                if tick <= self._order_opponents_until
+                else self._younger(self._opponent_memory - (tick - order.tick))
+            )
             merge2 = self._merge2
-            for xy in entries:  # `_add_unexplained`, inlined: the view's hottest loop
+            for xy in entries:  # the view's hottest loop
                 ex, ey = xy
                 for ox, oy in seen:
                     dx, dy = ex - ox, ey - oy
                     if dx * dx + dy * dy < merge2:
                         break
                 else:
-                    opponents.append(xy)
-        self.opponents = opponents
+                    unexplained.append(xy)
+        self.opponents = seen + unexplained if unexplained else seen  # `seen` is this tick's own, kept nowhere else
+        self._unexplained = unexplained  # `opponents_near` adds them to its predictions
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
 
@@ -429,13 +418,14 @@ class RobotView:
                 if tp.age > oldest:  # never below 0: the filter in `update` then runs, with the same result
                     oldest = tp.age
         self.mates, self._mate_xy = mates, mate_xy
-        self._order_opponent_xy, self._order_opponent_oldest = xys, oldest
+        self._order_opponent_xy = xys
+        # oldest + (tick - order.tick) <= opponent_memory, solved for tick (integers: exact)
+        self._order_opponents_until = order.tick + self._opponent_memory - oldest if order is not None else 0
 
     def _track(self, tick: int, seen: list[Vec]) -> None:
         """Continue each track with the detection nearest its last one (within merge_radius), start new ones."""
-        old, merge2, window = self._tracks, self._merge2, self._window
-        far = self._merge_far
-        nfar = -far
+        old = self._tracks
+        merge2, window, far, nfar = self._tracking
         tracks: list[Tracked] = []
         for x, y in seen:
             best, best_d2 = None, merge2
@@ -480,14 +470,14 @@ class RobotView:
 
         The same positions in the same order, only fewer: a caller that skips what lies outside that box
         gets the same result from either. A track is predicted only when it may be inside: the regression
-        is most of the view's work (the bound: `_slopes`, plus 1 um for rounding).
+        is most of the view's work (the bound: `_predict`'s slopes, plus 1 um for rounding).
         """
         if self.lead == 0.0:
             return self.opponents
         if self._now is not None:
             return self._now
-        ahead, slopes, lead, out = self._ahead, self._slopes, self.lead, []
-        window, window_ahead = self._window_ahead
+        slopes, lead, window, window_ahead = self._predict
+        ahead, out = self._ahead, []
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
         for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
             p = ahead[k]
@@ -525,7 +515,7 @@ class RobotView:
                         syt += d * (v - my)
                     p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
-        out.extend(self.opponents[len(self._seen) :])
+        out += self._unexplained
         return out
 
     @property
@@ -535,7 +525,14 @@ class RobotView:
         if mates is None:
             near, merge2 = self._near, self._merge2
             mates = near[:]
-            _add_unexplained(mates, self._mate_xy, near, merge2)
+            for xy in self._mate_xy:  # each with no own detection within merge_radius
+                x, y = xy
+                for a, b in near:
+                    dx, dy = x - a, y - b
+                    if dx * dx + dy * dy < merge2:
+                        break
+                else:
+                    mates.append(xy)
             self._mate_obstacles = mates
         return mates
 

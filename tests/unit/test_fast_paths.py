@@ -298,8 +298,8 @@ def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
     rng = random.Random(9)
     for radius in (0.5, 0.3, 1e-3):
         view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, FusionParams(merge_radius=radius), latency=3)
+        last: list = []  # the detections of the tick before
         for tick in range(1, 400):
-            last = view._seen
             seen = []
             for _ in range(rng.randrange(0, 4)):
                 if last and rng.random() < 0.7:  # near a track's last detection, often at the radius along x
@@ -310,7 +310,7 @@ def test_tracking_skips_only_pairs_surely_beyond_the_merge_radius():
                     seen.append((rng.uniform(-6, 6), rng.uniform(-4, 4)))
             expected = _tracked_reference(view._tracks, seen, tick, view._merge2, view._window)
             view._track(tick, seen)
-            view._seen = seen
+            last = seen
             assert view._tracks == expected
 
 
@@ -333,3 +333,23 @@ def test_the_base_stations_ball_is_the_first_cluster_of_its_detections_bit_for_b
             balls.append((bx, by, 1.0 / (s * s)))
         m.update(10, reports)
         assert m.ball_xy(10) == cluster(balls, math.inf)[0][:2]
+
+
+def test_an_orders_opponents_are_dropped_once_older_than_the_memory_tick_by_tick():
+    """`update` keeps the order's opponents while age + (tick - order.tick) <= opponent_memory, each on its own."""
+    cfg = MatchConfig()
+    p = FusionParams(opponent_memory=10)
+    view = RobotView("a", 1, cfg.sensor, cfg.timing.dt, p, latency=3)
+    ages = (0, 4, 9, 2)
+    order = Order(
+        tick=5,
+        robot=1,
+        own=[TeamPose(robot=1, x=0.0, y=0.0)],
+        opponents=[TeamPose(robot=-1, x=float(i), y=1.0, age=a) for i, a in enumerate(ages)],
+    )
+    kept = []
+    for tick in range(5, 20):
+        view.update(tick, None, order)
+        assert view.opponents == [(float(i), 1.0) for i, a in enumerate(ages) if a + tick - 5 <= 10]
+        kept.append(len(view.opponents))
+    assert kept[0] == 4 and kept[-1] == 0 and len(set(kept)) == 5  # every age leaves at its own tick
