@@ -31,11 +31,12 @@ class InProcess(msgspec.Struct, frozen=True):
     """Every node of the match on this thread, driven cooperatively (lockstep only)."""
 
     name: ClassVar[str] = "inprocess"
+    last: bool = False  # the process ends with its match (`arena match`): what it leaves is not collected
 
     def play(self, cfg: MatchConfig, *, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
         from arena.match import inprocess
 
-        return inprocess.play_match(cfg, record=record, watch=watch)
+        return inprocess.play_match(cfg, record=record, watch=watch, last=self.last)
 
     def stepped(
         self,

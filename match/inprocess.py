@@ -99,9 +99,10 @@ class Stepped:
         return coop.play(self.bus, nodes, recorder.pump if recorder is not None else None, quit_early, killed)
 
 
-def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = ""):
-    """`record`: the recorder's MCAP path ("" for none); the other nodes get only `cfg.tap`."""
-    with match_heap():  # a worker plays many matches: what this one leaves is collected as it returns
+def _play(cfg: MatchConfig, watch: tuple[str, ...], record: str = "", last: bool = False):
+    """`record`: the recorder's MCAP path ("" for none); the other nodes get only `cfg.tap`;
+    `last`: this process ends with the match (no collection of what it leaves, `match_heap`)."""
+    with match_heap(collect=not last):  # a worker plays many matches: what this one leaves is collected as it returns
         return _play_here(cfg, watch, record)
 
 
@@ -148,9 +149,9 @@ def play_in_process(
     return summaries, frames
 
 
-def play_match(cfg: MatchConfig, record: str = "", watch: tuple[str, ...] = ()) -> MatchResult:
+def play_match(cfg: MatchConfig, record: str = "", watch: tuple[str, ...] = (), last: bool = False) -> MatchResult:
     """Play one match in-process and return the result of `arena match --json`; `record`: an MCAP path;
-    `watch`: keys whose payloads the result keeps (`frames`)."""
+    `watch`: keys whose payloads the result keeps (`frames`); `last`: this process ends with the match."""
     from arena.match.result import Collected, assemble
 
     if cfg.realtime:
@@ -162,7 +163,7 @@ def play_match(cfg: MatchConfig, record: str = "", watch: tuple[str, ...] = ()) 
         raise InprocessError(f"--engine inprocess cannot host {', '.join(others)} (use --engine processes)")
     t_start = time.monotonic()
     launched = time.time()
-    summaries, frames, play, deadlocks, quit_early = _play(cfg, watch=watch, record=record)
+    summaries, frames, play, deadlocks, quit_early = _play(cfg, watch=watch, record=record, last=last)
     lost = {name: "its loop ended while others still waited for it" for name in quit_early}
     got = Collected(summaries=summaries, started=0.0, ended=play, lost=lost)
     result = assemble(cfg.replace(tap=bool(record)), got, time.monotonic() - t_start, record=record)

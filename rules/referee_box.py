@@ -90,6 +90,9 @@ def check_referee(frame: Referee) -> str | None:
 # --------------------------------------------------------------------- state
 @dataclass(frozen=True)
 class RefereeState:
+    """What the referee box holds in force: the stage, the command with its team and spot, the score, fouls,
+    robots sent off, and the ticks that bound the restart."""
+
     stage: str = "PRE_GAME"
     command: str = "STOP"  # the command in force
     command_team: str = ""
@@ -416,6 +419,8 @@ def process(state: RefereeState, change: Change, rules: Rules) -> Result:
 # ------------------------------------------------------------------- the box
 @dataclass(frozen=True)
 class LogEntry:
+    """One change the box made: its id, tick, the change and the states before and after."""
+
     id: int
     tick: int
     change: Change

@@ -115,6 +115,8 @@ def drop_ball_spot(x: float, y: float, cfg: MatchConfig) -> tuple[float, float]:
 # ------------------------------------------------------------------ distances
 @dataclass(frozen=True)
 class KeepAway:
+    """The distance a restart keeps robots from the ball spot, and the teams it binds."""
+
     distance: float  # [m] robot centre to ball spot
     teams: tuple[str, ...]  # the teams that must keep it
 

@@ -36,11 +36,14 @@ A wheel command with the wrong number of wheels for the model gives no motion
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from arena.config import RobotParams
-from arena.navigation import diffdrive, omni3, omni4
 from arena.navigation.saturation import saturation_scale
 from arena.schemas.messages import Cmd
+
+if TYPE_CHECKING:
+    from arena.navigation import diffdrive
 
 Matrix = tuple[tuple[float, ...], ...]
 
@@ -55,6 +58,8 @@ def _diff_matrices(p: diffdrive.DiffDriveParams) -> tuple[Matrix, Matrix]:
     Built column by column from `diffdrive.wheel_speeds` and `diffdrive.body_velocity`,
     so that the engine and the navigation library share one formula.
     """
+    from arena.navigation import diffdrive
+
     (rv, lv), (rw, lw) = diffdrive.wheel_speeds(1.0, 0.0, p), diffdrive.wheel_speeds(0.0, 1.0, p)
     inv = ((rv, 0.0, rw), (lv, 0.0, lw))  # vy moves no wheel
     (vr, wr), (vl, wl) = diffdrive.body_velocity(1.0, 0.0, p), diffdrive.body_velocity(0.0, 1.0, p)
@@ -66,13 +71,20 @@ class Drive:
     """Wheel kinematics and limits of one robot model (`RobotParams.model`)."""
 
     def __init__(self, rp: RobotParams) -> None:
+        # Only the model's own module is imported (each brings a frozen dataclass to build at import).
         if rp.model == "omni3":
+            from arena.navigation import omni3
+
             p3 = omni3.Omni3Params(wheel_radius=rp.wheel_radius, wheel_distance=rp.wheel_base)
             inv, fwd = omni3.inverse_matrix(p3), omni3.forward_matrix(p3)
         elif rp.model == "omni4":
+            from arena.navigation import omni4
+
             p4 = omni4.Omni4Params(wheel_distance=rp.wheel_base, wheel_radii=(rp.wheel_radius,) * 4)
             inv, fwd = omni4.inverse_matrix(p4), omni4.forward_matrix(p4)
         elif rp.model == "diff":
+            from arena.navigation import diffdrive
+
             pd = diffdrive.DiffDriveParams(wheel_radius=rp.wheel_radius, axle_length=2.0 * rp.wheel_base)
             inv, fwd = _diff_matrices(pd)
         else:

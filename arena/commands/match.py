@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
 
 def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = "") -> int:
     """`arena match --engine inprocess`: flags that need separate processes are refused."""
-    from arena.match import MatchError, play
+    from arena.match import InProcess, MatchError, play
 
     for flag, given in (
         ("--realtime", args.realtime),
@@ -133,7 +133,7 @@ def match_inprocess(args: argparse.Namespace, cfg: MatchConfig, record: str = ""
         if given:
             raise ConfigError(f"{flag} needs --engine processes (inprocess plays lockstep in one process)")
     try:
-        result = play(cfg, engine="inprocess", record=record)
+        result = play(cfg, engine=InProcess(last=True), record=record)  # this process ends with the match
     except MatchError as exc:
         print(f"arena match: error: {one_line(str(exc))}", file=sys.stderr)
         return 1

@@ -134,6 +134,8 @@ class ControlWriter:
 
 @dataclass(eq=False)
 class RobotBody:
+    """One robot in the physics: its team and number, its Chipmunk body and the kinematic body that drives it."""
+
     team: str
     n: int
     body: pymunk.Body

@@ -128,3 +128,19 @@ def test_a_match_collects_its_own_cycles_and_leaves_nothing_frozen(monkeypatch):
     assert full == [1, 2], "one young collection before, one full collection (of the match's objects) after"
     assert gc.get_freeze_count() == 0
     assert collect() == 0, "the match's cycles were collected as it returned"
+
+
+def test_a_processs_last_match_leaves_its_cycles_to_the_exit(monkeypatch):
+    """`arena match` ends its process with the match (`InProcess(last=True)`): no full collection
+    after it, which would only free what the exit drops anyway; nothing stays frozen either."""
+    import gc
+
+    from arena.match import InProcess, play
+
+    full = []
+    collect = gc.collect
+    collect()
+    monkeypatch.setattr(gc, "collect", lambda generation=2: full.append(generation) or collect(generation))
+    play(MatchConfig(seed=1, half_time=0.5), engine=InProcess(last=True))
+    assert full == [1], "only the young collection before the match"
+    assert gc.get_freeze_count() == 0
