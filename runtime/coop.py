@@ -274,7 +274,8 @@ def _drained(ib: Inbound[Any], k: int) -> bool:
 
 def _advance(task: Task) -> None:
     """Run `task` until it waits on a link that is not ready (parked on its channel), or ends."""
-    task.waiting = advance(task.steps, task.waiting, _drained, task.before_wait)  # type: ignore[arg-type]
+    w = task.waiting  # once its loop has started, the node's flusher itself, as `drive` passes it
+    task.waiting = advance(task.steps, w, _drained, task.before_wait if w is None else task.flush)  # type: ignore[arg-type]
     if task.waiting is None:
         task.end()
     else:
