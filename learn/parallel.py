@@ -209,6 +209,7 @@ class SoccerParallelEnv(ParallelEnv):
             if goal or over or decided:
                 self.verdict = verdict
                 passed = verdict["passed"]
+        restarts = m.restarts
         out = {
             team: Outcome(
                 m.tick,
@@ -219,9 +220,7 @@ class SoccerParallelEnv(ParallelEnv):
                 m.new_commands,
                 closing[team],
                 passed,
-                tuple(r.name for r in m.restarts if r.team == team),
-                tuple(r.name for r in m.restarts if r.team not in ("", team)),
-                sum(max(0.0, r.banked if team == "a" else -r.banked) for r in m.restarts if r.team not in ("", team)),
+                *(_restarts_of(restarts, team) if restarts else ((), (), 0)),  # most steps: none (no generators)
             )
             for team in ("a", "b")
         }
@@ -355,3 +354,12 @@ class SoccerParallelEnv(ParallelEnv):
                 failures.append({"expectation": e.name, "tick": tick, "detail": detail, "final": final[-1]})
         decided = bool(final) and (all(final) or any(x["final"] for x in failures))  # none: only the time limit
         return {"name": sc.name, "passed": not failures, "failures": failures, "decided": decided}
+
+
+def _restarts_of(restarts: list, team: str) -> tuple[tuple[str, ...], tuple[str, ...], float]:
+    """`Outcome`'s restarts for `team`: its own, the opponents', and what the opponents' charged back."""
+    return (
+        tuple(r.name for r in restarts if r.team == team),
+        tuple(r.name for r in restarts if r.team not in ("", team)),
+        sum(max(0.0, r.banked if team == "a" else -r.banked) for r in restarts if r.team not in ("", team)),
+    )

@@ -192,7 +192,8 @@ def observe(sense: Sense | None, order: Order | None, v: View) -> np.ndarray:
         out += [0.0, 0.0]
         role[len(ROLES)] = 1.0
     out += role
-    return np.clip(np.array(out, dtype=np.float32), v.low, v.high)
+    # np.clip's own arithmetic (NaN kept), without its Python wrapper: ~1 us a step less
+    return np.minimum(np.maximum(np.array(out, dtype=np.float32), v.low), v.high)
 
 
 # The discrete actions: (vx, vy, omega, kick) as fractions of the Box's scales.
