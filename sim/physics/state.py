@@ -27,13 +27,9 @@ class State:
         self._states_of, self._states = s, out
         return out
 
-    def commanded_speed(self, team: str, n: int) -> float:
-        """[m/s] the linear speed robot n's command asks for (within the limits); 0 when parked."""
-        r = self._by_id[(team, n)]
-        return 0.0 if r.parked else math.hypot(r.twist[0], r.twist[1])
-
     def commanded_speeds(self) -> list[float]:
-        """`commanded_speed` of every robot, in `robot_states`' order (the stuck check's one call a period)."""
+        """[m/s] the linear speed each robot's command asks for (within the limits), 0 for a parked one,
+        in `robot_states`' order (the stuck check's one call a period)."""
         out, hypot = [], math.hypot
         for r in self._robots:
             out.append(0.0 if r.parked else hypot(r.twist[0], r.twist[1]))
