@@ -83,8 +83,10 @@ class InPlay:
         self.sorted = False
         self.judged_to = max(self.judged_to, ref.tick)
 
-    def world(self, raw: bytes) -> None:
-        self.balls.append(_ball(raw))
+    def world(self, raw: bytes) -> _Ball:
+        b = _ball(raw)
+        self.balls.append(b)
+        return b
 
     def settle(self, everything: bool) -> tuple[float, list[Restart]]:
         """Team a's in-play progress [m] over the frames judged now (all of them: `everything`), and the
@@ -249,16 +251,15 @@ class SteppedMatch:
             self.attack_dir_a = ref.attack_dir_a
             self.new_commands.extend(ref.commands)
             self.inplay.referee(ref)
-        last = None
+        last = ball = None
         while (raw := self.world_ch.try_recv()) is not None:
             last = raw
-            self.inplay.world(raw)
+            ball = self.inplay.world(raw)  # the ball's fields alone: no robots decoded a step
             if self.keep:
                 self.worlds.append(_world(raw))
-        if last is not None:
+        if ball is not None:
             self.world_raw = last
-            w = self.worlds[-1] if self.keep else _world(last)
-            self.ball = (w.ball_x, w.ball_y)
+            self.ball = (ball.ball_x, ball.ball_y)
         self.progress_a, self.restarts = self.inplay.settle(everything=self.over)
 
     def act(self, actions: dict[str, Any]) -> None:
