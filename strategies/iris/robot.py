@@ -39,6 +39,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         *("area_params", "mem", "role", "order", "plan", "_support", "_restart", "_planned", "_keep_away_until"),
         *("_ticks_2s", "tick", "ball_reach", "_commit_ticks", "_dt", "_defense_area", "_areas", "_drive_hx"),
         *("_drive_hy", "_penalty_half_width", "_near_ball", "_pid", "_guard", "_guard_shrinks", "_static_area"),
+        "_guard_body",
         "__dict__",
     )
 
@@ -79,6 +80,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         # `_heading_pid`: the gains and the bounds of the integral and the output
         self._pid = (pid.k_p, pid.k_i, pid.k_d, -pid.max_integral, pid.max_integral, -pid.max_output, pid.max_output)
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
+        self._guard_body = (-p.push_guard_range, *self._guard, p.contact_range)  # `drive`'s guard of the body
         # `drive` narrows the guard's box to the opponents it may cap: not with a cap that pushes back (below 0)
         self._guard_shrinks = p.contact_push >= 0.0 and p.brake > 0.0
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
