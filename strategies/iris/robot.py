@@ -143,7 +143,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         if areas is None:
             areas = self._areas[key] = R.areas(dict(key), self.area_params)
         d = order.attack_dir
-        # positional, in the fields' order (a dataclass __init__ called with keywords costs twice as much):
+        # positional, in the fields' order (msgspec looks each keyword's name up):
         # role, area, areas, attacking (`R.is_attacking`), team (a new dict with every order, `RobotView.update`),
         # goal and own goal centres
         return Plan(
