@@ -77,7 +77,8 @@ class MotionMixin:
         view, p = self.view, self.p
         x, y, th = view.pose  # type: ignore[misc]
         # target = self.inside(target), inlined
-        gx, gy, hx, hy = target[0], target[1], self._drive_hx, self._drive_hy
+        gx, gy = target
+        hx, hy = self._drive_hx, self._drive_hy
         gx = -hx if gx < -hx else hx if gx > hx else gx
         gy = -hy if gy < -hy else hy if gy > hy else gy
         if self._static_area and not view.has_ball:  # paper 2, Fig. 5: a static robot stays in its area
@@ -93,8 +94,7 @@ class MotionMixin:
             vx, vy = tx * k, ty * k
         if avoid and d > p.direct_range:  # round the robots (a call of its own: most drives go straight)
             vx, vy = self._steer(x, y, gx, gy, vx, vy, extra_obstacles)
-        speed = hypot(vx, vy)
-        cap = (gain or p.k_pos) * d
+        speed, cap = hypot(vx, vy), (gain or p.k_pos) * d
         cap = cap if cap < vmax else vmax  # min(vmax, (gain or k_pos) * d)
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
