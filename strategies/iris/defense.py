@@ -35,9 +35,9 @@ class DefenseMixin:
     def without_ball(self, tick: int, order: Order, ball: Vec) -> Cmd:
         view, p = self.view, self.p
         x, y, _ = view.pose  # type: ignore[misc]
-        pos = (x, y)
         goal = self.plan.goal  # type: ignore[union-attr]
         if (tick - self.mem.lost_at) * self._dt < p.regroup and self.carrier(ball) is not None:
+            pos = (x, y)
             # Lost the ball to a tackle: step back instead of wrestling for it, then challenge again;
             # basic: aside; advance: goal-side, onto the carrier's kick line (Fig. 7b).
             if S.dist(pos, ball) < self.p.regroup_clear:  # first get the body off the ball, straight back
@@ -60,7 +60,7 @@ class DefenseMixin:
                     return self.drive(tick, home, atan2(by - home[1], bx - home[0]), p.cruise)  # S.angle_to(home, ball)
         chaser = self.is_chaser(order, ball)
         if p.advance and not attacking:
-            cmd = self.advance_defense(tick, order, ball, pos, chaser)
+            cmd = self.advance_defense(tick, order, ball, (x, y), chaser)
             if cmd is not None:
                 return cmd
         if chaser:

@@ -60,12 +60,11 @@ class HandlingMixin:
         p = self.p
         sp = p.skills
         x, y, th = self.view.pose  # type: ignore[misc]
-        pos = (x, y)
         bx, by = ball
         to_ball = math.atan2(by - y, bx - x)  # S.angle_to(pos, ball)
         d = hypot(x - bx, y - by)  # S.dist(pos, ball)
         if d < self._near_ball and (
-            S.lined_up(pos, ball, target, sp.capture_lane) or abs(wrap_angle(to_ball - th)) < 0.35
+            S.lined_up((x, y), ball, target, sp.capture_lane) or abs(wrap_angle(to_ball - th)) < 0.35
         ):
             return self.drive(tick, ball, to_ball, p.approach_speed, dribbler=True, avoid=False)
         a = math.atan2(target[1] - by, target[0] - bx)  # S.angle_to(ball, target) ...

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+
+import msgspec
 
 from arena.strategies.iris.params import Vec
 
@@ -26,9 +28,9 @@ class Memory:
     pid_error: float | None = None  # [rad] ... and the latest error (None before the first step)
 
 
-@dataclass(slots=True)
-class Plan:
-    """What follows from one order alone: roles, areas, teammates (worked out once per order; never changed)."""
+class Plan(msgspec.Struct):
+    """What follows from one order alone: roles, areas, teammates (worked out once per order; never changed).
+    A msgspec Struct, not a dataclass: built in C, without an `__init__` frame (a robot builds one every order)."""
 
     role: str
     area: tuple[float, float]  # (u_min, u_max) [m] of this robot
@@ -38,8 +40,8 @@ class Plan:
     goal: Vec  # [m] the centre of the goal we attack ...
     own: Vec  # [m] ... and of ours
     # `mates` and `attackers`, worked out at the first ask (a holder asks every tick)
-    _mates: tuple[Vec, ...] | None = field(default=None, repr=False, compare=False)
-    _attackers: tuple[Vec, ...] | None = field(default=None, repr=False, compare=False)
+    _mates: tuple[Vec, ...] | None = None
+    _attackers: tuple[Vec, ...] | None = None
 
     @property
     def mates(self) -> tuple[Vec, ...]:

@@ -77,12 +77,12 @@ class MotionMixin:
         view, p = self.view, self.p
         x, y, th = view.pose  # type: ignore[misc]
         # target = self.inside(target), inlined
-        gx, gy, hx, hy = target[0], target[1], self._drive_hx, self._drive_hy
+        gx, gy = target
+        hx, hy = self._drive_hx, self._drive_hy
         gx = -hx if gx < -hx else hx if gx > hx else gx
         gy = -hy if gy < -hy else hy if gy > hy else gy
         if self._static_area and not view.has_ball:  # paper 2, Fig. 5: a static robot stays in its area
-            d = self.order.attack_dir  # type: ignore[union-attr]
-            lo, hi = self.plan.area  # type: ignore[union-attr]
+            (lo, hi), d = self.plan.area, self.order.attack_dir  # type: ignore[union-attr]
             u = d * gx
             gx = d * lo if u < lo else d * hi if u > hi else gx
         tx, ty = gx - x, gy - y
@@ -92,27 +92,14 @@ class MotionMixin:
             k = gain * d
             k = (k if k < vmax else vmax) / d  # min(vmax, gain * d) / d
             vx, vy = tx * k, ty * k
-        if avoid and d > p.direct_range:
-            near = p.obstacle_range
-            nnear = -near
-            obstacles = []  # every other robot (view.others(): opponents, then teammates) and the extras within reach
-            for group in (view.opponents, view.mate_obstacles, extra_obstacles):
-                for o in group:
-                    dx = o[0] - x
-                    if nnear < dx < near:
-                        dy = o[1] - y
-                        if nnear < dy < near and hypot(dx, dy) < near:
-                            obstacles.append(o)
-            if obstacles:  # with none, F-SFM's answer is the straight line at cruise speed
-                vx, vy = self.nav((x, y), view.vel, (gx, gy), obstacles, self.nav_params)
-        speed = hypot(vx, vy)
-        cap = (gain or p.k_pos) * d
+        if avoid and d > p.direct_range:  # round the robots (a call of its own: most drives go straight)
+            vx, vy = self._steer(x, y, gx, gy, vx, vy, extra_obstacles)
+        speed, cap = hypot(vx, vy), (gain or p.k_pos) * d
         cap = cap if cap < vmax else vmax  # min(vmax, (gain or k_pos) * d)
         if speed > cap and speed > 0.0:
             vx, vy = vx * cap / speed, vy * cap / speed
-        c, s = cos(th), sin(th)
+        c, s, guard = cos(th), sin(th), self._guard
         has_ball = view.has_ball
-        guard = self._guard
         if vx != 0.0 or vy != 0.0 or guard[3] < 0.0:  # `guard_push` does nothing for a robot not moving
             nx, ny = view.pose_now  # the guard works on the present: the view is `perception_latency` late
             rng = past = guard[0]  # [m] the guard's box; `past`: how far beyond contact it may cap
@@ -132,18 +119,54 @@ class MotionMixin:
                 rng = ball_rng if ball_rng > rng else rng
             near = view.opponents_near(nx, ny, rng)  # those surely outside the box left out
             if near:  # with none near, `_guard_push` leaves the velocity as it is; the opponents farther
-                # than the guard asks for are no change to it (above)
-                vx, vy = _guard_push(near, guard, nx, ny, vx, vy, p.contact_range)
+                # than the guard asks for are no change to it (above).
+                # `_guard_push(near, guard, nx, ny, vx, vy, p.contact_range)` inlined, the same operations (one
+                # call less nearly every tick; its test of a robot not moving holds here: see above)
+                nrng, rng, brake2, guard2, contact_push, contact = self._guard_body
+                for ox, oy in near:
+                    dx, dy = ox - nx, oy - ny
+                    if not (nrng <= dx <= rng and nrng <= dy <= rng):
+                        continue
+                    dd = hypot(dx, dy)
+                    if 1e-6 < dd < rng:
+                        ex, ey = dx / dd, dy / dd
+                        closing = vx * ex + vy * ey
+                        if closing > contact_push:
+                            most = contact_push if dd < contact else sqrt(guard2 + brake2 * (dd - contact))
+                            if closing > most:
+                                vx -= (closing - most) * ex
+                                vy -= (closing - most) * ey
                 if has_ball and (vx != 0.0 or vy != 0.0 or guard[3] < 0.0):
-                    # the held ball is part of the body: do not push it into an opponent either
-                    reach = self.ball_reach
-                    bx, by = nx + reach * c, ny + reach * s
+                    # the held ball is part of the body (its centre ball_reach ahead): do not push it into an
+                    # opponent either
+                    bx, by = nx + self.ball_reach * c, ny + self.ball_reach * s
                     vx, vy = _guard_push(near, guard, bx, by, vx, vy, p.ball_contact_range)
         omega = self._heading_pid(heading, th)
         limit = p.dribble_omega if has_ball or dribbler and d < 0.6 else p.max_omega
         omega = -limit if omega < -limit else limit if omega > limit else omega
         # positional, in the fields' order (msgspec looks each keyword's name up): mode "body", no wheel speeds
         return Cmd(tick, "body", c * vx + s * vy, -s * vx + c * vy, omega, [], dribbler, kick)
+
+    def _steer(
+        self, x: float, y: float, gx: float, gy: float, vx: float, vy: float, extra_obstacles: tuple[Vec, ...]
+    ) -> Vec:
+        """`drive` round the robots: the navigator's velocity from (x, y) to (gx, gy) among every other robot
+        (`view.others()`: opponents, then teammates) and the extras within `obstacle_range`; with none,
+        (vx, vy) as it is (F-SFM's answer would be the straight line at cruise speed)."""
+        view = self.view
+        near = self.p.obstacle_range
+        nnear = -near
+        obstacles = []
+        for group in (view.opponents, view.mate_obstacles, extra_obstacles):
+            for o in group:
+                dx = o[0] - x
+                if nnear < dx < near:
+                    dy = o[1] - y
+                    if nnear < dy < near and hypot(dx, dy) < near:
+                        obstacles.append(o)
+        if obstacles:
+            return self.nav((x, y), view.vel, (gx, gy), obstacles, self.nav_params)
+        return vx, vy
 
     def _heading_pid(self, beta: float, theta: float) -> float:
         """The heading PID (paper 1 eq. 15-16) on the robot's memory: `arena.navigation.pid.update` inlined,

@@ -36,9 +36,10 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
     # instructions; "__dict__" keeps room for attributes a test or a wrapper adds.
     __slots__ = (
         *("cfg", "team", "n", "p", "half_length", "half_width", "goal_half", "view", "nav", "nav_params"),
-        *("area_params", "mem", "role", "order", "plan", "_support", "_restart", "_planned", "_may_keep_away"),
+        *("area_params", "mem", "role", "order", "plan", "_support", "_restart", "_planned", "_keep_away_until"),
         *("_ticks_2s", "tick", "ball_reach", "_commit_ticks", "_dt", "_defense_area", "_areas", "_drive_hx"),
         *("_drive_hy", "_penalty_half_width", "_near_ball", "_pid", "_guard", "_guard_shrinks", "_static_area"),
+        "_guard_body",
         "__dict__",
     )
 
@@ -62,7 +63,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         self._support: tuple[Order | None, Vec] | None = None
         self._restart: tuple[Order, Vec, float, tuple[Vec, ...]] | None = None  # see `position_for_restart`
         self._planned: Order | None = None
-        self._may_keep_away = False  # see `step`
+        self._keep_away_until = -1  # [tick] see `step`
         self._ticks_2s = int(2.0 / cfg.timing.dt)
         self.tick = 0
         self.ball_reach = cfg.robot.size / 2.0 + cfg.ball.radius  # [m] robot centre to a held ball's centre
@@ -79,6 +80,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         # `_heading_pid`: the gains and the bounds of the integral and the output
         self._pid = (pid.k_p, pid.k_i, pid.k_d, -pid.max_integral, pid.max_integral, -pid.max_output, pid.max_output)
         self._guard = (p.push_guard_range, 2.0 * p.brake, p.push_guard * p.push_guard, p.contact_push)
+        self._guard_body = (-p.push_guard_range, *self._guard, p.contact_range)  # `drive`'s guard of the body
         # `drive` narrows the guard's box to the opponents it may cap: not with a cap that pushes back (below 0)
         self._guard_shrinks = p.contact_push >= 0.0 and p.brake > 0.0
         self._static_area = not p.dynamic and ctx.n != 0  # paper 2, Fig. 5: `drive` keeps it in its area
@@ -101,8 +103,10 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
             self.role = order.role or self.role or "defender"
             self.plan = self.make_plan(order)
             self._planned = order
-            # `keep_setpiece_distance` is False for the rest of this order: not the opponents' restart, or the keeper
-            self._may_keep_away = order.command_team not in (self.team, "") and self.role != "goalkeeper"
+            # `keep_setpiece_distance` holds only before this tick (2 s after the command): none for our restart
+            # or the keeper (False for the rest of this order), so that most ticks do not ask it
+            may = order.command_team not in (self.team, "") and self.role != "goalkeeper"
+            self._keep_away_until = mem.command_since + self._ticks_2s if may else -1
         has_ball = view.has_ball
         if not has_ball:
             if mem.carry_from is not None and tick - mem.kicked_at > 2:
@@ -118,7 +122,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         ball = view.ball
         if ball is None:
             return Cmd(tick=tick, omega=1.0)  # look round for the ball
-        if self._may_keep_away and self.keep_setpiece_distance(tick, order, ball):
+        if tick < self._keep_away_until and self.keep_setpiece_distance(tick, order, ball):
             return self.position_for_restart(tick, order)
         if self.role == "goalkeeper":
             return self.goalkeeper(tick, order, ball)
@@ -139,7 +143,7 @@ class IrisRobot(MotionMixin, HandlingMixin, AttackMixin, DefenseMixin, KeeperMix
         if areas is None:
             areas = self._areas[key] = R.areas(dict(key), self.area_params)
         d = order.attack_dir
-        # positional, in the fields' order (a dataclass __init__ called with keywords costs twice as much):
+        # positional, in the fields' order (msgspec looks each keyword's name up):
         # role, area, areas, attacking (`R.is_attacking`), team (a new dict with every order, `RobotView.update`),
         # goal and own goal centres
         return Plan(

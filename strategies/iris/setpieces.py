@@ -13,7 +13,7 @@ the table of rules is docs/rules.md.
 from __future__ import annotations
 
 import math
-from math import atan2, hypot
+from math import atan2, cos, hypot, sin
 
 from arena.navigation.frames import wrap_angle
 from arena.schemas.messages import Cmd, Order
@@ -42,21 +42,26 @@ class SetPieceMixin:
         if ours and self.is_taker(order, spot):
             behind = order.command_team == self.team and order.command == "DROP_BALL"
             gap = self.p.setpiece_behind if order.command_team == self.team or behind else 1.0
-            target = S.behind_point(spot, goal, gap)
-            return self.drive(tick, target, S.angle_to(target, goal), self.p.cruise, extra_obstacles=(spot,))
+            # S.behind_point(spot, goal, gap) and S.angle_to(target, goal) written out (the same operations): the
+            # taker asks every tick of the restart
+            a = atan2(goal[1] - spot[1], goal[0] - spot[0])
+            tx, ty = spot[0] - gap * cos(a), spot[1] - gap * sin(a)
+            return self.drive(tick, (tx, ty), atan2(goal[1] - ty, goal[0] - tx), self.p.cruise, extra_obstacles=(spot,))
         if self.p.advance and order.command_team not in (self.team, "") and order.command in WALL_PIECES:
             target = self.setpiece_defense(order, spot)
             if target is not None:
                 x, y, _ = self.view.pose  # type: ignore[misc]
                 keep = self.p.setpiece_distance + self.p.wall_margin
-                if S.dist((x, y), spot) < keep - 0.1:
+                sx, sy = spot
+                if hypot(x - sx, y - sy) < keep - 0.1:  # S.dist((x, y), spot)
                     # Inside the 2 m circle: out of it first, away from the spot but turned (by up to
                     # `wall_exit_turn`) towards the target, so that it leaves on the way round to it.
                     a = S.angle_to(spot, (x, y)) if S.dist((x, y), spot) > 1e-6 else S.angle_to(spot, target)
                     turn = wrap_angle(S.angle_to(spot, target) - a)
                     a += S.clamp(turn, -self.p.wall_exit_turn, self.p.wall_exit_turn)
                     target = (spot[0] + keep * math.cos(a), spot[1] + keep * math.sin(a))
-                return self.drive(tick, target, S.angle_to(target, spot), self.p.cruise, extra_obstacles=(spot,))
+                heading = atan2(sy - target[1], sx - target[0])  # S.angle_to(target, spot)
+                return self.drive(tick, target, heading, self.p.cruise, extra_obstacles=(spot,))
         home = self.home(order, spot)
         keep = self.p.setpiece_distance + 0.2 if order.command_team != self.team else 1.2
         sx, sy = spot
@@ -83,9 +88,9 @@ class SetPieceMixin:
         """
         own = self.plan.own  # type: ignore[union-attr]
         keep = self.p.setpiece_distance + self.p.wall_margin
-        d = S.dist(spot, own)
+        d = hypot(spot[0] - own[0], spot[1] - own[1])  # S.dist(spot, own), written out: the wall asks every tick
         r = max(min(self.p.skills.retreat_radius - 1.0, d), d - keep)
-        a = S.angle_to(own, spot)
+        a = atan2(spot[1] - own[1], spot[0] - own[0])  # S.angle_to(own, spot)
         wall = self.inside((own[0] + r * math.cos(a), own[1] + r * math.sin(a)), margin=-0.3)
         if self._walls(order, wall):
             return wall
@@ -99,7 +104,7 @@ class SetPieceMixin:
         if found is None:
             return None
         mark = S.mark_point(found, own, self.p.skills.mark_distance)
-        if S.dist(mark, spot) < keep:
+        if hypot(mark[0] - spot[0], mark[1] - spot[1]) < keep:  # S.dist(mark, spot)
             b = S.angle_to(spot, mark)
             mark = (spot[0] + keep * math.cos(b), spot[1] + keep * math.sin(b))
         return self.inside(mark, margin=-0.3)

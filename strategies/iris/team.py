@@ -45,8 +45,17 @@ class IrisTeam:
         if ball is None:
             return "", None
         bx, by = ball
-        opp = min((math.hypot(o.x - bx, o.y - by) for o in self.model.opponents), default=math.inf)  # S.dist
-        own = min((math.hypot(x - bx, y - by) for x, y, _, _ in self.model.own.values()), default=math.inf)
+        opp = own = (
+            math.inf
+        )  # the nearest opponent's and own robot's distances to the ball (plain loops: no generators)
+        for o in self.model.opponents:
+            d = math.hypot(o.x - bx, o.y - by)  # S.dist
+            if d < opp:
+                opp = d
+        for x, y, _, _ in self.model.own.values():
+            d = math.hypot(x - bx, y - by)
+            if d < own:
+                own = d
         if opp < self.p.possession_radius and opp < own:
             return "opponent", None
         return "", None
@@ -61,40 +70,52 @@ class IrisTeam:
         command, cteam, attack_dir = c["command"], c["command_team"], c["attack_dir"]
         possession, holder = self.possession(tick)
         if command == PLAY:
-            xy = {n: (v[0], v[1]) for n, v in self.model.own.items()}
-            u = {n: attack_dir * v[0] for n, v in xy.items()}
+            xy: dict[int, tuple[float, float]] = {}  # each own robot's position, and its x along the attack direction
+            u: dict[int, float] = {}
+            for n, v in self.model.own.items():
+                xy[n] = (v[0], v[1])
+                u[n] = attack_dir * v[0]
             self.roles.update(possession, holder, u, xy)
         elif command in SET_PIECES and cteam:
             # A set piece gives the ball to one side: its team attacks (b), the other defends (b-bar).
             self.roles.update("own" if cteam == self.team else "opponent", None, {}, {})
         role_of = {0: "goalkeeper", **self.roles.roles()}
-        own_poses = [
-            TeamPose(robot=n, x=v[0], y=v[1], theta=v[2], age=tick - v[3], role=role_of.get(n, ""))
-            for n, v in sorted(self.model.own.items())
-        ]
-        opponents = [TeamPose(robot=-1, x=o.x, y=o.y, age=tick - o.tick) for o in self.model.opponents]
+        # The messages below built with positional arguments in their fields' order (msgspec looks each keyword's
+        # name up), their lists in plain loops (a comprehension is a frame of its own).
+        # TeamPose: robot, x, y, theta, age, role
+        own_poses: list[TeamPose] = []
+        for n, v in sorted(self.model.own.items()):
+            own_poses.append(TeamPose(n, v[0], v[1], v[2], tick - v[3], role_of.get(n, "")))
+        opponents: list[TeamPose] = []
+        for o in self.model.opponents:
+            opponents.append(TeamPose(-1, o.x, o.y, 0.0, tick - o.tick))
         ball = self.model.ball_xy(tick)
-        # What every robot's order shares, the robot's own fields left at their defaults. Keywords spelled out, not
-        # `**c`: a call with more than 15 keywords or a `**` goes through a dict, which msgspec takes ~8 x slower.
+        bx, by, ball_age = (ball[0], ball[1], self.model.ball.age(tick)) if ball is not None else (0.0, 0.0, 0)
+        # What every robot's order shares, the robot's own fields at their defaults: tick, robot, command,
+        # command_team, spot_x, spot_y, attack_dir, strategy, role, role_state, own, opponents, ball_valid,
+        # ball_x, ball_y, ball_z, ball_age
         common = Order(
-            tick=tick,
-            robot=0,
-            command=c["command"],
-            command_team=c["command_team"],
-            spot_x=c["spot_x"],
-            spot_y=c["spot_y"],
-            attack_dir=c["attack_dir"],
-            strategy=c["strategy"],
-            own=own_poses,
-            opponents=opponents,
-            ball_valid=ball is not None,
-            ball_x=ball[0] if ball is not None else 0.0,
-            ball_y=ball[1] if ball is not None else 0.0,
-            ball_age=self.model.ball.age(tick) if ball is not None else 0,
+            tick,
+            0,
+            c["command"],
+            c["command_team"],
+            c["spot_x"],
+            c["spot_y"],
+            c["attack_dir"],
+            c["strategy"],
+            "",
+            0,
+            own_poses,
+            opponents,
+            ball is not None,
+            bx,
+            by,
+            0.0,
+            ball_age,
         )
         state = self.roles.state
-        # each robot's order is a copy of `common` made in C (`replace`), cheaper than parsing the keywords again
-        return {
-            n: replace(common, robot=n, role=role_of.get(n, "defender"), role_state=state.get(n, 0))
-            for n in range(self.cfg.robots)
-        }
+        # each robot's order is a copy of `common` made in C (`replace`), cheaper than building it again
+        orders: dict[int, Order] = {}
+        for n in range(self.cfg.robots):
+            orders[n] = replace(common, robot=n, role=role_of.get(n, "defender"), role_state=state.get(n, 0))
+        return orders
