@@ -275,7 +275,9 @@ class EngineNode(Node):
             if not (skip and k < ref_in.ready_below):  # `ref_in.ready(k)`, one call less
                 yield ref_in, k
             t0 = time.perf_counter()
-            self.apply_referee(self.ref_in.take(k), k)
+            frames = ref_in.take(k)
+            if frames or self.director is not None or self.operator is not None:
+                self.apply_referee(frames, k)  # not called for nothing (most ticks: no referee frame)
             self.publish(k)
             self.last_tick = k
             if k == last:
