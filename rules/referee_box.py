@@ -356,6 +356,24 @@ ClockRule = Callable[[RefereeState, int, Rules], Result | None]
 CLOCK_RULES: tuple[ClockRule, ...] = (end_game, first_half, half_time, positioning_over, set_piece_not_taken)
 
 
+def clock_due(st: RefereeState, rules: Rules) -> float:
+    """A tick before which no clock rule fires in `st` (`on_clock` returns it unchanged with no command):
+    at once out of PRE_GAME, never after END_GAME, else the earliest of the last tick, half time in the
+    first half, and the state's start_at and take_by (each rule above tests its own tick against one of them)."""
+    if st.stage == "END_GAME":
+        return math.inf
+    if st.stage == "PRE_GAME":
+        return 0
+    due = rules.total_ticks
+    if st.stage == "FIRST_HALF" and rules.half_ticks < due:
+        due = rules.half_ticks
+    if 0 <= st.start_at < due:
+        due = st.start_at
+    if 0 <= st.take_by < due:
+        due = st.take_by
+    return due
+
+
 def on_clock(st: RefereeState, tick: int, rules: Rules) -> Result:
     if st.stage == "END_GAME":
         return st, []
@@ -451,6 +469,8 @@ class RefereeBox:
         )
         self.log: list[LogEntry] = []
         self.counts: Counter[str] = Counter()
+        self._due_of: RefereeState | None = None  # the state `_due` is `clock_due` of
+        self._due: float = 0
 
     def step(
         self,
@@ -461,6 +481,14 @@ class RefereeBox:
     ) -> list[RefCommand]:
         """The commands of referee tick `tick`: a scenario's and an operator's forced ones, the engine's
         events, then the clock."""
+        if not events and not forced and not operator:
+            # most referee ticks: no event, and no clock rule due in the state in force (it changes
+            # rarely; a follower may set it too, hence the identity test): nothing changes
+            st = self.state
+            if st is not self._due_of:
+                self._due_of, self._due = st, clock_due(st, self.rules)
+            if tick < self._due:
+                return []
         out: list[RefCommand] = []
         # plain loops, no generators: most referee ticks have no forced change and no event
         changes: list[Change] = []

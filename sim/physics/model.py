@@ -166,14 +166,19 @@ class Physics(WorldBuilding, BallFlight, Possession, Events, Placement, State):
 
         The same additions as one per robot per substep, robot by robot: a robot's sum sees them in order.
         """
-        stride, hypot = len(p) // self._substeps, math.hypot
+        n, hypot = len(p), math.hypot
+        stride = n // self._substeps
         for r in self._robots:
             o = r.off
             x0, y0, d = s[o], s[o + 1], r.dist
-            for i in range(o // 3, len(p), stride):  # (x, y) per body, in the snapshot's order
-                x, y = p[i], p[i + 1]
+            i = o // 3  # (x, y) per body, in the snapshot's order
+            while i < n:  # not a for over a range: its iterator costs more here (~10 % of the loop)
+                x = p[i]
+                y = p[i + 1]
                 d += hypot(x - x0, y - y0)
-                x0, y0 = x, y
+                x0 = x
+                y0 = y
+                i += stride
             r.dist = d
 
     def _apply_commands(self, s: list[float]) -> None:

@@ -33,18 +33,19 @@ class StuckWatch:
         if not ph.in_play:
             self.anchor.clear()  # every clock restarts
             return []
-        k, out, anchor = ph.tick, [], self.anchor
+        k, out, anchor, radius, hypot = ph.tick, [], self.anchor, self.radius, math.hypot
         # a parked robot's commanded speed is 0: it is never driven
         for st, speed in zip(ph.robot_states(), ph.commanded_speeds()):
-            t, n, x, y = st[0], st[1], st[2], st[3]
-            r = (t, n)
+            r = (st[0], st[1])
             if speed <= DRIVEN_SPEED:
-                anchor.pop(r, None)
+                if anchor:
+                    anchor.pop(r, None)
                 continue
+            x, y = st[2], st[3]
             a = anchor.get(r)
-            if a is None or math.hypot(x - a[0], y - a[1]) > self.radius:
+            if a is None or hypot(x - a[0], y - a[1]) > radius:
                 anchor[r] = (x, y, k)
             elif k - a[2] >= self.ticks:
-                out.append(BallEvent(kind="ROBOT_STUCK", tick=k, team=t, robot=n, x=x, y=y))
+                out.append(BallEvent(kind="ROBOT_STUCK", tick=k, team=r[0], robot=r[1], x=x, y=y))
                 anchor[r] = (x, y, k)
         return out

@@ -17,6 +17,8 @@ from arena.rules.referee_box import (
     RefereeState,
     Rules,
     check_referee,
+    clock_due,
+    on_clock,
     process,
 )
 from arena.schemas.messages import BallEvent, RefCommand, Referee
@@ -406,3 +408,33 @@ def _frame(**kw) -> Referee:
 )
 def test_check_referee(frame, problem):
     assert check_referee(frame) == problem
+
+
+@pytest.mark.parametrize("stage", ["PRE_GAME", "FIRST_HALF", "HALF_TIME", "SECOND_HALF", "END_GAME"])
+@pytest.mark.parametrize("command", ["START", "THROWIN", "STOP"])
+def test_clock_due_no_clock_rule_fires_before_it(stage, command):
+    """The box skips a quiet referee tick before `clock_due`: `on_clock` must leave the state as it is there."""
+    ticks = [0, 1, 150, 151, HALF - 1, HALF, HALF + 1, END - 1, END, END + 1]
+    for start_at, take_by in [(-1, -1), (150, -1), (-1, 150), (HALF + 1, HALF - 1), (END + 5, END + 5)]:
+        st = RefereeState(stage=stage, command=command, command_team="a", start_at=start_at, take_by=take_by)
+        due = clock_due(st, RULES)
+        fired = [t for t in ticks if on_clock(st, t, RULES) != (st, [])]
+        assert all(t >= due for t in fired), (start_at, take_by, due, fired)
+        assert all(on_clock(st, t, RULES)[0] is st for t in ticks if t < due)
+
+
+def test_box_skips_quiet_ticks_with_the_same_log():
+    """A whole match's clock through `step` (with the skip) logs what `process` tick by tick logs."""
+    box, st, log = RefereeBox(CFG), RefereeState(), []  # log: every command `process` issued
+    goal = BallEvent(kind="GOAL", tick=KICKOFF_WAIT + 3, team="a", x=6.2)
+    for tick in range(0, END + 1, 5):
+        events = [goal] if tick == KICKOFF_WAIT + 5 else []
+        got = box.step(tick, events)
+        want = []
+        for change in [Observed(tick, e) for e in events] + [Clock(tick)]:
+            st, cmds = process(st, change, RULES)
+            want += cmds
+        assert got == want, tick
+        log += want
+    assert box.state == st
+    assert [c for e in box.log for c in e.commands] == log
