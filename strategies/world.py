@@ -45,8 +45,9 @@ from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
-# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y
-Tracked = tuple[float, float, list[int], list[float], list[float]]
+# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y; last, where it is
+# predicted now, once worked out this tick (None before)
+Tracked = list
 
 
 @dataclass(frozen=True)
@@ -266,7 +267,7 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _predict _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
         "_order_opponent_xy _order_opponents_until _mate_xy _merge2 _merge_far _tracking _opponent_memory "
         "_ball_memory __dict__"
@@ -293,7 +294,6 @@ class RobotView:
         full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
         ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
         self._predict = (slopes, self.lead, *ahead)  # what `opponents_near` reads, in one attribute
-        self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._unexplained: list[Vec] = []  # the order's opponents that no own detection of this tick explains
         self.sensor = sensor
         self.dt = dt
@@ -436,10 +436,10 @@ class RobotView:
                     if d2 < best_d2:
                         best, best_d2 = t, d2
             if best is None:
-                tracks.append((x, y, [tick], [x], [y]))
+                tracks.append([x, y, [tick], [x], [y], None])
                 continue
             old.remove(best)
-            _, _, ts, xs, ys = best
+            _, _, ts, xs, ys, _ = best
             n = len(ts)
             if ts[n - 1] >= tick:  # the same sense again: the newer detection replaces it (n - 1: not the slow -1)
                 ts.pop()
@@ -450,9 +450,8 @@ class RobotView:
             ts.append(tick)
             xs.append(x)
             ys.append(y)
-            tracks.append((x, y, ts, xs, ys))
+            tracks.append([x, y, ts, xs, ys, None])
         self._tracks = tracks
-        self._ahead = [None] * len(tracks)
 
     @property
     def opponents_now(self) -> list[Vec]:
@@ -477,17 +476,18 @@ class RobotView:
         if self._now is not None:
             return self._now
         slopes, lead, window, window_ahead = self._predict
-        ahead, out = self._ahead, []
+        out: list[Vec] = []
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
-        for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
-            p = ahead[k]
+        for t in self._tracks:
+            p = t[5]  # the prediction kept in the track: no enumerate, no list of them per tick
             if p is None:
+                lx, ly, ts, xs, ys, _ = t
                 n = len(ts)
                 m = n - 1  # the last detection's index: a negative index takes the interpreter's slow path
                 c = slopes[n] if ts[m] - ts[0] == m else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
-                    p = ahead[k] = (lx + vx * lead, ly + vy * lead)
+                    p = t[5] = (lx + vx * lead, ly + vy * lead)
                     out.append(p)
                     continue
                 # `_regression_velocity` of a consecutive track, inlined: the usual case
@@ -505,7 +505,7 @@ class RobotView:
                     if out_y > reach * (s[m] - s[0]):
                         continue
                 if n == window:  # a full window: the usual case
-                    p = ahead[k] = window_ahead(xs, ys)
+                    p = t[5] = window_ahead(xs, ys)
                 else:
                     mx = sum(xs) / n
                     my = sum(ys) / n
@@ -513,7 +513,7 @@ class RobotView:
                     for d, u, v in zip(ds, xs, ys):
                         sxt += d * (u - mx)
                         syt += d * (v - my)
-                    p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
+                    p = t[5] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
         out += self._unexplained
         return out
