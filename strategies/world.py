@@ -39,6 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 from math import cos, sin
+from operator import itemgetter
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
@@ -58,6 +59,9 @@ class FusionParams:
     vel_smoothing: float = 0.5  # [-] weight of the newest velocity sample (exponential filter)
     track_window: int = 10  # [detections] an opponent's velocity: linear regression over its last this many
     max_ball_speed: float = 10.0  # [m/s] faster jumps between estimates are noise, not motion
+
+
+_WEIGHT = itemgetter(2)  # a cluster's total weight
 
 
 def detection_sigma(sensor: SensorParams, rng_m: float) -> float:
@@ -172,7 +176,9 @@ class TeamModel:
                     sw += w
             self.ball.observe(newest, sx / sw, sy / sw)
         robots, merge = self.robots, self.p.merge_radius
-        fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
+        # heaviest first, ties in cluster order: reverse keeps a sort stable, so the order of key=-weight, without
+        # a Python call per cluster (weights are finite: 1 / s^2 of finite detections)
+        fresh = sorted(cluster(seen, merge), key=_WEIGHT, reverse=True)[:robots]
         tracks: list[Track] = []
         for x, y, _ in fresh:  # a plain loop: for three or so, cheaper than a comprehension
             tracks.append(Track(x, y, tick))
