@@ -67,10 +67,15 @@ class BaseStationNode(Node):
         self.timed(t0)
 
     def lockstep(self) -> Waits:
+        reports, ref_in, skip_below = list(self.report_in.values()), self.ref_in, self.skip_below
         for k in self.order_schedule.ticks(self.cfg.total_ticks):
-            for ib in self.report_in.values():
-                yield ib, k
-            yield self.ref_in, k
+            for ib in reports:
+                ib.waited = k  # a wait not yielded (`Node.skip_below`)
+                if k >= skip_below or k >= ib.ready_below:  # `not ib.ready(k)`, one call less
+                    yield ib, k
+            ref_in.waited = k
+            if k >= skip_below or k >= ref_in.ready_below:
+                yield ref_in, k
             self.act(k)
 
     def loop_realtime(self) -> None:
