@@ -456,7 +456,10 @@ class RobotView:
             ts.append(tick)
             xs.append(x)
             ys.append(y)
-            tracks.append([x, y, ts, xs, ys, None])
+            best[0] = x  # the track itself moved on, not a new list: its last point, no prediction yet
+            best[1] = y
+            best[5] = None
+            tracks.append(best)
         self._tracks = tracks
 
     @property
