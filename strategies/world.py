@@ -38,7 +38,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
-from math import cos, sin
+from math import cos, hypot, sin
 from operator import itemgetter
 
 from arena.config import SensorParams
@@ -96,11 +96,11 @@ class BallFilter:
         if t is None:
             self.track = Track(x, y, tick)
             return
-        if tick > t.tick:
-            gap = tick - t.tick  # [ticks]
+        gap = tick - t.tick  # [ticks]
+        if gap > 0:  # `tick > t.tick`: integers
             span = gap * self.dt
             vx, vy = (x - t.x) / span, (y - t.y) / span
-            if math.hypot(vx, vy) <= self._max_speed and gap <= 10:
+            if hypot(vx, vy) <= self._max_speed and gap <= 10:
                 w, keep, vel = self._w, self._keep, self.vel
                 self.vel = (w * vx + keep * vel[0], w * vy + keep * vel[1])
             else:
@@ -386,7 +386,8 @@ class RobotView:
                         break
                 else:
                     unexplained.append(xy)
-        self.opponents = seen + unexplained if unexplained else seen  # `seen` is this tick's own, kept nowhere else
+        seen += unexplained  # `seen` is this tick's own, kept nowhere else: extended in place, no new list
+        self.opponents = seen
         self._unexplained = unexplained  # `opponents_near` adds them to its predictions
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
