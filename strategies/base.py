@@ -51,15 +51,8 @@ def report_of(
     """A robot's report to its base station: what its `sense` says, or `pose` (its best guess) before any."""
     if sense is None:
         return Report(tick=tick, robot=n, pose=Pose(x=pose[0], y=pose[1], theta=pose[2]), role=role)
-    return Report(
-        tick=tick,
-        robot=n,
-        pose=sense.pose,
-        ball=sense.ball,
-        robots=sense.robots,
-        has_ball=sense.has_ball,
-        role=role,
-    )
+    # positional, in Report's fields' order: msgspec looks each keyword's name up (every robot, every report tick)
+    return Report(tick, n, sense.pose, sense.ball, sense.robots, sense.has_ball, role)
 
 
 @dataclass(frozen=True)

@@ -213,8 +213,7 @@ class RoleAssigner:
             return
         att_lo = self.p.attack[0]
         def_hi = self.p.defense[1]
-        mine = self.state[holder]
-        attacker = is_attacker(mine)
+        attacker = self.state[holder] in (ATTACKING_ATTACKER, DEFENDING_ATTACKER)  # `is_attacker`, inline
         if attacker:
             swap = (captured and u[holder] < def_hi) or u[holder] < att_lo
             out_inp, in_inp = D, A
@@ -222,8 +221,8 @@ class RoleAssigner:
             swap = (captured and u[holder] > att_lo) or u[holder] > def_hi
             out_inp, in_inp = A, D
         partners: list[int] = []  # the robots of the other role with a position (a plain loop: no comprehension frames)
-        for n, s in self.state.items():
-            if is_attacker(s) is not attacker and n in xy:
+        for n, s in self.state.items():  # `is_attacker(s)` inline: a call less per robot
+            if (s in (ATTACKING_ATTACKER, DEFENDING_ATTACKER)) is not attacker and n in xy:
                 partners.append(n)
         if not swap or not partners or holder not in xy:
             return

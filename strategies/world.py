@@ -38,15 +38,17 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
-from math import cos, sin
+from math import cos, hypot, sin
+from operator import itemgetter
 
 from arena.config import SensorParams
 from arena.schemas.messages import Order, Report, Sense
 from arena.schemas.vocabulary import other_team
 
 Vec = tuple[float, float]
-# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y
-Tracked = tuple[float, float, list[int], list[float], list[float]]
+# a track: where it was last seen (x, y), then its detections as columns: their ticks, x and y; last, where it is
+# predicted now, once worked out this tick (None before)
+Tracked = list
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,9 @@ class FusionParams:
     vel_smoothing: float = 0.5  # [-] weight of the newest velocity sample (exponential filter)
     track_window: int = 10  # [detections] an opponent's velocity: linear regression over its last this many
     max_ball_speed: float = 10.0  # [m/s] faster jumps between estimates are noise, not motion
+
+
+_WEIGHT = itemgetter(2)  # a cluster's total weight
 
 
 def detection_sigma(sensor: SensorParams, rng_m: float) -> float:
@@ -91,11 +96,11 @@ class BallFilter:
         if t is None:
             self.track = Track(x, y, tick)
             return
-        if tick > t.tick:
-            gap = tick - t.tick  # [ticks]
+        gap = tick - t.tick  # [ticks]
+        if gap > 0:  # `tick > t.tick`: integers
             span = gap * self.dt
             vx, vy = (x - t.x) / span, (y - t.y) / span
-            if math.hypot(vx, vy) <= self._max_speed and gap <= 10:
+            if hypot(vx, vy) <= self._max_speed and gap <= 10:
                 w, keep, vel = self._w, self._keep, self.vel
                 self.vel = (w * vx + keep * vel[0], w * vy + keep * vel[1])
             else:
@@ -171,7 +176,9 @@ class TeamModel:
                     sw += w
             self.ball.observe(newest, sx / sw, sy / sw)
         robots, merge = self.robots, self.p.merge_radius
-        fresh = sorted(cluster(seen, merge), key=lambda c: -c[2])[:robots]
+        # heaviest first, ties in cluster order: reverse keeps a sort stable, so the order of key=-weight, without
+        # a Python call per cluster (weights are finite: 1 / s^2 of finite detections)
+        fresh = sorted(cluster(seen, merge), key=_WEIGHT, reverse=True)[:robots]
         tracks: list[Track] = []
         for x, y, _ in fresh:  # a plain loop: for three or so, cheaper than a comprehension
             tracks.append(Track(x, y, tick))
@@ -266,7 +273,7 @@ class RobotView:
     # slots: an instance dict of 30 keys or more loses CPython 3.11's shared keys, and every method call
     # on the instance then costs ~250 instructions more
     __slots__ = (
-        "team other n p lead _tracks _now _predict _ahead _unexplained sensor dt own_ball pose vel "
+        "team other n p lead _tracks _now _predict _unexplained sensor dt own_ball pose vel "
         "pose_now omega ball ball_vel ball_age opponents mates has_ball _near _mate_obstacles _order "
         "_order_opponent_xy _order_opponents_until _mate_xy _merge2 _merge_far _tracking _opponent_memory "
         "_ball_memory __dict__"
@@ -293,7 +300,6 @@ class RobotView:
         full = slopes[window] if window > 0 else None  # a full window's: its prediction written out
         ahead = (window, _unrolled_ahead(window, full[1], self.lead)) if full is not None else (-1, None)
         self._predict = (slopes, self.lead, *ahead)  # what `opponents_near` reads, in one attribute
-        self._ahead: list[Vec | None] = []  # per track: its prediction, once worked out this tick
         self._unexplained: list[Vec] = []  # the order's opponents that no own detection of this tick explains
         self.sensor = sensor
         self.dt = dt
@@ -380,7 +386,8 @@ class RobotView:
                         break
                 else:
                     unexplained.append(xy)
-        self.opponents = seen + unexplained if unexplained else seen  # `seen` is this tick's own, kept nowhere else
+        seen += unexplained  # `seen` is this tick's own, kept nowhere else: extended in place, no new list
+        self.opponents = seen
         self._unexplained = unexplained  # `opponents_near` adds them to its predictions
         self._near = near
         self._mate_obstacles = None  # worked out when asked for (`mate_obstacles`)
@@ -436,10 +443,10 @@ class RobotView:
                     if d2 < best_d2:
                         best, best_d2 = t, d2
             if best is None:
-                tracks.append((x, y, [tick], [x], [y]))
+                tracks.append([x, y, [tick], [x], [y], None])
                 continue
             old.remove(best)
-            _, _, ts, xs, ys = best
+            _, _, ts, xs, ys, _ = best
             n = len(ts)
             if ts[n - 1] >= tick:  # the same sense again: the newer detection replaces it (n - 1: not the slow -1)
                 ts.pop()
@@ -450,9 +457,11 @@ class RobotView:
             ts.append(tick)
             xs.append(x)
             ys.append(y)
-            tracks.append((x, y, ts, xs, ys))
+            best[0] = x  # the track itself moved on, not a new list: its last point, no prediction yet
+            best[1] = y
+            best[5] = None
+            tracks.append(best)
         self._tracks = tracks
-        self._ahead = [None] * len(tracks)
 
     @property
     def opponents_now(self) -> list[Vec]:
@@ -477,17 +486,18 @@ class RobotView:
         if self._now is not None:
             return self._now
         slopes, lead, window, window_ahead = self._predict
-        ahead, out = self._ahead, []
+        out: list[Vec] = []
         rng += 1e-6  # [m] beyond every rounding of a prediction (positions on a field: |x|, |y| << 1e6 m)
-        for k, (lx, ly, ts, xs, ys) in enumerate(self._tracks):
-            p = ahead[k]
+        for t in self._tracks:
+            p = t[5]  # the prediction kept in the track: no enumerate, no list of them per tick
             if p is None:
+                lx, ly, ts, xs, ys, _ = t
                 n = len(ts)
                 m = n - 1  # the last detection's index: a negative index takes the interpreter's slow path
                 c = slopes[n] if ts[m] - ts[0] == m else None
                 if c is None:  # fewer than 3 detections, or a gap: the general regression
                     vx, vy = _regression_velocity(ts, xs, ys, self.dt)
-                    p = ahead[k] = (lx + vx * lead, ly + vy * lead)
+                    p = t[5] = (lx + vx * lead, ly + vy * lead)
                     out.append(p)
                     continue
                 # `_regression_velocity` of a consecutive track, inlined: the usual case
@@ -505,7 +515,7 @@ class RobotView:
                     if out_y > reach * (s[m] - s[0]):
                         continue
                 if n == window:  # a full window: the usual case
-                    p = ahead[k] = window_ahead(xs, ys)
+                    p = t[5] = window_ahead(xs, ys)
                 else:
                     mx = sum(xs) / n
                     my = sum(ys) / n
@@ -513,7 +523,7 @@ class RobotView:
                     for d, u, v in zip(ds, xs, ys):
                         sxt += d * (u - mx)
                         syt += d * (v - my)
-                    p = ahead[k] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
+                    p = t[5] = (lx + sxt / stt_dt * lead, ly + syt / stt_dt * lead)
             out.append(p)
         out += self._unexplained
         return out
