@@ -432,12 +432,18 @@ class Inbound(Generic[M]):
         float (its batch was scanned); False, scanned for every float header (`validate.suspect`);
         None (`_accept_one(raw)` alone, what a cooperative link's own publishers put, runtime/coop.py
         `CoopLink.own`): an `Outbound`'s frame, where msgspec writes every float as a float64 (0xcb),
-        so only a 0xcb header before the first byte of a non-finite value can make it suspect: two
-        `find`s, about half the full scan. Every other caller says True or False."""
+        so only a 0xcb header before the first byte of a non-finite value can make it suspect. Every
+        other caller says True or False."""
         if clean is None:  # one Python call a frame from an `Outbound` to here, not two
             if raw[0] in BATCH_HEADS or len(raw) > MAX_FRAME_BYTES:
                 return self._accept_frame(raw, now_tick)
-            clean = raw.find(b"\xcb\x7f") < 0 and raw.find(b"\xcb\xff") < 0 or not starts_nonfinite(raw)
+            # A pair only where its second byte is in the frame at all: `int in bytes` is one memchr,
+            # no method call; `partition` (one argument, no parsing) looks for the pair only then.
+            clean = (
+                (0x7F not in raw or not raw.partition(b"\xcb\x7f")[1])
+                and (0xFF not in raw or not raw.partition(b"\xcb\xff")[1])
+                or not starts_nonfinite(raw)
+            )
         try:
             msg = self._decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
