@@ -470,7 +470,12 @@ class Inbound(Generic[M]):
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
         # `suspect(raw)` inlined (one call less a frame; b"\x01\x02" is its SUSPECT_PAIR, a constant here)
-        problem = None if clean or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0 else nonfinite(raw, msg)
+        # A payload without either first byte of a non-finite value is not translated (one memchr each).
+        problem = (
+            None
+            if clean or 0x7F not in raw and 0xFF not in raw or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0
+            else nonfinite(raw, msg)
+        )
         if problem is None and self._check is not None:
             problem = self._check(msg)
         if problem:

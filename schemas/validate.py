@@ -90,7 +90,9 @@ def suspect(raw: bytes) -> bool:
     """Whether `raw` holds a msgpack float header followed by the first byte of a non-finite value."""
     # `find`, not `in`: bytes' `in` first tries its operand as an integer, and builds and drops a
     # TypeError's message for every other operand (~1,800 instructions a call, more than the scan).
-    return raw.translate(SUSPECT_CLASSES).find(SUSPECT_PAIR) >= 0
+    # An integer's `in` is one memchr: a payload without either first byte is not translated at all
+    # (about half the frames of a match; ~4.1 k -> 2.5 k instructions a frame).
+    return (0x7F in raw or 0xFF in raw) and raw.translate(SUSPECT_CLASSES).find(SUSPECT_PAIR) >= 0
 
 
 def safe_default(msg: Base, previous: Base | None) -> Base | None:
