@@ -7,8 +7,8 @@ Two things, for every message type:
   The raw payload is scanned first for the msgpack float headers of a
   non-finite value (0xcb/0xca then the first byte of an all-ones exponent);
   only a payload where such a pair does start one (`starts_nonfinite`) is
-  walked field by field, so a clean frame costs one translation and one byte
-  scan.
+  walked field by field, so a clean frame costs two byte searches (no 0x7f or
+  0xff at all), or one translation and one byte scan.
 * `safe_default(msg, previous)`: what an in-sequence frame that failed
   validation is replaced by, so its link still advances and nobody waits for a
   frame that will never come (docs/architecture.md, "Faults"): a `cmd` stops
