@@ -439,12 +439,14 @@ class Inbound(Generic[M]):
         `CoopLink.own`): an `Outbound`'s frame, where msgspec writes every float as a float64 (0xcb),
         so only a 0xcb header before the first byte of a non-finite value can make it suspect. Every
         other caller says True or False."""
+        scanned = clean
         if clean is None:  # one Python call a frame from an `Outbound` to here, not two
-            if raw[0] in BATCH_HEADS or len(raw) > MAX_FRAME_BYTES:
+            if len(raw) > MAX_FRAME_BYTES:
                 return self._accept_frame(raw, now_tick)
             # A pair only where its second byte is in the frame at all: `int in bytes` is one memchr,
             # no method call; `partition` (one argument, no parsing) looks for the pair only then.
-            clean = (
+            # (A batch, from an `Outbound` that batches, is known by its failing decode: below.)
+            scanned = (
                 (0x7F not in raw or not raw.partition(b"\xcb\x7f")[1])
                 and (0xFF not in raw or not raw.partition(b"\xcb\xff")[1])
                 or not starts_nonfinite(raw)
@@ -453,8 +455,7 @@ class Inbound(Generic[M]):
         try:
             msg = decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-            self._rej.reject(self.key, "malformed", str(exc)[:120])
-            return False
+            return self._undecoded(raw, now_tick, clean, exc)
         tick = msg.tick
         if self.strict:  # lockstep: exactly the next scheduled tick
             if tick != self._next:
@@ -479,7 +480,7 @@ class Inbound(Generic[M]):
         # A payload without either first byte of a non-finite value is not translated (one memchr each).
         problem = (
             None
-            if clean or 0x7F not in raw and 0xFF not in raw or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0
+            if scanned or 0x7F not in raw and 0xFF not in raw or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0
             else nonfinite(raw, msg)
         )
         if problem is None and (check := self._check) is not None:
@@ -504,6 +505,14 @@ class Inbound(Generic[M]):
                 wake(w)
             return True
         return self._emulate(msg, tick, now_tick)
+
+    def _undecoded(self, raw: bytes, now_tick: int | None, clean: bool | None, exc: Exception) -> bool:
+        """`_accept_one`'s frame that did not decode: an own `Outbound`'s batch (clean None; a frame is a
+        map, never an array) goes to `_accept_frame`; anything else is malformed, counted."""
+        if clean is None and raw and raw[0] in BATCH_HEADS:
+            return self._accept_frame(raw, now_tick)
+        self._rej.reject(self.key, "malformed", str(exc)[:120])
+        return False
 
     def _emulate(self, msg: M | None, tick: int, now_tick: int | None) -> bool:
         """`_accept_one`'s end on a link that is not ideal: the link emulation decides the frame's fate."""
