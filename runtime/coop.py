@@ -185,7 +185,10 @@ class CoopBus(MemoryBus):
 
     def link(self, owner: object, ib: Inbound[Any]) -> CoopLink:
         """Subscribe `ib` to its key: every frame put there is taken in at once (`CoopLink`)."""
-        ch = CoopLink(ib, self.runnable.append)
+        # A task its frame makes ready runs next (the front of the run queue): a consumer takes what
+        # its producer just sent before others run on, which leaves it fewer waits that park it
+        # (3.78 -> 3.42 parks a tick, BD v BS). Any order gives the same frames and digests.
+        ch = CoopLink(ib, self.runnable.appendleft)
         ib.link = ch  # its frames wake the task parked on `ch` (`Inbound._accept_one`)
         self._subscribed(owner, ib.key, ch)
         return ch

@@ -200,7 +200,8 @@ class Latest:
 
     def __call__(self, payload: bytes) -> None:
         self.last = payload
-        self._put(payload)
+        put = self._put  # a local, then called: see `Outbound.send`
+        put(payload)
 
     def get(self) -> bytes | None:
         return self.last
@@ -289,7 +290,10 @@ class Outbound(Generic[M]):
 
     def send(self, msg: M) -> bytes:
         """Encode, digest and put `msg`; returns the payload (for a tap, runtime/tap.py)."""
-        payload = self._encode(msg)
+        # An instance's callable read into a local, then called: `self._encode(msg)` compiles to a
+        # LOAD_METHOD, which never specializes for an attribute (~300 instructions a call more).
+        encode = self._encode
+        payload = encode(msg)
         # The digest takes rel, the payload's length (4 bytes, little-endian), the payload: the
         # first two as one prebuilt header per length (the same bytes, one update less).
         n = len(payload)
@@ -303,7 +307,8 @@ class Outbound(Generic[M]):
         self.sent += 1
         buf = self._buf
         if buf is None:
-            self._put(payload)
+            put = self._put  # (a local: see `encode`)
+            put(payload)
             return payload
         buf.append(payload)
         tick = msg.tick
@@ -432,17 +437,25 @@ class Inbound(Generic[M]):
         float (its batch was scanned); False, scanned for every float header (`validate.suspect`);
         None (`_accept_one(raw)` alone, what a cooperative link's own publishers put, runtime/coop.py
         `CoopLink.own`): an `Outbound`'s frame, where msgspec writes every float as a float64 (0xcb),
-        so only a 0xcb header before the first byte of a non-finite value can make it suspect: two
-        `find`s, about half the full scan. Every other caller says True or False."""
+        so only a 0xcb header before the first byte of a non-finite value can make it suspect. Every
+        other caller says True or False."""
+        scanned = clean
         if clean is None:  # one Python call a frame from an `Outbound` to here, not two
-            if raw[0] in BATCH_HEADS or len(raw) > MAX_FRAME_BYTES:
+            if len(raw) > MAX_FRAME_BYTES:
                 return self._accept_frame(raw, now_tick)
-            clean = raw.find(b"\xcb\x7f") < 0 and raw.find(b"\xcb\xff") < 0 or not starts_nonfinite(raw)
+            # A pair only where its second byte is in the frame at all: `int in bytes` is one memchr,
+            # no method call; `partition` (one argument, no parsing) looks for the pair only then.
+            # (A batch, from an `Outbound` that batches, is known by its failing decode: below.)
+            scanned = (
+                (0x7F not in raw or not raw.partition(b"\xcb\x7f")[1])
+                and (0xFF not in raw or not raw.partition(b"\xcb\xff")[1])
+                or not starts_nonfinite(raw)
+            )
+        decode = self._decode  # a local, then called: see `Outbound.send`
         try:
-            msg = self._decode(raw)
+            msg = decode(raw)
         except (msgspec.DecodeError, msgspec.ValidationError) as exc:
-            self._rej.reject(self.key, "malformed", str(exc)[:120])
-            return False
+            return self._undecoded(raw, now_tick, clean, exc)
         tick = msg.tick
         if self.strict:  # lockstep: exactly the next scheduled tick
             if tick != self._next:
@@ -464,9 +477,14 @@ class Inbound(Generic[M]):
         # validation is counted and replaced by the key's safe default
         # (schemas/validate.py), so nobody waits for a frame that will never come.
         # `suspect(raw)` inlined (one call less a frame; b"\x01\x02" is its SUSPECT_PAIR, a constant here)
-        problem = None if clean or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0 else nonfinite(raw, msg)
-        if problem is None and self._check is not None:
-            problem = self._check(msg)
+        # A payload without either first byte of a non-finite value is not translated (one memchr each).
+        problem = (
+            None
+            if scanned or 0x7F not in raw and 0xFF not in raw or raw.translate(SUSPECT_CLASSES).find(b"\x01\x02") < 0
+            else nonfinite(raw, msg)
+        )
+        if problem is None and (check := self._check) is not None:
+            problem = check(msg)
         if problem:
             msg = self._stand_in(msg, problem)
         else:
@@ -483,9 +501,18 @@ class Inbound(Generic[M]):
             # `_wake`, inlined (a cooperative link's every frame)
             if (link := self.link) is not None and (w := link.waiter) is not None and w.waiting[1] < self.ready_below:
                 link.waiter = None
-                link._wake(w)
+                wake = link._wake  # a local, then called: see `Outbound.send`
+                wake(w)
             return True
         return self._emulate(msg, tick, now_tick)
+
+    def _undecoded(self, raw: bytes, now_tick: int | None, clean: bool | None, exc: Exception) -> bool:
+        """`_accept_one`'s frame that did not decode: an own `Outbound`'s batch (clean None; a frame is a
+        map, never an array) goes to `_accept_frame`; anything else is malformed, counted."""
+        if clean is None and raw and raw[0] in BATCH_HEADS:
+            return self._accept_frame(raw, now_tick)
+        self._rej.reject(self.key, "malformed", str(exc)[:120])
+        return False
 
     def _emulate(self, msg: M | None, tick: int, now_tick: int | None) -> bool:
         """`_accept_one`'s end on a link that is not ideal: the link emulation decides the frame's fate."""

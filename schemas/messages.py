@@ -32,8 +32,12 @@ Radians = Annotated[float, Meta(description="[rad]")]
 RadPerSecond = Annotated[float, Meta(description="[rad/s]")]
 
 
-class Base(Struct, kw_only=True, forbid_unknown_fields=False):
-    """Common base: maps with named fields; unknown fields are ignored (evolution)."""
+class Base(Struct, kw_only=True, forbid_unknown_fields=False, gc=False):
+    """Common base: maps with named fields; unknown fields are ignored (evolution).
+
+    `gc=False`: a message is plain data (numbers, strings, lists of messages), never part of a
+    reference cycle, so the cyclic collector need not track it: ~50 are built and decoded a tick,
+    and a tracked one costs its allocation, its release and the collections it brings about."""
 
 
 class Pose(Base):
