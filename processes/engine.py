@@ -57,17 +57,8 @@ from arena.sim.sensors import NormalStream, sense_every
 
 
 def check_cmd(cmd: Cmd, wheels: int) -> str | None:
-    """Reject commands no robot could mean: non-finite numbers, a wheel count the model has not."""
-    isfinite = math.isfinite
-    if (
-        cmd.mode == "body"
-        and not cmd.wheels
-        and isfinite(cmd.vx)
-        and isfinite(cmd.vy)
-        and isfinite(cmd.omega)
-        and isfinite(cmd.kick_speed)
-    ):
-        return None  # the usual command, passed in one expression (six times a tick)
+    """Reject commands no robot could mean: non-finite numbers, a wheel count the model has not.
+    (`EngineNode.check_cmd` passes the usual command itself, six times a tick, before calling this.)"""
     for name in ("vx", "vy", "omega", "kick_speed"):
         if not math.isfinite(getattr(cmd, name)):
             return f"{name} is not finite"
